@@ -1,0 +1,15 @@
+#pragma once
+// Particle export that ParaView and Blender read: binary little-endian PLY (vertices with properties)
+// and legacy VTK polydata. Fields come from the one field list (sim/fields.h), so a new field is
+// exported without touching this file.
+#include <string>
+
+#include "sphxr/common/status.h"
+#include "sphxr/sim/fields.h"
+
+namespace sphxr::app {
+
+Status WritePly(const std::string& path, const sim::HostFluid& fluid);
+Status WriteVtk(const std::string& path, const sim::HostFluid& fluid);
+
+}  // namespace sphxr::app

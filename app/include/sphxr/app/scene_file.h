@@ -1,0 +1,47 @@
+#pragma once
+// JSON scene files -> sim::SceneSetup. A scene declares only what it uses. Unknown keys are warned
+// about by name; invalid values are refused with the key and the reason, before anything is allocated.
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sphxr/common/status.h"
+#include "sphxr/sim/params.h"
+
+namespace sphxr::app {
+
+/// What the runner and the tests measure on a scene ("probe" section).
+struct DamBreakProbe {
+  float columnWidth = 0.0f;   // a, m: the column's width along x from the back wall
+  float wallX = 0.0f;         // back wall
+  float floorY = 0.0f;
+  float depth = 0.0f;         // tank width along z (for the spray threshold)
+};
+
+/// The surge front and column height ignore spray: a bin one spacing wide belongs to the fluid body
+/// only while it holds at least half a row of particles across the tank's depth (sim::ConnectedExtent).
+inline int DamBreakMinPerBin(const DamBreakProbe& probe, float spacing) {
+  return std::max(2, static_cast<int>(std::lround(0.5f * probe.depth / spacing)));
+}
+
+struct SceneFile {
+  std::string path;
+  std::string name;
+  std::string description;
+  sim::SceneSetup setup;
+  double runTime = 0.0;       // s, default run length ("run.time")
+  int64_t runSteps = 0;       // default step count ("run.steps"), used when runTime == 0
+  std::optional<DamBreakProbe> damBreak;
+  std::vector<std::string> warnings;  // unknown keys, already logged
+};
+
+/// Parses `text` (the content of a scene file). `origin` names it in messages.
+Status ParseScene(const std::string& text, const std::string& origin, SceneFile* out);
+/// Reads and parses a file.
+Status LoadScene(const std::string& path, SceneFile* out);
+/// Applies "key=value" to a solver parameter (the same names as the scene's "solver" section).
+Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment);
+
+}  // namespace sphxr::app

@@ -1,0 +1,127 @@
+#include "sphxr/app/export.h"
+
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <type_traits>
+
+namespace sphxr::app {
+namespace {
+
+struct FileCloser {
+  void operator()(FILE* f) const { std::fclose(f); }
+};
+using File = std::unique_ptr<FILE, FileCloser>;
+
+// Components of one field as floats/ints: Vec4 fields export x, y, z (w is a spare lane).
+template <class T>
+constexpr int Components() {
+  if constexpr (std::is_same_v<T, sim::Vec4>) return 3;
+  else return 1;
+}
+template <class T>
+const char* PlyType() {
+  if constexpr (std::is_same_v<T, sim::Vec4> || std::is_same_v<T, float>) return "float";
+  else if constexpr (std::is_same_v<T, uint32_t>) return "uint";
+  else return "int";
+}
+template <class T>
+const char* VtkType() {
+  if constexpr (std::is_same_v<T, sim::Vec4> || std::is_same_v<T, float>) return "float";
+  else if constexpr (std::is_same_v<T, uint32_t>) return "unsigned_int";
+  else return "int";
+}
+
+uint32_t ToBigEndian(uint32_t v) { return __builtin_bswap32(v); }
+
+template <class T>
+void PutBigEndian(FILE* f, const T& value) {
+  if constexpr (std::is_same_v<T, sim::Vec4>) {
+    const float c[3] = {value.x, value.y, value.z};
+    for (float x : c) {
+      uint32_t u;
+      std::memcpy(&u, &x, 4);
+      u = ToBigEndian(u);
+      std::fwrite(&u, 4, 1, f);
+    }
+  } else {
+    uint32_t u;
+    static_assert(sizeof(T) == 4, "export supports 4-byte scalar fields");
+    std::memcpy(&u, &value, 4);
+    u = ToBigEndian(u);
+    std::fwrite(&u, 4, 1, f);
+  }
+}
+
+template <class T>
+void PutLittleEndian(FILE* f, const T& value) {
+  if constexpr (std::is_same_v<T, sim::Vec4>) {
+    const float c[3] = {value.x, value.y, value.z};
+    std::fwrite(c, 4, 3, f);
+  } else {
+    static_assert(sizeof(T) == 4, "export supports 4-byte scalar fields");
+    std::fwrite(&value, 4, 1, f);
+  }
+}
+
+Status OpenForWrite(const std::string& path, File* out) {
+  out->reset(std::fopen(path.c_str(), "wb"));
+  if (!*out) return Status::Error(path + ": cannot open for writing: " + std::strerror(errno));
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WritePly(const std::string& path, const sim::HostFluid& fluid) {
+  File f;
+  if (Status s = OpenForWrite(path, &f); !s) return s;
+  const size_t n = fluid.size();
+  std::fprintf(f.get(), "ply\nformat binary_little_endian 1.0\ncomment sphxr fluid particles\nelement vertex %zu\n", n);
+  // position first, named x y z so that every reader finds the points.
+#define SPHXR_PLY_HEADER(type, name)                                                                  \
+  if (std::strcmp(#name, "position") == 0) {                                                         \
+    std::fprintf(f.get(), "property float x\nproperty float y\nproperty float z\n");                  \
+  } else if (Components<type>() == 3) {                                                              \
+    for (const char* c : {"x", "y", "z"}) std::fprintf(f.get(), "property float %s_%s\n", #name, c); \
+  } else {                                                                                           \
+    std::fprintf(f.get(), "property %s %s\n", PlyType<type>(), #name);                               \
+  }
+  SPHXR_FLUID_FIELDS(SPHXR_PLY_HEADER)
+#undef SPHXR_PLY_HEADER
+  std::fprintf(f.get(), "end_header\n");
+  for (size_t i = 0; i < n; ++i) {
+#define SPHXR_PLY_VALUE(type, name) PutLittleEndian(f.get(), fluid.name[i]);
+    SPHXR_FLUID_FIELDS(SPHXR_PLY_VALUE)
+#undef SPHXR_PLY_VALUE
+  }
+  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  return Status::Ok();
+}
+
+Status WriteVtk(const std::string& path, const sim::HostFluid& fluid) {
+  File f;
+  if (Status s = OpenForWrite(path, &f); !s) return s;
+  const size_t n = fluid.size();
+  std::fprintf(f.get(), "# vtk DataFile Version 3.0\nsphxr fluid particles\nBINARY\nDATASET POLYDATA\n");
+  std::fprintf(f.get(), "POINTS %zu float\n", n);
+  for (size_t i = 0; i < n; ++i) PutBigEndian(f.get(), fluid.position[i]);
+  std::fprintf(f.get(), "\nVERTICES %zu %zu\n", n, 2 * n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t cell[2] = {ToBigEndian(1u), ToBigEndian(static_cast<uint32_t>(i))};
+    std::fwrite(cell, 4, 2, f.get());
+  }
+  std::fprintf(f.get(), "\nPOINT_DATA %zu\n", n);
+#define SPHXR_VTK_FIELD(type, name)                                                                    \
+  if (std::strcmp(#name, "position") != 0) {                                                          \
+    if (Components<type>() == 3) std::fprintf(f.get(), "VECTORS %s float\n", #name);                  \
+    else std::fprintf(f.get(), "SCALARS %s %s 1\nLOOKUP_TABLE default\n", #name, VtkType<type>());   \
+    for (size_t i = 0; i < n; ++i) PutBigEndian(f.get(), fluid.name[i]);                              \
+    std::fprintf(f.get(), "\n");                                                                      \
+  }
+  SPHXR_FLUID_FIELDS(SPHXR_VTK_FIELD)
+#undef SPHXR_VTK_FIELD
+  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  return Status::Ok();
+}
+
+}  // namespace sphxr::app

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Installs the missing system packages (Debian 12 / Ubuntu 22.04+), configures and builds Release on
+# all cores into build/. Safe to run again: installs nothing that is already there.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(build-essential cmake ninja-build pkg-config libthrust-dev nlohmann-json3-dev libgtest-dev libgmock-dev
+          python3 python3-matplotlib)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "sphxr setup: installing ${missing[*]}"
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+cmake --preset release "$@"
+cmake --build --preset release -j "$(nproc)"

@@ -1,0 +1,32 @@
+#pragma once
+// Measurements on a host copy of the fluid, shared by the headless runner, tests and benchmarks.
+#include "sphxr/sim/fields.h"
+
+namespace sphxr::sim {
+
+/// Extent of the connected fluid body along `axis` (0 = x, 1 = y) from a wall at `wall`, counted in
+/// bins one spacing wide: walking away from the wall, a bin belongs to the body while it holds at least
+/// `minPerBin` particles, so isolated spray beyond the first sparse bin does not count. Only particles
+/// whose other horizontal coordinate (x for axis 1) lies within `band` of the wall are used when band > 0.
+/// Returns the distance from the wall to the outermost particle of the last connected bin plus half a
+/// spacing (the particle's own extent), or 0 when there is no fluid.
+float ConnectedExtent(const HostFluid& fluid, int axis, float wall, float spacing, int minPerBin,
+                      float bandWall = 0.0f, float band = 0.0f);
+
+/// Dam break (Martin & Moyce 1952): surge front distance from the back wall at x = wallX.
+inline float SurgeFront(const HostFluid& fluid, float wallX, float spacing, int minPerBin) {
+  return ConnectedExtent(fluid, 0, wallX, spacing, minPerBin);
+}
+
+/// Residual column height above the floor at y = floorY, over the two particle columns next to the back wall.
+inline float ColumnHeight(const HostFluid& fluid, float floorY, float wallX, float spacing, int minPerBin) {
+  return ConnectedExtent(fluid, 1, floorY, spacing, minPerBin, wallX, 2.0f * spacing);
+}
+
+struct MomentumSummary {
+  double px = 0, py = 0, pz = 0;  // total momentum / particle mass
+  double sumAbs = 0;              // sum of |v| (scale for relative errors)
+};
+MomentumSummary Momentum(const HostFluid& fluid);
+
+}  // namespace sphxr::sim

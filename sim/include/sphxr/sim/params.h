@@ -1,0 +1,72 @@
+#pragma once
+// What the solver needs to know about a scene, as plain data. The JSON scene loader (app/) fills
+// these structs; the solver validates them again (sim never trusts its caller with physics).
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "sphxr/sim/vec.h"
+
+namespace sphxr::sim {
+
+/// Scalar solver parameters. Every one is described once in SolverParamInfos() (name, unit, range,
+/// help), and that table drives the scene file, the command line and validation.
+struct SolverParams {
+  float spacing = 0.02f;           // m, rest particle spacing dx; particle mass = rho0 * dx^3
+  float supportFactor = 2.0f;      // kernel support radius / spacing
+  float restDensity = 1000.0f;     // kg/m^3
+  float stiffness = 50000.0f;      // Pa, Tait B (Becker & Teschner 2007, eq. 7)
+  float exponent = 7.0f;           // Tait gamma
+  float viscosity = 0.02f;         // Monaghan artificial viscosity alpha, fluid-fluid
+  float boundaryViscosity = 0.02f; // alpha between fluid and walls (wall friction)
+  float cfl = 0.4f;                // CFL number for the adaptive time step
+  float maxDt = 2e-3f;             // s, upper bound of the adaptive step
+  float fixedDt = 0.0f;            // s, 0 = adaptive; a fixed step above the CFL limit is clamped
+};
+
+struct ParamInfo {
+  const char* key;    // scene-file key and command-line name
+  const char* unit;
+  const char* help;
+  double min, max;    // inclusive valid range
+  float SolverParams::*member;
+};
+
+/// The table of solver parameters (same order as SolverParams).
+std::span<const ParamInfo> SolverParamInfos();
+const ParamInfo* FindSolverParam(const std::string& key);
+
+struct Aabb {
+  Vec3 min, max;
+};
+
+struct FluidBlock {
+  Aabb box;
+  Vec3 velocity;  // initial velocity, m/s
+};
+
+struct SceneSetup {
+  SolverParams params;
+  Vec3 gravity{0.0f, -9.81f, 0.0f};
+  /// The tank: its interior is the simulation domain. Walls and floor are sampled as boundary
+  /// particles on its faces (the top face only when `openTop` is false).
+  Aabb tank{{0, 0, 0}, {1, 1, 1}};
+  bool openTop = true;
+  int boundaryLayers = 1;        // layers of boundary particles behind each wall
+  std::vector<FluidBlock> fluid;
+  std::vector<Aabb> obstacles;   // solid boxes inside the tank, surfaces sampled
+};
+
+/// Counts the particles a scene will create, without allocating them (for validation).
+struct ParticleCounts {
+  int64_t fluid = 0;
+  int64_t boundary = 0;
+  int64_t gridCells = 0;
+};
+ParticleCounts CountParticles(const SceneSetup& scene);
+
+/// Bytes the solver allocates for a scene of these counts (used to refuse scenes that do not fit).
+int64_t EstimateMemoryBytes(const ParticleCounts& counts);
+
+}  // namespace sphxr::sim

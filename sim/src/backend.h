@@ -1,0 +1,50 @@
+#pragma once
+// The interface between the Solver (host logic: validation, time step, statistics) and a backend
+// (where the particle arrays live and the stages run). Both backends are instances of the one template
+// in backend_impl.h.
+#include <functional>
+#include <memory>
+
+#include "sphxr/common/status.h"
+#include "sphxr/sim/fields.h"
+#include "sphxr/sim/solver.h"
+#include "stages.h"
+
+namespace sphxr::sim {
+
+struct GridShape {
+  Vec3 origin;
+  float cellSize;
+  int nx, ny, nz;
+  int64_t Cells() const { return static_cast<int64_t>(nx) * ny * nz; }
+};
+
+/// Called after each stage of a step (validate mode); a non-ok status stops the step.
+using StageHook = std::function<Status(Stage)>;
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual const char* Name() const = 0;
+  /// Uploads particles, sorts the boundary once and computes its volumes (Akinci et al. 2012).
+  virtual Status Init(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
+                      const HostBoundary& boundary) = 0;
+  /// One step of size dt. Adds each stage's wall time to stageSeconds.
+  virtual Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
+                      const StageHook& hook) = 0;
+  /// Runs only stages 1-3 (cells, sort, grid) and copies the cell ranges out (tests).
+  virtual void RebuildGrid(std::vector<uint32_t>* fluidStart, std::vector<uint32_t>* fluidEnd) = 0;
+  virtual void Download(HostFluid* out) const = 0;
+  virtual void DownloadBoundary(HostBoundary* out) const = 0;
+  virtual void Upload(const HostFluid& fluid) = 0;
+  virtual int FluidCount() const = 0;
+  virtual int BoundaryCount() const = 0;
+};
+
+std::unique_ptr<Backend> MakeCpuBackend(int threads);
+/// Null when the CUDA backend is not compiled in; `*why` says so.
+std::unique_ptr<Backend> MakeCudaBackend(std::string* why);
+int CudaDevices();
+bool CudaCompiled();
+
+}  // namespace sphxr::sim

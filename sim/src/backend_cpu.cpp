@@ -1,0 +1,26 @@
+// CPU backend: the step of backend_impl.h on thrust's OpenMP system.
+#include <omp.h>
+#include <thrust/system/omp/execution_policy.h>
+#include <thrust/system/omp/vector.h>
+
+#include "backend_impl.h"
+
+namespace sphxr::sim {
+namespace {
+
+struct OmpTraits {
+  template <class T>
+  using Vector = thrust::omp::vector<T>;
+  static auto Policy() { return thrust::omp::par; }
+  static void Sync() {}
+  static constexpr const char* kName = "cpu";
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> MakeCpuBackend(int threads) {
+  if (threads > 0) omp_set_num_threads(threads);
+  return std::make_unique<BackendImpl<OmpTraits>>();
+}
+
+}  // namespace sphxr::sim

@@ -1,0 +1,37 @@
+// CUDA backend: the same step of backend_impl.h on thrust's CUDA system (cub radix sort underneath).
+#include <cuda_runtime.h>
+#include <thrust/system/cuda/execution_policy.h>
+#include <thrust/system/cuda/vector.h>
+
+#include "backend_impl.h"
+
+namespace sphxr::sim {
+namespace {
+
+struct CudaTraits {
+  template <class T>
+  using Vector = thrust::cuda::vector<T>;
+  static auto Policy() { return thrust::cuda::par; }
+  static void Sync() { cudaDeviceSynchronize(); }
+  static constexpr const char* kName = "cuda";
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> MakeCudaBackend(std::string* /*why*/) {
+  return std::make_unique<BackendImpl<CudaTraits>>();
+}
+
+int CudaDevices() {
+  int count = 0;
+  // Without a driver this returns an error (cudart is linked statically, so the program still starts).
+  if (cudaGetDeviceCount(&count) != cudaSuccess) {
+    cudaGetLastError();
+    return 0;
+  }
+  return count;
+}
+
+bool CudaCompiled() { return true; }
+
+}  // namespace sphxr::sim

@@ -1,0 +1,240 @@
+#pragma once
+// The one implementation of a step, templated on the thrust system. backend_cpu.cpp instantiates it
+// with thrust's OpenMP system (built by the host compiler), backend_cuda.cu with the CUDA system
+// (built by nvcc). Sorting, fills, gathers and reductions come from thrust (CCCL); nothing of that
+// kind is hand-written. Include this from exactly one translation unit per system.
+#include <thrust/copy.h>
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/gather.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/sequence.h>
+#include <thrust/sort.h>
+#include <thrust/transform_reduce.h>
+
+#include <chrono>
+#include <type_traits>
+
+#include "backend.h"
+
+namespace sphxr::sim {
+
+/// Traits: `template <class T> using Vector`, `static auto Policy()`, `static void Sync()`,
+/// `static const char* kName`.
+template <class Traits>
+class BackendImpl final : public Backend {
+  template <class T>
+  using Vector = typename Traits::template Vector<T>;
+
+ public:
+  const char* Name() const override { return Traits::kName; }
+
+  Status Init(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
+              const HostBoundary& boundary) override {
+    m_shape = grid;
+    const size_t cells = static_cast<size_t>(grid.Cells());
+    m_fluidStart.resize(cells);
+    m_fluidEnd.resize(cells);
+    m_boundaryStart.resize(cells);
+    m_boundaryEnd.resize(cells);
+    Upload(fluid);
+
+    // Boundary: sort once by cell code, build its cell ranges, then its volumes.
+    const int nb = static_cast<int>(boundary.size());
+    Vector<Vec4> unsorted(boundary.position.begin(), boundary.position.end());
+    m_boundary.resize(nb);
+    Vector<uint32_t> keys(nb), order(nb);
+    thrust::fill(Traits::Policy(), m_boundaryStart.begin(), m_boundaryStart.end(), kEmptyCell);
+    thrust::fill(Traits::Policy(), m_boundaryEnd.begin(), m_boundaryEnd.end(), kEmptyCell);
+    if (nb > 0) {
+      GridView g = View();
+      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
+                         CellCodeStage{g, Raw(unsorted), Raw(keys), Raw(order)});
+      thrust::stable_sort_by_key(Traits::Policy(), keys.begin(), keys.end(), order.begin());
+      Vector<Vec4> sorted(nb);
+      thrust::gather(Traits::Policy(), order.begin(), order.end(), unsorted.begin(), sorted.begin());
+      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
+                         CellRangeStage{g, Raw(sorted), Raw(keys), Raw(m_boundaryStart), Raw(m_boundaryEnd), nb});
+      g = View();
+      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
+                         BoundaryVolumeStage{g, Raw(sorted), Raw(m_boundary), physics.boundaryGamma * physics.restDensity, physics.kernel});
+    }
+    Traits::Sync();
+    return Status::Ok();
+  }
+
+  Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
+              const StageHook& hook) override {
+    const int n = FluidCount();
+    auto policy = Traits::Policy();
+    auto clock = std::chrono::steady_clock::now();
+    auto lap = [&](Stage stage) -> Status {
+      Traits::Sync();
+      const auto now = std::chrono::steady_clock::now();
+      stageSeconds[static_cast<int>(stage)] += std::chrono::duration<double>(now - clock).count();
+      Status s = hook ? hook(stage) : Status::Ok();
+      clock = std::chrono::steady_clock::now();
+      return s;
+    };
+    const thrust::counting_iterator<int> first(0);
+
+    // 1. cell codes
+    CellCodes();
+    if (Status s = lap(Stage::kCells); !s) return s;
+
+    // 2. sort by Z-order and reorder every field of the list
+    SortAndReorder();
+    if (Status s = lap(Stage::kSort); !s) return s;
+
+    // 3. cell ranges
+    CellRanges();
+    if (Status s = lap(Stage::kGrid); !s) return s;
+
+    // 4. density and pressure
+    const FluidView fv = Fluid();
+    thrust::for_each_n(policy, first, n, DensityStage{View(), fv, physics});
+    if (Status s = lap(Stage::kDensity); !s) return s;
+
+    // 5. forces
+    thrust::for_each_n(policy, first, n, ForceStage{View(), fv, physics});
+    if (Status s = lap(Stage::kForces); !s) return s;
+
+    // 6. integrate, then the statistics the next time step needs
+    thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
+    *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics.invRestDensity},
+                                    StepReduction{}, StepReductionCombine{});
+    return lap(Stage::kIntegrate);
+  }
+
+  void RebuildGrid(std::vector<uint32_t>* fluidStart, std::vector<uint32_t>* fluidEnd) override {
+    CellCodes();
+    SortAndReorder();
+    CellRanges();
+    Traits::Sync();
+    fluidStart->resize(m_fluidStart.size());
+    fluidEnd->resize(m_fluidEnd.size());
+    thrust::copy(m_fluidStart.begin(), m_fluidStart.end(), fluidStart->begin());
+    thrust::copy(m_fluidEnd.begin(), m_fluidEnd.end(), fluidEnd->begin());
+  }
+
+  void Download(HostFluid* out) const override {
+    out->resize(m_fluid.position.size());
+#define SPHXR_DOWNLOAD_FIELD(type, name) thrust::copy(m_fluid.name.begin(), m_fluid.name.end(), out->name.begin());
+    SPHXR_FLUID_FIELDS(SPHXR_DOWNLOAD_FIELD)
+#undef SPHXR_DOWNLOAD_FIELD
+  }
+
+  void DownloadBoundary(HostBoundary* out) const override {
+    out->position.resize(m_boundary.size());
+    thrust::copy(m_boundary.begin(), m_boundary.end(), out->position.begin());
+  }
+
+  void Upload(const HostFluid& fluid) override {
+    const size_t n = fluid.size();
+#define SPHXR_UPLOAD_FIELD(type, name) \
+  m_fluid.name.resize(n);              \
+  thrust::copy(fluid.name.begin(), fluid.name.end(), m_fluid.name.begin());
+    SPHXR_FLUID_FIELDS(SPHXR_UPLOAD_FIELD)
+#undef SPHXR_UPLOAD_FIELD
+    m_keys.resize(n);
+    m_order.resize(n);
+    m_scratchVec4.resize(n);
+    m_scratchFloat.resize(n);
+    m_scratchU32.resize(n);
+  }
+
+  int FluidCount() const override { return static_cast<int>(m_fluid.position.size()); }
+  int BoundaryCount() const override { return static_cast<int>(m_boundary.size()); }
+
+ private:
+  struct Fields {
+#define SPHXR_DEVICE_FIELD(type, name) Vector<type> name;
+    SPHXR_FLUID_FIELDS(SPHXR_DEVICE_FIELD)
+#undef SPHXR_DEVICE_FIELD
+  };
+
+  template <class T>
+  static T* Raw(Vector<T>& v) {
+    return thrust::raw_pointer_cast(v.data());
+  }
+  template <class T>
+  static const T* Raw(const Vector<T>& v) {
+    return thrust::raw_pointer_cast(v.data());
+  }
+
+  template <class T>
+  Vector<T>& Scratch() {
+    if constexpr (std::is_same_v<T, Vec4>) return m_scratchVec4;
+    else if constexpr (std::is_same_v<T, float>) return m_scratchFloat;
+    else {
+      static_assert(std::is_same_v<T, uint32_t> || std::is_same_v<T, int32_t>, "add a scratch buffer for this type");
+      return m_scratchU32;
+    }
+  }
+
+  void CellCodes() {
+    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), FluidCount(),
+                       CellCodeStage{View(), Raw(m_fluid.position), Raw(m_keys), Raw(m_order)});
+  }
+
+  void SortAndReorder() {
+    thrust::stable_sort_by_key(Traits::Policy(), m_keys.begin(), m_keys.end(), m_order.begin());
+    Reorder();
+  }
+
+  void CellRanges() {
+    const int n = FluidCount();
+    thrust::fill(Traits::Policy(), m_fluidStart.begin(), m_fluidStart.end(), kEmptyCell);
+    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), n,
+                       CellRangeStage{View(), Raw(m_fluid.position), Raw(m_keys), Raw(m_fluidStart), Raw(m_fluidEnd), n});
+  }
+
+  /// Applies the sort permutation to every field of the list (one gather and one O(1) swap each).
+  void Reorder() {
+    auto policy = Traits::Policy();
+#define SPHXR_REORDER_FIELD(type, name)                                                             \
+  {                                                                                                 \
+    auto& scratch = Scratch<type>();                                                                \
+    thrust::gather(policy, m_order.begin(), m_order.end(), m_fluid.name.begin(), scratch.begin()); \
+    m_fluid.name.swap(scratch);                                                                     \
+  }
+    SPHXR_FLUID_FIELDS(SPHXR_REORDER_FIELD)
+#undef SPHXR_REORDER_FIELD
+  }
+
+  FluidView Fluid() {
+    FluidView v;
+#define SPHXR_VIEW_OF(type, name) v.name = Raw(m_fluid.name);
+    SPHXR_FLUID_FIELDS(SPHXR_VIEW_OF)
+#undef SPHXR_VIEW_OF
+    v.count = FluidCount();
+    return v;
+  }
+
+  GridView View() const {
+    GridView g;
+    g.origin = m_shape.origin;
+    g.cellSize = m_shape.cellSize;
+    g.invCellSize = 1.0f / m_shape.cellSize;
+    g.nx = m_shape.nx;
+    g.ny = m_shape.ny;
+    g.nz = m_shape.nz;
+    g.fluidStart = Raw(m_fluidStart);
+    g.fluidEnd = Raw(m_fluidEnd);
+    g.boundaryStart = Raw(m_boundaryStart);
+    g.boundaryEnd = Raw(m_boundaryEnd);
+    g.boundary = Raw(m_boundary);
+    return g;
+  }
+
+  GridShape m_shape{};
+  Fields m_fluid;
+  Vector<uint32_t> m_keys, m_order;
+  Vector<Vec4> m_scratchVec4;
+  Vector<float> m_scratchFloat;
+  Vector<uint32_t> m_scratchU32;
+  Vector<uint32_t> m_fluidStart, m_fluidEnd, m_boundaryStart, m_boundaryEnd;
+  Vector<Vec4> m_boundary;
+};
+
+}  // namespace sphxr::sim

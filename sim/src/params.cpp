@@ -1,0 +1,57 @@
+#include <array>
+#include <string>
+
+#include "sampling.h"
+#include "sphxr/sim/params.h"
+
+namespace sphxr::sim {
+namespace {
+
+const std::array<ParamInfo, 10> kParams = {{
+    {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
+     &SolverParams::spacing},
+    {"support_factor", "", "kernel support radius in spacings (cubic spline)", 1.5, 4.0, &SolverParams::supportFactor},
+    {"rest_density", "kg/m^3", "density of the fluid at rest", 1.0, 1e5, &SolverParams::restDensity},
+    {"stiffness", "Pa", "Tait stiffness B: p = B((rho/rho0)^gamma - 1); sound speed sqrt(gamma B / rho0)", 1.0, 1e10,
+     &SolverParams::stiffness},
+    {"exponent", "", "Tait exponent gamma", 1.0, 10.0, &SolverParams::exponent},
+    {"viscosity", "", "Monaghan artificial viscosity alpha between fluid particles", 0.0, 10.0,
+     &SolverParams::viscosity},
+    {"boundary_viscosity", "", "artificial viscosity alpha between fluid and walls (wall friction)", 0.0, 10.0,
+     &SolverParams::boundaryViscosity},
+    {"cfl", "", "CFL number: dt <= cfl * h / (c + v_max)", 0.01, 1.0, &SolverParams::cfl},
+    {"max_dt", "s", "upper bound of the time step", 1e-7, 0.1, &SolverParams::maxDt},
+    {"fixed_dt", "s", "fixed time step (0 = adaptive); clamped to the stability limit", 0.0, 0.1,
+     &SolverParams::fixedDt},
+}};
+
+}  // namespace
+
+std::span<const ParamInfo> SolverParamInfos() { return kParams; }
+
+const ParamInfo* FindSolverParam(const std::string& key) {
+  for (const ParamInfo& p : kParams) {
+    if (key == p.key) return &p;
+  }
+  return nullptr;
+}
+
+ParticleCounts CountParticles(const SceneSetup& scene) {
+  ParticleCounts c;
+  c.fluid = SampleFluid(scene, nullptr);
+  c.boundary = SampleBoundary(scene, nullptr);
+  c.gridCells = MakeGridShape(scene).Cells();
+  return c;
+}
+
+int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
+  // Fluid: the field list (60 B) + sort keys and order (8) + reorder scratch of the widest field (16)
+  // + the sort's temporary storage (about keys and values again, 8). Boundary: 16 B, plus its sort at
+  // start-up (~40 B transient). Grid: 4 ranges of 4 B per cell. Host copy at creation: the same again.
+  const int64_t fluid = counts.fluid * (60 + 8 + 16 + 8 + 60);
+  const int64_t boundary = counts.boundary * (16 + 40 + 16);
+  const int64_t grid = counts.gridCells * 16;
+  return fluid + boundary + grid;
+}
+
+}  // namespace sphxr::sim

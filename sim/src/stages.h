@@ -1,0 +1,304 @@
+#pragma once
+// The per-particle stages of one WCSPH step, written once as host+device functors over plain views of
+// raw pointers. backend_impl.h launches them with thrust on the OpenMP system (CPU backend) or the CUDA
+// system (CUDA backend): the physics has exactly one source.
+//
+// Step (Becker & Teschner 2007, "Weakly compressible SPH for free surface flows"):
+//   1. cells:     Morton code of each fluid particle's cell                  (Huang et al. 2013, §3.1)
+//   2. sort:      stable radix/merge sort by code; gather every field         (fields.h list)
+//   3. grid:      cellStart/cellEnd per cell from the sorted codes
+//   4. density:   rho_i = sum_j m W_ij + sum_b Psi_b W_ib                     (Akinci et al. 2012, eq. 4-5)
+//                 p_i = B ((rho_i/rho0)^gamma - 1), clamped at 0             (B&T 2007, eq. 7)
+//   5. forces:    a_i = -sum_j m (p_i/rho_i^2 + p_j/rho_j^2 + Pi_ij) gradW_ij  (B&T 2007, eq. 6 and 10)
+//                       -sum_b Psi_b (2 p_i/rho_i^2 + Pi_ib) gradW_ib        (Akinci et al. 2012, eq. 10-11, with
+//                                                  pressure mirroring p_b = p_i, rho_b = rho_i in the symmetric form)
+//                       + g
+//                 Pi_ij = -2 alpha c h min(v_ij.x_ij, 0) / ((|x_ij|^2 + 0.01 h^2)(rho_i + rho_j))  (Monaghan 1992)
+//   6. integrate: symplectic Euler v += dt a, x += dt v; particles leaving the domain are clamped back
+//                 and counted.
+#include <cstdint>
+
+#include "kernel.h"
+#include "morton.h"
+#include "sphxr/sim/fields.h"
+#include "sphxr/sim/hd.h"
+#include "sphxr/sim/vec.h"
+
+namespace sphxr::sim {
+
+inline constexpr uint32_t kEmptyCell = 0xffffffffu;
+
+/// Raw pointers to every fluid field (generated from the field list).
+struct FluidView {
+#define SPHXR_VIEW_FIELD(type, name) type* name;
+  SPHXR_FLUID_FIELDS(SPHXR_VIEW_FIELD)
+#undef SPHXR_VIEW_FIELD
+  int count;
+};
+
+/// The uniform grid over the domain: cells of size >= the kernel support; two particle sets
+/// (fluid, re-sorted every step; boundary, sorted once) with their own cell ranges.
+struct GridView {
+  Vec3 origin;
+  float cellSize;
+  float invCellSize;
+  int nx, ny, nz;
+  const uint32_t* fluidStart;
+  const uint32_t* fluidEnd;
+  const uint32_t* boundaryStart;
+  const uint32_t* boundaryEnd;
+  const Vec4* boundary;  // xyz position, w = Psi_b (kg)
+
+  SPHXR_HD SPHXR_INLINE int Clampi(int v, int hi) const { return v < 0 ? 0 : (v > hi ? hi : v); }
+  SPHXR_HD SPHXR_INLINE void CellOf(Vec3 p, int* cx, int* cy, int* cz) const {
+    // fminf/fmaxf keep a NaN position inside the grid (validate mode names it later).
+    *cx = Clampi(static_cast<int>(fmaxf(0.0f, fminf((p.x - origin.x) * invCellSize, 1e9f))), nx - 1);
+    *cy = Clampi(static_cast<int>(fmaxf(0.0f, fminf((p.y - origin.y) * invCellSize, 1e9f))), ny - 1);
+    *cz = Clampi(static_cast<int>(fmaxf(0.0f, fminf((p.z - origin.z) * invCellSize, 1e9f))), nz - 1);
+  }
+  SPHXR_HD SPHXR_INLINE uint32_t Linear(int cx, int cy, int cz) const {
+    return static_cast<uint32_t>(cx + nx * (cy + ny * cz));
+  }
+};
+
+/// Calls f(j, xi - xj) for every particle j of `points` (ranges start/end) in the 27 cells around xi.
+template <class F>
+SPHXR_HD SPHXR_INLINE void ForEachInCells(const GridView& g, const uint32_t* start, const uint32_t* end,
+                                           const Vec4* points, Vec3 xi, F&& f) {
+  int cx, cy, cz;
+  g.CellOf(xi, &cx, &cy, &cz);
+  const int z0 = cz > 0 ? cz - 1 : 0, z1 = cz < g.nz - 1 ? cz + 1 : cz;
+  const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy < g.ny - 1 ? cy + 1 : cy;
+  const int x0 = cx > 0 ? cx - 1 : 0, x1 = cx < g.nx - 1 ? cx + 1 : cx;
+  for (int z = z0; z <= z1; ++z) {
+    for (int y = y0; y <= y1; ++y) {
+      const uint32_t row = g.Linear(0, y, z);
+      for (int x = x0; x <= x1; ++x) {
+        const uint32_t s = start[row + x];
+        if (s == kEmptyCell) continue;
+        const uint32_t e = end[row + x];
+        for (uint32_t j = s; j < e; ++j) {
+          const Vec4 pj = points[j];
+          f(j, Vec3{xi.x - pj.x, xi.y - pj.y, xi.z - pj.z});
+        }
+      }
+    }
+  }
+}
+
+/// Constants of one step, passed by value into every stage.
+struct Physics {
+  CubicSpline kernel;
+  float mass;           // kg per fluid particle
+  float restDensity;
+  float invRestDensity;
+  float boundaryGamma;  // Psi_b = gamma rho0 V_b: flat-wall rest-density correction (sampling.h)
+  float stiffness;      // Tait B
+  float exponent;       // Tait gamma
+  float soundSpeed;     // sqrt(B gamma / rho0)
+  float smoothing;      // h = support / 2, used by the viscosity term
+  float alpha;          // fluid-fluid artificial viscosity
+  float alphaBoundary;  // fluid-wall artificial viscosity
+  Vec3 gravity;
+  Vec3 domainMin;       // clamp box for fluid particles
+  Vec3 domainMax;
+};
+
+SPHXR_HD SPHXR_INLINE float TaitPressure(const Physics& ph, float density) {
+  const float ratio = density * ph.invRestDensity;
+  float power;
+  if (ph.exponent == 7.0f) {
+    const float r2 = ratio * ratio;
+    power = r2 * r2 * r2 * ratio;
+  } else {
+    power = powf(ratio, ph.exponent);
+  }
+  const float p = ph.stiffness * (power - 1.0f);
+  return p > 0.0f ? p : 0.0f;  // clamp: no tension at the free surface (B&T 2007)
+}
+
+// ---- stage 1: cell codes -------------------------------------------------------------------------
+struct CellCodeStage {
+  GridView grid;
+  const Vec4* position;
+  uint32_t* keys;
+  uint32_t* order;
+  SPHXR_HD void operator()(int i) const {
+    int cx, cy, cz;
+    grid.CellOf(Xyz(position[i]), &cx, &cy, &cz);
+    keys[i] = MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz));
+    order[i] = static_cast<uint32_t>(i);
+  }
+};
+
+// ---- stage 3: cell ranges from sorted particles --------------------------------------------------
+struct CellRangeStage {
+  GridView grid;
+  const Vec4* position;  // sorted
+  const uint32_t* keys;  // sorted
+  uint32_t* start;
+  uint32_t* end;
+  int count;
+  SPHXR_HD void operator()(int i) const {
+    const uint32_t key = keys[i];
+    if (i > 0 && keys[i - 1] == key && i < count - 1 && keys[i + 1] == key) return;
+    int cx, cy, cz;
+    grid.CellOf(Xyz(position[i]), &cx, &cy, &cz);
+    const uint32_t cell = grid.Linear(cx, cy, cz);
+    if (i == 0 || keys[i - 1] != key) start[cell] = static_cast<uint32_t>(i);
+    if (i == count - 1 || keys[i + 1] != key) end[cell] = static_cast<uint32_t>(i + 1);
+  }
+};
+
+// ---- boundary volumes (once, Akinci et al. 2012 eq. 4: V_b = 1 / sum_k W_bk; Psi_b = gamma rho0 V_b) --
+struct BoundaryVolumeStage {
+  GridView grid;
+  const Vec4* in;   // sorted boundary positions
+  Vec4* out;        // same, with w = Psi_b = rho0 V_b
+  float psiScale;  // gamma rho0
+  CubicSpline kernel;
+  SPHXR_HD void operator()(int b) const {
+    const Vec3 xb = Xyz(in[b]);
+    float sum = 0.0f;
+    const CubicSpline k = kernel;
+    ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, in, xb, [&](uint32_t, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 < k.H2) sum += k.W(sqrtf(r2));
+    });
+    out[b] = MakeVec4(xb, psiScale / sum);
+  }
+};
+
+// ---- stage 4: density and pressure ---------------------------------------------------------------
+struct DensityStage {
+  GridView grid;
+  FluidView fluid;
+  Physics ph;
+  SPHXR_HD void operator()(int i) const {
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const CubicSpline k = ph.kernel;
+    float sumFluid = 0.0f;
+    ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 < k.H2) sumFluid += k.W(sqrtf(r2));
+    });
+    float sumBoundary = 0.0f;
+    ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 < k.H2) sumBoundary += grid.boundary[j].w * k.W(sqrtf(r2));
+    });
+    const float rho = ph.mass * sumFluid + sumBoundary;
+    fluid.density[i] = rho;
+    fluid.pressure[i] = TaitPressure(ph, rho);
+  }
+};
+
+// ---- stage 5: pressure, viscosity and gravity ----------------------------------------------------
+struct ForceStage {
+  GridView grid;
+  FluidView fluid;
+  Physics ph;
+  SPHXR_HD void operator()(int i) const {
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const Vec3 vi = Xyz(fluid.velocity[i]);
+    const float rhoi = fluid.density[i];
+    const float pTermI = fluid.pressure[i] / (rhoi * rhoi);
+    const CubicSpline k = ph.kernel;
+    const float h = ph.smoothing;
+    const float eps = 0.01f * h * h;
+    const float viscFluid = 2.0f * ph.alpha * ph.soundSpeed * h;
+    Vec3 a{0.0f, 0.0f, 0.0f};
+    ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t j, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 >= k.H2 || r2 == 0.0f) return;  // r2 == 0: self, or a coincident particle (no direction)
+      const float rhoj = fluid.density[j];
+      float term = pTermI + fluid.pressure[j] / (rhoj * rhoj);
+      const Vec3 vij = vi - Xyz(fluid.velocity[j]);
+      const float vx = Dot(vij, d);
+      if (vx < 0.0f) term -= viscFluid * vx / ((r2 + eps) * (rhoi + rhoj));
+      a -= d * (ph.mass * term * k.GradFactor(sqrtf(r2)));
+    });
+    const float viscWall = ph.alphaBoundary * ph.soundSpeed * h / (2.0f * rhoi);
+    ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 >= k.H2 || r2 == 0.0f) return;
+      float term = 2.0f * pTermI;  // pressure mirroring: p_b = p_i, rho_b = rho_i in the symmetric form
+      const float vx = Dot(vi, d);  // static walls: v_b = 0
+      if (vx < 0.0f) term -= viscWall * vx / (r2 + eps);
+      a -= d * (grid.boundary[j].w * term * k.GradFactor(sqrtf(r2)));
+    });
+    a += ph.gravity;
+    fluid.acceleration[i] = MakeVec4(a);
+  }
+};
+
+// ---- stage 6: symplectic Euler and domain clamp --------------------------------------------------
+struct IntegrateStage {
+  FluidView fluid;
+  Physics ph;
+  float dt;
+  SPHXR_HD void operator()(int i) const {
+    Vec4 a = fluid.acceleration[i];
+    Vec4 v = fluid.velocity[i];
+    Vec4 x = fluid.position[i];
+    v.x += dt * a.x;
+    v.y += dt * a.y;
+    v.z += dt * a.z;
+    x.x += dt * v.x;
+    x.y += dt * v.y;
+    x.z += dt * v.z;
+    // A particle that leaves the domain is put back on its edge with the outward velocity removed,
+    // and flagged in acceleration.w so that the step reports how many were clamped.
+    bool clamped = false;
+    if (x.x < ph.domainMin.x) { x.x = ph.domainMin.x; if (v.x < 0.0f) v.x = 0.0f; clamped = true; }
+    if (x.x > ph.domainMax.x) { x.x = ph.domainMax.x; if (v.x > 0.0f) v.x = 0.0f; clamped = true; }
+    if (x.y < ph.domainMin.y) { x.y = ph.domainMin.y; if (v.y < 0.0f) v.y = 0.0f; clamped = true; }
+    if (x.y > ph.domainMax.y) { x.y = ph.domainMax.y; if (v.y > 0.0f) v.y = 0.0f; clamped = true; }
+    if (x.z < ph.domainMin.z) { x.z = ph.domainMin.z; if (v.z < 0.0f) v.z = 0.0f; clamped = true; }
+    if (x.z > ph.domainMax.z) { x.z = ph.domainMax.z; if (v.z > 0.0f) v.z = 0.0f; clamped = true; }
+    a.w = clamped ? 1.0f : 0.0f;
+    fluid.acceleration[i] = a;
+    fluid.velocity[i] = v;
+    fluid.position[i] = x;
+  }
+};
+
+// ---- step statistics (a reduction over particles) ------------------------------------------------
+struct StepReduction {
+  float maxSpeed2 = 0.0f;
+  float maxAccel2 = 0.0f;
+  float maxDensityError = 0.0f;
+  double sumCompression = 0.0;
+  int32_t clamped = 0;
+};
+
+struct StepReductionOp {
+  FluidView fluid;
+  float invRestDensity;
+  SPHXR_HD StepReduction operator()(int i) const {
+    StepReduction r;
+    const Vec4 v = fluid.velocity[i];
+    const Vec4 a = fluid.acceleration[i];
+    r.maxSpeed2 = v.x * v.x + v.y * v.y + v.z * v.z;
+    r.maxAccel2 = a.x * a.x + a.y * a.y + a.z * a.z;
+    const float err = fluid.density[i] * invRestDensity - 1.0f;
+    r.maxDensityError = fabsf(err);
+    r.sumCompression = err > 0.0f ? err : 0.0f;
+    r.clamped = a.w != 0.0f ? 1 : 0;
+    return r;
+  }
+};
+
+struct StepReductionCombine {
+  SPHXR_HD StepReduction operator()(const StepReduction& a, const StepReduction& b) const {
+    StepReduction r;
+    r.maxSpeed2 = fmaxf(a.maxSpeed2, b.maxSpeed2);
+    r.maxAccel2 = fmaxf(a.maxAccel2, b.maxAccel2);
+    r.maxDensityError = fmaxf(a.maxDensityError, b.maxDensityError);
+    r.sumCompression = a.sumCompression + b.sumCompression;
+    r.clamped = a.clamped + b.clamped;
+    return r;
+  }
+};
+
+}  // namespace sphxr::sim
