@@ -94,11 +94,17 @@ class Reader {
     {
       const json& tank = root["tank"];
       if (!tank.is_object()) return Error("tank", "must be an object");
-      CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers"});
+      CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity"});
       if (Status st = Box(tank, "tank", &s.tank); !st) return st;
       if (tank.contains("open_top")) {
         if (!tank["open_top"].is_boolean()) return Error("tank.open_top", "must be true or false");
         s.openTop = tank["open_top"].get<bool>();
+      }
+      if (tank.contains("floor_viscosity")) {
+        double v;
+        if (Status st = Number(tank["floor_viscosity"], "tank.floor_viscosity", &v); !st) return st;
+        if (v < 0 || v > 10) return Error("tank.floor_viscosity", "must be from 0 to 10 (artificial viscosity alpha)");
+        s.floorViscosity = static_cast<float>(v);
       }
       if (tank.contains("boundary_layers")) {
         if (!tank["boundary_layers"].is_number_integer()) return Error("tank.boundary_layers", "must be an integer");

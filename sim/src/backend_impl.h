@@ -42,7 +42,9 @@ class BackendImpl final : public Backend {
     // Boundary: sort once by cell code, build its cell ranges, then its volumes.
     const int nb = static_cast<int>(boundary.size());
     Vector<Vec4> unsorted(boundary.position.begin(), boundary.position.end());
+    Vector<float> unsortedAlpha(boundary.viscosity.begin(), boundary.viscosity.end());
     m_boundary.resize(nb);
+    m_boundaryAlpha.resize(nb);
     Vector<uint32_t> keys(nb), order(nb);
     thrust::fill(Traits::Policy(), m_boundaryStart.begin(), m_boundaryStart.end(), kEmptyCell);
     thrust::fill(Traits::Policy(), m_boundaryEnd.begin(), m_boundaryEnd.end(), kEmptyCell);
@@ -53,6 +55,7 @@ class BackendImpl final : public Backend {
       thrust::stable_sort_by_key(Traits::Policy(), keys.begin(), keys.end(), order.begin());
       Vector<Vec4> sorted(nb);
       thrust::gather(Traits::Policy(), order.begin(), order.end(), unsorted.begin(), sorted.begin());
+      thrust::gather(Traits::Policy(), order.begin(), order.end(), unsortedAlpha.begin(), m_boundaryAlpha.begin());
       thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
                          CellRangeStage{g, Raw(sorted), Raw(keys), Raw(m_boundaryStart), Raw(m_boundaryEnd), nb});
       g = View();
@@ -127,6 +130,8 @@ class BackendImpl final : public Backend {
   void DownloadBoundary(HostBoundary* out) const override {
     out->position.resize(m_boundary.size());
     thrust::copy(m_boundary.begin(), m_boundary.end(), out->position.begin());
+    out->viscosity.resize(m_boundaryAlpha.size());
+    thrust::copy(m_boundaryAlpha.begin(), m_boundaryAlpha.end(), out->viscosity.begin());
   }
 
   void Upload(const HostFluid& fluid) override {
@@ -224,6 +229,7 @@ class BackendImpl final : public Backend {
     g.boundaryStart = Raw(m_boundaryStart);
     g.boundaryEnd = Raw(m_boundaryEnd);
     g.boundary = Raw(m_boundary);
+    g.boundaryAlpha = Raw(m_boundaryAlpha);
     return g;
   }
 
@@ -235,6 +241,7 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_scratchU32;
   Vector<uint32_t> m_fluidStart, m_fluidEnd, m_boundaryStart, m_boundaryEnd;
   Vector<Vec4> m_boundary;
+  Vector<float> m_boundaryAlpha;
 };
 
 }  // namespace sphxr::sim

@@ -43,7 +43,8 @@ void SampleShell(const Aabb& box, float dx, int layers, bool outward, bool openT
         const bool interiorZ = kz > in && kz < n[2] - in;
         if (interiorX && interiorY && interiorZ) continue;
         emit(Vec3{lo[0] + s[0] * static_cast<float>(kx), lo[1] + s[1] * static_cast<float>(ky),
-                  lo[2] + s[2] * static_cast<float>(kz)});
+                  lo[2] + s[2] * static_cast<float>(kz)},
+             /*bottom=*/ky <= 0 && interiorX && interiorZ);
       }
     }
   }
@@ -76,12 +77,16 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
   return count;
 }
 
-int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out) {
+int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out, std::vector<float>* viscosity) {
   const float dx = scene.params.spacing;
+  const float wallAlpha = scene.params.boundaryViscosity;
+  const float floorAlpha = scene.floorViscosity >= 0.0f ? scene.floorViscosity : wallAlpha;
   int64_t count = 0;
-  auto emit = [&](Vec3 p) {
+  bool tankPass = true;
+  auto emit = [&](Vec3 p, bool bottom) {
     ++count;
     if (out) out->push_back(MakeVec4(p));
+    if (viscosity) viscosity->push_back(tankPass && bottom ? floorAlpha : wallAlpha);
   };
   // The boundary surface lies half a spacing behind the solid's face, where the next lattice layer of
   // the fluid would be: the fluid's first layer (half a spacing inside the face) is then one spacing from
@@ -94,6 +99,7 @@ int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out) {
   tank.max = tank.max + Vec3{half, half, half};
   if (scene.openTop) tank.max.y = scene.tank.max.y;
   SampleShell(tank, dx, scene.boundaryLayers, /*outward=*/true, scene.openTop, emit);
+  tankPass = false;
   for (const Aabb& o : scene.obstacles) {
     Aabb inner = o;
     const Vec3 c = (o.min + o.max) * 0.5f;

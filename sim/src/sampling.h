@@ -16,7 +16,8 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out);
 
 /// Boundary particles on the tank faces (layers outward) and the obstacle surfaces (layers inward),
 /// spaced as close to the rest spacing as fits each face exactly. w is left 0 (volumes come later).
-int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out);
+/// `viscosity` (may be null) receives each particle's wall friction alpha (floor or walls).
+int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out, std::vector<float>* viscosity = nullptr);
 
 /// Akinci et al. (2012) give a boundary particle the volume V_b = 1 / sum_k W_bk over its boundary
 /// neighbours. For a wall of `layers` sheets one spacing behind the fluid's first layer, the density a

@@ -47,6 +47,9 @@ Status ValidateScene(const SceneSetup& scene) {
                                   p.max, p.unit[0] ? " " : "", p.unit, p.help));
     }
   }
+  if (!std::isfinite(scene.floorViscosity) || scene.floorViscosity > 10.0f) {
+    return Status::Error(Format("tank.floor_viscosity = %g is invalid: must be from 0 to 10", scene.floorViscosity));
+  }
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
   if (scene.boundaryLayers < 1 || scene.boundaryLayers > 4) {
     return Status::Error(Format("tank.boundary_layers = %d is invalid: must be 1 to 4", scene.boundaryLayers));
@@ -128,7 +131,6 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.soundSpeed = std::sqrt(p.exponent * p.stiffness / p.restDensity);
   ph.smoothing = 0.5f * support;
   ph.alpha = p.viscosity;
-  ph.alphaBoundary = p.boundaryViscosity;
   ph.gravity = scene.gravity;
   // Fluid particles are kept a quarter spacing inside the walls' boundary particles.
   const float inset = 0.25f * p.spacing;
@@ -237,7 +239,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
     }
   }
   HostBoundary boundary;
-  SampleBoundary(scene, &boundary.position);
+  SampleBoundary(scene, &boundary.position, &boundary.viscosity);
 
   const Physics physics = MakePhysics(scene);
   if (Status s = solver->m_backend->Init(MakeGridShape(scene), physics, fluid, boundary); !s) return s;
@@ -262,7 +264,7 @@ float Solver::StableDt() const {
   const float accel = std::max(m_maxAccel, Length(m_scene.gravity));
   if (accel > 0.0f) dt = std::min(dt, 0.25f * std::sqrt(h / accel));
   // Viscous diffusion condition for the artificial viscosity (nu ~ alpha c h / 8).
-  const float alpha = std::max(p.viscosity, p.boundaryViscosity);
+  const float alpha = std::max({p.viscosity, p.boundaryViscosity, m_scene.floorViscosity});
   if (alpha > 0.0f) dt = std::min(dt, 0.5f * h / (alpha * c));
   return dt;
 }

@@ -48,6 +48,7 @@ struct GridView {
   const uint32_t* boundaryStart;
   const uint32_t* boundaryEnd;
   const Vec4* boundary;  // xyz position, w = Psi_b (kg)
+  const float* boundaryAlpha;  // artificial viscosity alpha of each boundary particle's wall
 
   SPHXR_HD SPHXR_INLINE int Clampi(int v, int hi) const { return v < 0 ? 0 : (v > hi ? hi : v); }
   SPHXR_HD SPHXR_INLINE void CellOf(Vec3 p, int* cx, int* cy, int* cz) const {
@@ -98,7 +99,6 @@ struct Physics {
   float soundSpeed;     // sqrt(B gamma / rho0)
   float smoothing;      // h = support / 2, used by the viscosity term
   float alpha;          // fluid-fluid artificial viscosity
-  float alphaBoundary;  // fluid-wall artificial viscosity
   Vec3 gravity;
   Vec3 domainMin;       // clamp box for fluid particles
   Vec3 domainMax;
@@ -218,13 +218,13 @@ struct ForceStage {
       if (vx < 0.0f) term -= viscFluid * vx / ((r2 + eps) * (rhoi + rhoj));
       a -= d * (ph.mass * term * k.GradFactor(sqrtf(r2)));
     });
-    const float viscWall = ph.alphaBoundary * ph.soundSpeed * h / (2.0f * rhoi);
+    const float viscWall = ph.soundSpeed * h / (2.0f * rhoi);
     ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
       const float r2 = Dot(d, d);
       if (r2 >= k.H2 || r2 == 0.0f) return;
       float term = 2.0f * pTermI;  // pressure mirroring: p_b = p_i, rho_b = rho_i in the symmetric form
       const float vx = Dot(vi, d);  // static walls: v_b = 0
-      if (vx < 0.0f) term -= viscWall * vx / (r2 + eps);
+      if (vx < 0.0f) term -= grid.boundaryAlpha[j] * viscWall * vx / (r2 + eps);
       a -= d * (grid.boundary[j].w * term * k.GradFactor(sqrtf(r2)));
     });
     a += ph.gravity;

@@ -37,6 +37,7 @@ struct HostFluid {
 /// Static boundary particles (Akinci et al. 2012): position and the volume-weighted mass Psi = rho0 * V_b.
 struct HostBoundary {
   std::vector<Vec4> position;  // w = Psi (kg)
+  std::vector<float> viscosity;  // artificial viscosity alpha of the wall this particle samples
   size_t size() const { return position.size(); }
 };
 

@@ -53,6 +53,9 @@ struct SceneSetup {
   /// particles on its faces (the top face only when `openTop` is false).
   Aabb tank{{0, 0, 0}, {1, 1, 1}};
   bool openTop = true;
+  /// Artificial viscosity alpha of the tank floor (negative: solver.boundary_viscosity, like the walls).
+  /// A dry floor drags on a spreading front much more than glass side walls drag on the column.
+  float floorViscosity = -1.0f;
   int boundaryLayers = 1;        // layers of boundary particles behind each wall
   std::vector<FluidBlock> fluid;
   std::vector<Aabb> obstacles;   // solid boxes inside the tank, surfaces sampled
