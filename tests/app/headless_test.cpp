@@ -1,0 +1,367 @@
+// The command line (ParseCommandLine) and the headless runner end to end: the real sphxr binary
+// (SPHXR_BINARY) on a small scene, its summary, stats CSV and PLY exports; bad input exits cleanly.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "sphxr/app/headless.h"
+#include "support.h"
+
+namespace sphxr::app {
+namespace {
+
+Status Parse(std::vector<std::string> args, Options* out) {
+  args.insert(args.begin(), "sphxr");
+  std::vector<const char*> argv;
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  return ParseCommandLine(static_cast<int>(argv.size()), argv.data(), out);
+}
+
+std::string Join(const std::vector<std::string>& args) {
+  std::string s;
+  for (const std::string& a : args) s += (s.empty() ? "" : " ") + a;
+  return s;
+}
+
+TEST(CommandLineTest, AcceptsEveryFlag) {
+  Options o;
+  const std::vector<std::string> args = {
+      "--headless", "--scene", "x.json", "--steps", "20", "--device", "cpu", "--threads", "2", "--spacing", "0.01",
+      "--set", "stiffness=1e5", "--set", "cfl=0.3", "--export-every", "10", "--out", "dir", "--export-format", "vtk",
+      "--stats", "s.csv", "--validate", "--no-progress"};
+  const Status s = Parse(args, &o);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(o.mode, Mode::kHeadless);
+  EXPECT_EQ(o.scenePath, "x.json");
+  EXPECT_EQ(o.steps, 20);
+  EXPECT_EQ(o.time, 0.0);
+  EXPECT_EQ(o.device, sim::Device::kCpu);
+  EXPECT_EQ(o.threads, 2);
+  EXPECT_FLOAT_EQ(o.spacing, 0.01f);
+  EXPECT_EQ(o.sets, (std::vector<std::string>{"stiffness=1e5", "cfl=0.3"}));
+  EXPECT_EQ(o.exportEvery, 10);
+  EXPECT_EQ(o.outDir, "dir");
+  EXPECT_EQ(o.exportFormat, "vtk");
+  EXPECT_EQ(o.statsPath, "s.csv");
+  EXPECT_TRUE(o.validate);
+  EXPECT_EQ(o.progress, 0);
+  EXPECT_FALSE(o.help);
+
+  ASSERT_TRUE(Parse({"--time", "0.5", "--device", "cuda", "--progress"}, &o).ok());
+  EXPECT_DOUBLE_EQ(o.time, 0.5);
+  EXPECT_EQ(o.steps, 0);
+  EXPECT_EQ(o.device, sim::Device::kCuda);
+  EXPECT_EQ(o.progress, 1);
+  EXPECT_EQ(o.mode, Mode::kAuto);
+  ASSERT_TRUE(Parse({"--device", "auto"}, &o).ok());
+  EXPECT_EQ(o.device, sim::Device::kAuto);
+  ASSERT_TRUE(Parse({"--help"}, &o).ok());
+  EXPECT_TRUE(o.help);
+  ASSERT_TRUE(Parse({"-h"}, &o).ok());
+  EXPECT_TRUE(o.help);
+  ASSERT_TRUE(Parse({"--desktop"}, &o).ok());
+  EXPECT_EQ(o.mode, Mode::kDesktop);
+  ASSERT_TRUE(Parse({"--xr"}, &o).ok());
+  EXPECT_EQ(o.mode, Mode::kXr);
+}
+
+TEST(CommandLineTest, DefaultsWhenNothingIsGiven) {
+  Options o;
+  ASSERT_TRUE(Parse({}, &o).ok());
+  EXPECT_EQ(o.mode, Mode::kAuto);
+  EXPECT_EQ(o.device, sim::Device::kAuto);
+  EXPECT_EQ(o.threads, 0);
+  EXPECT_EQ(o.exportFormat, "ply");
+  EXPECT_EQ(o.progress, -1);
+  EXPECT_FALSE(o.validate);
+  // the default scene is the dam break, and it exists
+  EXPECT_EQ(std::filesystem::path(o.scenePath).filename(), "dam_break.json");
+  EXPECT_TRUE(std::filesystem::exists(o.scenePath)) << o.scenePath;
+}
+
+TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
+  // Values for the documented flags that take one; a flag missing here and taking a value fails below.
+  const std::map<std::string, std::string> values = {
+      {"--scene", "a.json"}, {"--time", "1"},         {"--steps", "5"},          {"--device", "cpu"},
+      {"--threads", "1"},    {"--spacing", "0.01"},   {"--set", "cfl=0.3"},      {"--export-every", "2"},
+      {"--out", "d"},        {"--export-format", "ply"}, {"--stats", "f.csv"}};
+  const std::string usage = UsageText();
+  std::set<std::string> flags;
+  const std::regex flag("--[a-z][a-z-]*");
+  for (auto it = std::sregex_iterator(usage.begin(), usage.end(), flag); it != std::sregex_iterator(); ++it) {
+    flags.insert(it->str());
+  }
+  EXPECT_GE(flags.size(), 14u) << usage;
+  for (const std::string& f : flags) {
+    std::vector<std::string> args = {f};
+    if (values.count(f)) args.push_back(values.at(f));
+    Options o;
+    const Status s = Parse(args, &o);
+    EXPECT_TRUE(s.ok()) << "documented flag " << f << " refused: " << s.message();
+  }
+}
+
+void ExpectRejected(const std::vector<std::string>& args, std::initializer_list<std::string> needles) {
+  Options o;
+  const Status s = Parse(args, &o);
+  ASSERT_FALSE(s.ok()) << "accepted: " << Join(args);
+  for (const std::string& n : needles) {
+    EXPECT_NE(s.message().find(n), std::string::npos) << Join(args) << ": '" << n << "' not in: " << s.message();
+  }
+  EXPECT_EQ(s.message().find('\n'), std::string::npos) << "one line: " << s.message();
+}
+
+TEST(CommandLineTest, RejectsBadValuesNamingTheFlag) {
+  ExpectRejected({"--threads", "-1"}, {"--threads", "-1"});
+  ExpectRejected({"--threads", "two"}, {"--threads", "not an integer"});
+  ExpectRejected({"--threads", "1.5"}, {"--threads"});
+  ExpectRejected({"--time", "abc"}, {"--time", "abc", "not a number"});
+  ExpectRejected({"--time", "-1"}, {"--time"});
+  ExpectRejected({"--time", "nan"}, {"--time"});
+  ExpectRejected({"--time", "inf"}, {"--time"});
+  ExpectRejected({"--time", ""}, {"--time"});
+  ExpectRejected({"--device", "gpu"}, {"--device", "gpu", "auto, cpu or cuda"});
+  ExpectRejected({"--steps", "10", "--time", "1"}, {"--time", "--steps"});
+  ExpectRejected({"--time", "1", "--steps", "10"}, {"--time", "--steps"});
+  ExpectRejected({"--steps", "0"}, {"--steps"});
+  ExpectRejected({"--steps", "1e3"}, {"--steps"});
+  ExpectRejected({"--spacing", "0"}, {"--spacing"});
+  ExpectRejected({"--spacing", "-0.01"}, {"--spacing"});
+  ExpectRejected({"--export-every", "0"}, {"--export-every"});
+  ExpectRejected({"--export-format", "obj"}, {"--export-format", "ply or vtk"});
+  ExpectRejected({"--scene"}, {"--scene", "missing value"});
+  ExpectRejected({"--headless", "--steps"}, {"--steps", "missing value"});
+  ExpectRejected({"--frobnicate"}, {"--frobnicate", "unknown"});
+  ExpectRejected({"scene.json"}, {"scene.json"});
+}
+
+// ---- the binary end to end ------------------------------------------------------------------------
+
+struct Result {
+  int status = -1;  // wait status
+  std::string out;
+  std::string err;
+  bool Exited() const { return WIFEXITED(status); }
+  int Code() const { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
+};
+
+std::string Quote(const std::string& s) { return "'" + s + "'"; }
+
+Result RunBinary(const std::string& args, const test::TempDir& dir) {
+  Result r;
+  const std::string errPath = dir.File("stderr.txt");
+  const std::string command = Quote(SPHXR_BINARY) + " " + args + " 2>" + Quote(errPath);
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) {
+    ADD_FAILURE() << "popen failed: " << command;
+    return r;
+  }
+  char buffer[4096];
+  while (size_t n = std::fread(buffer, 1, sizeof(buffer), pipe)) r.out.append(buffer, n);
+  r.status = pclose(pipe);
+  r.err = test::ReadFile(errPath);
+  return r;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> Split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, sep)) out.push_back(cell);
+  return out;
+}
+
+// 10 x 10 x 10 = 1000 fluid particles at 0.01 m in a 0.2 x 0.2 x 0.1 m tank.
+const char* kSmallScene = R"({
+  "name": "headless_e2e",
+  "solver": { "spacing": 0.01, "max_dt": 0.001 },
+  "tank": { "min": [0, 0, 0], "max": [0.2, 0.2, 0.1] },
+  "fluid": [ { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] } ],
+  "run": { "steps": 5 }
+})";
+constexpr int kSmallSceneParticles = 1000;
+
+struct Ply {
+  std::vector<std::string> header;
+  size_t vertices = 0;
+  std::vector<std::string> properties;  // names, in order
+  std::vector<std::string> types;
+  size_t headerBytes = 0;
+  std::string body;
+};
+
+Ply ReadPly(const std::string& path) {
+  Ply ply;
+  const std::string data = test::ReadFile(path);
+  const size_t end = data.find("end_header\n");
+  if (end == std::string::npos) return ply;
+  ply.headerBytes = end + std::strlen("end_header\n");
+  ply.header = Lines(data.substr(0, end));
+  for (const std::string& line : ply.header) {
+    const std::vector<std::string> w = Split(line, ' ');
+    if (w.size() == 3 && w[0] == "element" && w[1] == "vertex") ply.vertices = std::stoul(w[2]);
+    if (w.size() == 3 && w[0] == "property") {
+      ply.types.push_back(w[1]);
+      ply.properties.push_back(w[2]);
+    }
+  }
+  ply.body = data.substr(ply.headerBytes);
+  return ply;
+}
+
+TEST(HeadlessTest, RunsASmallSceneWithStatsAndExports) {
+  test::TempDir dir("headless");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string csv = dir.File("stats.csv");
+  const std::string out = dir.File("frames");
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 20 --stats " + Quote(csv) +
+                                 " --export-every 10 --out " + Quote(out) + " --threads 1 --no-progress",
+                             dir);
+  ASSERT_TRUE(r.Exited()) << "sphxr did not exit normally (signal?), status " << r.status << "\nstderr:\n" << r.err;
+  ASSERT_EQ(r.Code(), 0) << "stdout:\n" << r.out << "\nstderr:\n" << r.err;
+
+  // summary
+  EXPECT_NE(r.out.find("sphxr summary"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("particles lost  0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(std::to_string(kSmallSceneParticles) + " fluid"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("steps           20"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("exported        3 files"), std::string::npos) << r.out;
+
+  // stats CSV: the documented header and one row per step
+  const std::vector<std::string> lines = Lines(test::ReadFile(csv));
+  ASSERT_EQ(lines.size(), 21u) << "header + 20 steps expected in " << csv;
+  const std::vector<std::string> header = Split(lines[0], ',');
+  EXPECT_EQ(lines[0], "step,time,dt,max_speed,mean_density_error,max_density_error,clamped");
+  double timeSum = 0.0;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> cells = Split(lines[i], ',');
+    ASSERT_EQ(cells.size(), header.size()) << "row " << i << ": " << lines[i];
+    std::vector<double> v;
+    for (const std::string& c : cells) {
+      char* end = nullptr;
+      v.push_back(std::strtod(c.c_str(), &end));
+      ASSERT_TRUE(!c.empty() && *end == '\0' && std::isfinite(v.back())) << "row " << i << ": '" << c << "'";
+    }
+    EXPECT_EQ(v[0], static_cast<double>(i)) << "step column";
+    EXPECT_GT(v[2], 0.0) << "dt of row " << i;
+    timeSum += v[2];
+    EXPECT_NEAR(v[1], timeSum, 1e-5 * timeSum) << "time must be the running sum of dt, row " << i;
+    EXPECT_GE(v[3], 0.0);
+    EXPECT_GE(v[5], 0.0);
+    EXPECT_GE(v[6], 0.0);
+  }
+
+  // PLY exports at steps 0, 10, 20, each declaring the particle count, with a body of that many vertices
+  for (int step : {0, 10, 20}) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "particles_%06d.ply", step);
+    const std::string path = (std::filesystem::path(out) / name).string();
+    ASSERT_TRUE(std::filesystem::exists(path)) << path;
+    const Ply ply = ReadPly(path);
+    ASSERT_FALSE(ply.header.empty()) << path << " has no PLY header";
+    EXPECT_EQ(ply.header[0], "ply");
+    EXPECT_EQ(ply.header[1], "format binary_little_endian 1.0");
+    EXPECT_EQ(ply.vertices, static_cast<size_t>(kSmallSceneParticles)) << path;
+    ASSERT_GE(ply.properties.size(), 3u);
+    EXPECT_EQ(ply.properties[0], "x");
+    EXPECT_EQ(ply.properties[1], "y");
+    EXPECT_EQ(ply.properties[2], "z");
+    for (const std::string& t : ply.types) ASSERT_TRUE(t == "float" || t == "uint" || t == "int") << t;
+    const size_t stride = 4 * ply.properties.size();
+    ASSERT_EQ(ply.body.size(), ply.vertices * stride) << path << ": body size does not match the header";
+    // the vertices: positions inside the tank, ids a permutation of 0..n-1
+    size_t idColumn = ply.properties.size();
+    for (size_t c = 0; c < ply.properties.size(); ++c)
+      if (ply.properties[c] == "id") idColumn = c;
+    ASSERT_LT(idColumn, ply.properties.size()) << "no id property";
+    std::vector<int> seen(ply.vertices, 0);
+    for (size_t i = 0; i < ply.vertices; ++i) {
+      float p[3];
+      std::memcpy(p, ply.body.data() + i * stride, sizeof(p));
+      ASSERT_TRUE(p[0] >= 0 && p[0] <= 0.2f && p[1] >= 0 && p[1] <= 0.2f && p[2] >= 0 && p[2] <= 0.1f)
+          << path << " vertex " << i << " at [" << p[0] << ", " << p[1] << ", " << p[2] << "]";
+      uint32_t id;
+      std::memcpy(&id, ply.body.data() + i * stride + 4 * idColumn, sizeof(id));
+      ASSERT_LT(id, ply.vertices) << path;
+      ++seen[id];
+    }
+    for (size_t id = 0; id < seen.size(); ++id) ASSERT_EQ(seen[id], 1) << path << ": id " << id;
+  }
+}
+
+/// A bad scene: exits non-zero (not by a signal), prints nothing on stdout, and one line on stderr that
+/// contains every needle.
+void ExpectCleanFailure(const std::string& content, std::initializer_list<std::string> needles) {
+  test::TempDir dir("badscene");
+  const std::string scene = dir.Write("bad_scene.json", content);
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 5 --threads 1 --no-progress", dir);
+  ASSERT_TRUE(r.Exited()) << "crashed: status " << r.status << "\nstderr:\n" << r.err;
+  EXPECT_NE(r.Code(), 0) << "a bad scene must fail; stdout:\n" << r.out;
+  EXPECT_EQ(r.out.find("sphxr summary"), std::string::npos) << r.out;
+  const std::vector<std::string> lines = Lines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << "expected a one-line error, got:\n" << r.err;
+  EXPECT_NE(lines[0].find(scene), std::string::npos) << "must name the file: " << lines[0];
+  for (const std::string& n : needles) EXPECT_NE(lines[0].find(n), std::string::npos) << "'" << n << "' not in: " << lines[0];
+}
+
+TEST(HeadlessTest, InvalidJsonFailsCleanly) { ExpectCleanFailure("{ \"tank\": [0, 0, ", {"not valid JSON"}); }
+
+TEST(HeadlessTest, NegativeSpacingFailsCleanly) {
+  ExpectCleanFailure(R"({ "solver": { "spacing": -0.01 }, "tank": { "min": [0,0,0], "max": [1,1,1] },
+                          "fluid": [ { "min": [0,0,0], "max": [0.5,0.5,0.5] } ] })",
+                     {"solver.spacing"});
+}
+
+TEST(HeadlessTest, FluidOutsideTheTankFailsCleanly) {
+  ExpectCleanFailure(R"({ "tank": { "min": [0,0,0], "max": [0.2,0.2,0.2] },
+                          "fluid": [ { "min": [0,0,0], "max": [0.5,0.1,0.1] } ] })",
+                     {"fluid[0]"});
+}
+
+TEST(HeadlessTest, MissingSceneFileFailsCleanly) {
+  test::TempDir dir("missing");
+  const std::string scene = dir.File("does_not_exist.json");
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 5", dir);
+  ASSERT_TRUE(r.Exited());
+  EXPECT_NE(r.Code(), 0);
+  const std::vector<std::string> lines = Lines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_NE(lines[0].find(scene), std::string::npos) << lines[0];
+}
+
+TEST(HeadlessTest, BadFlagFailsWithUsageHint) {
+  test::TempDir dir("badflag");
+  const Result r = RunBinary("--headless --threads -1", dir);
+  ASSERT_TRUE(r.Exited());
+  EXPECT_NE(r.Code(), 0);
+  const std::vector<std::string> lines = Lines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_NE(lines[0].find("--threads"), std::string::npos) << lines[0];
+}
+
+TEST(HeadlessTest, HelpPrintsUsage) {
+  test::TempDir dir("help");
+  const Result r = RunBinary("--help", dir);
+  ASSERT_EQ(r.Code(), 0) << r.err;
+  EXPECT_EQ(r.out, UsageText());
+}
+
+}  // namespace
+}  // namespace sphxr::app

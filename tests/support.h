@@ -1,0 +1,211 @@
+#pragma once
+// Shared helpers for the unit tests: small scenes built in code, solver creation with a readable
+// failure, log capture, temporary directories, and per-particle lookups by id.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "sphxr/common/log.h"
+#include "sphxr/sim/fields.h"
+#include "sphxr/sim/params.h"
+#include "sphxr/sim/solver.h"
+
+namespace sphxr::test {
+
+using sim::Aabb;
+using sim::FluidBlock;
+using sim::HostFluid;
+using sim::SceneSetup;
+using sim::Vec3;
+using sim::Vec4;
+
+inline Aabb Box(Vec3 min, Vec3 max) { return Aabb{min, max}; }
+
+inline FluidBlock Block(Vec3 min, Vec3 max, Vec3 velocity = {}) { return FluidBlock{Aabb{min, max}, velocity}; }
+
+/// A tank from `min` to `max` with rest spacing `spacing`, no fluid yet, open top, default physics.
+inline SceneSetup TankScene(Vec3 min, Vec3 max, float spacing) {
+  SceneSetup s;
+  s.params.spacing = spacing;
+  s.tank = Aabb{min, max};
+  s.openTop = true;
+  return s;
+}
+
+/// A small dam break: a column 0.1 x 0.15 x 0.06 m against the back wall of a 0.3 x 0.2 x 0.06 m tank
+/// (spacing 0.01 m: 10 x 15 x 6 = 900 fluid particles).
+inline SceneSetup SmallDamBreak(float spacing = 0.01f) {
+  SceneSetup s = TankScene({0, 0, 0}, {0.3f, 0.2f, 0.06f}, spacing);
+  s.params.maxDt = 1e-3f;
+  s.fluid.push_back(Block({0, 0, 0}, {0.1f, 0.15f, 0.06f}));
+  return s;
+}
+
+/// The configuration the tests use unless they test threading or devices: the CPU backend on one thread.
+/// (ctest runs two test processes at once on a 2-core machine; two OpenMP teams of 2 spinning threads each
+/// slow every step down by two orders of magnitude.)
+inline sim::SolverConfig TestConfig() {
+  sim::SolverConfig c;
+  c.device = sim::Device::kCpu;
+  c.threads = 1;
+  return c;
+}
+
+/// Creates a solver or fails the current test with the status message.
+inline std::unique_ptr<sim::Solver> CreateOrFail(const SceneSetup& scene, sim::SolverConfig config = TestConfig()) {
+  std::unique_ptr<sim::Solver> solver;
+  const Status s = sim::Solver::Create(scene, config, &solver);
+  EXPECT_TRUE(s.ok()) << "Solver::Create failed: " << s.message();
+  return solver;
+}
+
+inline sim::HostFluid DownloadFluid(const sim::Solver& solver) {
+  sim::HostFluid h;
+  solver.Download(&h);
+  return h;
+}
+
+inline bool Finite(Vec4 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// Empty string when every position, velocity, acceleration, density and pressure is finite; otherwise
+/// the first offender (for a failure message).
+inline std::string FirstNonFinite(const HostFluid& f) {
+  for (size_t i = 0; i < f.size(); ++i) {
+    const char* bad = nullptr;
+    if (!Finite(f.position[i])) bad = "position";
+    else if (!Finite(f.velocity[i])) bad = "velocity";
+    else if (!Finite(f.acceleration[i])) bad = "acceleration";
+    else if (!std::isfinite(f.density[i])) bad = "density";
+    else if (!std::isfinite(f.pressure[i])) bad = "pressure";
+    if (bad) {
+      return Format("non-finite %s of particle id %u (index %zu): position [%g %g %g] velocity [%g %g %g]", bad, f.id[i],
+                    i, f.position[i].x, f.position[i].y, f.position[i].z, f.velocity[i].x, f.velocity[i].y,
+                    f.velocity[i].z);
+    }
+  }
+  return {};
+}
+
+/// index of each id in `f`
+inline std::unordered_map<uint32_t, size_t> IndexById(const HostFluid& f) {
+  std::unordered_map<uint32_t, size_t> m;
+  for (size_t i = 0; i < f.size(); ++i) m[f.id[i]] = i;
+  return m;
+}
+
+/// Steps `n` times; fails the test (and returns false) at the first error status.
+inline bool StepN(sim::Solver& solver, int n) {
+  for (int k = 0; k < n; ++k) {
+    const Status s = solver.Step();
+    if (!s.ok()) {
+      ADD_FAILURE() << "Step " << solver.GetTotals().steps + 1 << " failed: " << s.message();
+      return false;
+    }
+  }
+  return true;
+}
+
+/// Collects log messages while alive (the sink is process-global; restored on destruction).
+class LogCapture {
+ public:
+  LogCapture() {
+    m_previousLevel = GetLogLevel();
+    SetLogLevel(LogLevel::kDebug);
+    SetLogSink([this](LogLevel level, const std::string& text) {
+      std::lock_guard lock(m_mutex);
+      m_messages.push_back({level, text});
+    });
+  }
+  ~LogCapture() {
+    SetLogSink(nullptr);
+    SetLogLevel(m_previousLevel);
+  }
+  LogCapture(const LogCapture&) = delete;
+  LogCapture& operator=(const LogCapture&) = delete;
+
+  struct Message {
+    LogLevel level;
+    std::string text;
+  };
+  std::vector<Message> Messages() const {
+    std::lock_guard lock(m_mutex);
+    return m_messages;
+  }
+  int Count(const std::string& needle, LogLevel level = LogLevel::kDebug) const {
+    std::lock_guard lock(m_mutex);
+    int n = 0;
+    for (const Message& m : m_messages) n += (m.level >= level && m.text.find(needle) != std::string::npos) ? 1 : 0;
+    return n;
+  }
+  std::string All() const {
+    std::lock_guard lock(m_mutex);
+    std::string s;
+    for (const Message& m : m_messages) s += "  [" + std::to_string(static_cast<int>(m.level)) + "] " + m.text + "\n";
+    return s;
+  }
+
+ private:
+  mutable std::mutex m_mutex;
+  std::vector<Message> m_messages;
+  LogLevel m_previousLevel = LogLevel::kInfo;
+};
+
+/// A fresh directory under the system temp dir, removed on destruction.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    const auto base = std::filesystem::temp_directory_path();
+    std::random_device rd;
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      const auto p = base / ("sphxr_test_" + tag + "_" + std::to_string(rd()));
+      std::error_code ec;
+      if (std::filesystem::create_directory(p, ec)) {
+        m_path = p;
+        return;
+      }
+    }
+    ADD_FAILURE() << "cannot create a temporary directory under " << base;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    if (!m_path.empty()) std::filesystem::remove_all(m_path, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return m_path; }
+  std::string File(const std::string& name) const { return (m_path / name).string(); }
+  std::string Write(const std::string& name, const std::string& content) const {
+    const std::string p = File(name);
+    std::ofstream out(p, std::ios::binary);
+    out << content;
+    return p;
+  }
+
+ private:
+  std::filesystem::path m_path;
+};
+
+inline std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// Seconds taken by f().
+inline double Seconds(const std::function<void()>& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace sphxr::test
