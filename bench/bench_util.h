@@ -1,0 +1,128 @@
+#pragma once
+// Small helpers shared by the benchmarks: the machine, the process's memory, timestamps, CSV files.
+// Benchmarks report; they never assert a target.
+#include <malloc.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace sphxr::bench {
+
+/// "model name" of the first processor in /proc/cpuinfo ("unknown" when absent).
+inline std::string CpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const size_t colon = line.find(':');
+      if (colon != std::string::npos) {
+        std::string v = line.substr(colon + 1);
+        v.erase(0, v.find_first_not_of(" \t"));
+        return v;
+      }
+    }
+  }
+  return "unknown";
+}
+
+/// Online processors (what `nproc` prints without affinity limits).
+inline int CpuCount() { return static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)); }
+
+/// The 1-minute load average (/proc/loadavg), or -1.
+inline double LoadAverage() {
+  std::ifstream in("/proc/loadavg");
+  double v = -1.0;
+  in >> v;
+  return in ? v : -1.0;
+}
+
+/// A field of /proc/self/status in bytes ("VmHWM", "VmRSS"), or -1.
+inline int64_t ProcStatusBytes(const std::string& key) {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(key + ":", 0) == 0) {
+      std::istringstream ss(line.substr(key.size() + 1));
+      int64_t kb = -1;
+      ss >> kb;
+      return kb < 0 ? -1 : kb * 1024;
+    }
+  }
+  return -1;
+}
+
+/// Returns freed heap memory to the OS and resets the peak resident set (VmHWM) to the current RSS
+/// (Linux >= 4.0: writing 5 to /proc/self/clear_refs). False when the reset is not available.
+inline bool ResetPeakRss() {
+  malloc_trim(0);
+  std::FILE* f = std::fopen("/proc/self/clear_refs", "w");
+  if (!f) return false;
+  const bool ok = std::fputs("5", f) >= 0;
+  return (std::fclose(f) == 0) && ok;
+}
+
+/// CPU time of the whole process (all threads), s. With one solver thread on a busy machine this is
+/// close to what the step would take on an idle core; with several it also counts OpenMP spin-waiting.
+inline double ProcessCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+/// UTC time as 2024-01-31T12:34:56Z.
+inline std::string UtcTimestamp() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+/// Quotes a CSV field when it holds a comma or a quote.
+inline std::string CsvField(const std::string& s) {
+  if (s.find_first_of(",\"") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+/// Opens `path` for appending; writes `header` first when the file is new or empty.
+inline bool OpenCsv(const std::string& path, const std::string& header, bool append, std::ofstream* out) {
+  bool empty = true;
+  if (append) {
+    std::ifstream probe(path, std::ios::ate);
+    empty = !probe || probe.tellg() <= 0;
+  }
+  out->open(path, append ? std::ios::app : std::ios::trunc);
+  if (!*out) return false;
+  if (empty) *out << header << '\n';
+  return true;
+}
+
+inline double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// The q-quantile (0..1) by nearest rank.
+inline double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
+  return v[k];
+}
+
+}  // namespace sphxr::bench

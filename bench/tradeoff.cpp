@@ -1,0 +1,378 @@
+// sphxr_bench_tradeoff: cost against accuracy on the Martin & Moyce (1952) dam break
+// (scenes/dam_break.json), swept over particle spacing (a/14, a/20, a/26 with a = 0.05715 m) and Tait
+// stiffness (x0.5, x1, x4 of the scene's value). Everything else is the scene's: the column and the tank
+// are fixed in metres, so the particle count changes with the spacing.
+//
+// Each run goes to t = 0.19 s (T = t sqrt(2g/a) = 3.5) and records:
+//   - wall seconds per simulated second (time inside Solver::Step only; the probe is not counted),
+//   - the surge front error against tests/data/martin_moyce_1952.csv: relative error of Z over the
+//     measured points with 1.0 <= T <= 3.3, the simulated Z (sim::SurgeFront on a host copy every step,
+//     minPerBin from app::DamBreakMinPerBin, as the headless runner) interpolated linearly in time at
+//     each measured T; RMS and maximum of |Z_sim / Z_measured - 1|,
+//   - the mean density error, time-averaged (weighted by dt) over the run.
+// --csv writes one row per run (docs/tradeoff.csv); bench/plot_tradeoff.py draws docs/tradeoff.png.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <omp.h>
+
+#include "bench_util.h"
+#include "sphxr/app/scene_file.h"
+#include "sphxr/common/log.h"
+#include "sphxr/sim/measure.h"
+#include "sphxr/sim/solver.h"
+
+#ifndef SPHXR_SCENES_DIR
+#define SPHXR_SCENES_DIR "scenes"
+#endif
+#ifndef SPHXR_TEST_DATA_DIR
+#define SPHXR_TEST_DATA_DIR "tests/data"
+#endif
+
+namespace sphxr::bench {
+namespace {
+
+struct Args {
+  bool quick = false;
+  int threads = 0;
+  std::string csv;
+  std::string scene = SPHXR_SCENES_DIR "/dam_break.json";
+  std::string measurements = SPHXR_TEST_DATA_DIR "/martin_moyce_1952.csv";
+  bool help = false;
+};
+
+const char* kUsage =
+    "usage: sphxr_bench_tradeoff [--quick] [--threads N] [--csv FILE] [--scene FILE] [--data FILE]\n"
+    "  --quick       2 configurations (a/14 and a/20, stiffness x1) to t = 0.05 s (a smoke run; the front error\n"
+    "                then covers only the measured points with T <= 0.93, which the full sweep excludes)\n"
+    "  --threads N   CPU backend threads (default 0 = all cores)\n"
+    "  --csv FILE    write one row per run to FILE (overwritten)\n"
+    "  --scene FILE  dam-break scene (default " SPHXR_SCENES_DIR "/dam_break.json)\n"
+    "  --data FILE   Martin & Moyce measurements (default " SPHXR_TEST_DATA_DIR "/martin_moyce_1952.csv)\n";
+
+bool ParseArgs(int argc, char** argv, Args* out) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&](const char** v) {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s: missing value\n%s", a.c_str(), kUsage);
+        return false;
+      }
+      *v = argv[++i];
+      return true;
+    };
+    const char* v = nullptr;
+    if (a == "--quick") {
+      out->quick = true;
+    } else if (a == "--threads") {
+      if (!next(&v)) return false;
+      char* end = nullptr;
+      const long t = std::strtol(v, &end, 10);
+      if (!*v || *end || t < 0 || t > 1024) {
+        std::fprintf(stderr, "--threads %s: must be an integer from 0 to 1024\n", v);
+        return false;
+      }
+      out->threads = static_cast<int>(t);
+    } else if (a == "--csv") {
+      if (!next(&v)) return false;
+      out->csv = v;
+    } else if (a == "--scene") {
+      if (!next(&v)) return false;
+      out->scene = v;
+    } else if (a == "--data") {
+      if (!next(&v)) return false;
+      out->measurements = v;
+    } else if (a == "--help" || a == "-h") {
+      out->help = true;
+    } else {
+      std::fprintf(stderr, "unknown argument '%s'\n%s", a.c_str(), kUsage);
+      return false;
+    }
+  }
+  return true;
+}
+
+struct Point {
+  double t, value;
+};
+
+/// The "front" series of the measurements file: (T, Z).
+bool ReadFront(const std::string& path, std::vector<Point>* front) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("series", 0) == 0) continue;
+    std::stringstream ss(line);
+    std::string series, t, v;
+    std::getline(ss, series, ',');
+    std::getline(ss, t, ',');
+    std::getline(ss, v, ',');
+    if (series == "front") front->push_back({std::stod(t), std::stod(v)});
+  }
+  return !front->empty();
+}
+
+/// Linear interpolation in a series sorted by t (clamped at the ends).
+double Interpolate(const std::vector<Point>& s, double t) {
+  if (t <= s.front().t) return s.front().value;
+  for (size_t i = 1; i < s.size(); ++i) {
+    if (s[i].t >= t) {
+      const double w = (t - s[i - 1].t) / (s[i].t - s[i - 1].t);
+      return s[i - 1].value + w * (s[i].value - s[i - 1].value);
+    }
+  }
+  return s.back().value;
+}
+
+struct Config {
+  int spacingDivisor;     // spacing = a / divisor
+  double stiffnessFactor; // x the scene's stiffness
+};
+
+struct Result {
+  Config config{};
+  float spacing = 0.0f;
+  float stiffness = 0.0f;
+  float soundSpeed = 0.0f;
+  sim::SolverParams params;      // as run (the scene's, with spacing and stiffness overridden)
+  float floorViscosity = -1.0f;  // the scene's tank.floor_viscosity (negative: boundary_viscosity)
+  int fluid = 0, boundary = 0, threads = 0;
+  int64_t steps = 0, dtClampedSteps = 0, clampedEvents = 0;
+  double simTime = 0.0;
+  double stepWall = 0.0;       // s inside Solver::Step
+  double loopWall = 0.0;       // s of the whole loop, probe included
+  double wallPerSimSecond = 0.0;
+  double frontRms = NAN, frontMax = NAN;  // relative
+  double frontBias = NAN;                 // mean signed relative error (> 0: the simulated front is ahead)
+  int frontPoints = 0;
+  double frontTMin = 0.0, frontTMax = 0.0;
+  double finalZ = 0.0;
+  double meanDensityError = 0.0;     // time average
+  float peakMeanDensityError = 0.0f;
+};
+
+bool Run(const Args& args, const Config& config, double tEnd, double tMin, double tMax, const std::vector<Point>& measured,
+         Result* r) {
+  r->config = config;
+  app::SceneFile scene;
+  if (Status s = app::LoadScene(args.scene, &scene); !s) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
+    return false;
+  }
+  if (!scene.damBreak) {
+    std::fprintf(stderr, "%s: no probe.dam_break_column_width: not a dam-break scene\n", args.scene.c_str());
+    return false;
+  }
+  const app::DamBreakProbe probe = *scene.damBreak;
+  const double a = probe.columnWidth;
+  // Only the spacing and the stiffness are overridden, through the same path as --set on the command line.
+  const float stiffness = static_cast<float>(config.stiffnessFactor * scene.setup.params.stiffness);
+  for (const std::string& set : {Format("spacing=%.9g", a / config.spacingDivisor), Format("stiffness=%.9g", stiffness)}) {
+    if (Status s = app::SetSolverParam(&scene.setup, set); !s) {
+      std::fprintf(stderr, "%s\n", s.message().c_str());
+      return false;
+    }
+  }
+  const float dx = scene.setup.params.spacing;
+  r->spacing = dx;
+  r->params = scene.setup.params;
+  r->floorViscosity = scene.setup.floorViscosity;
+  r->stiffness = scene.setup.params.stiffness;
+  const int minPerBin = app::DamBreakMinPerBin(probe, dx);
+  const double g = std::sqrt(scene.setup.gravity.x * scene.setup.gravity.x + scene.setup.gravity.y * scene.setup.gravity.y +
+                             scene.setup.gravity.z * scene.setup.gravity.z);
+  const double toT = std::sqrt(2.0 * g / a);  // T = t sqrt(2g/a)
+
+  sim::SolverConfig solverConfig;
+  solverConfig.device = sim::Device::kCpu;
+  solverConfig.threads = args.threads;
+  std::unique_ptr<sim::Solver> solver;
+  if (Status s = sim::Solver::Create(scene.setup, solverConfig, &solver); !s) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
+    return false;
+  }
+  r->fluid = solver->FluidCount();
+  r->boundary = solver->BoundaryCount();
+  r->soundSpeed = solver->SoundSpeed();
+  r->threads = omp_get_max_threads();
+  std::fprintf(stderr, "a/%d (%.4g mm), stiffness x%g (%.4g Pa): %d fluid + %d boundary particles, to t = %g s ...\n",
+               config.spacingDivisor, 1e3 * dx, config.stiffnessFactor, stiffness, r->fluid, r->boundary, tEnd);
+
+  sim::HostFluid host;
+  std::vector<Point> front;  // (T, Z)
+  solver->Download(&host);
+  front.push_back({0.0, sim::SurgeFront(host, probe.wallX, dx, minPerBin) / a});
+  double errorTime = 0.0;
+  const auto begin = std::chrono::steady_clock::now();
+  while (solver->Time() < tEnd - 1e-9) {
+    if (Status s = solver->Step(); !s) {
+      std::fprintf(stderr, "step failed: %s\n", s.message().c_str());
+      return false;
+    }
+    const sim::StepInfo& info = solver->LastStep();
+    if (!std::isfinite(info.maxSpeed)) {
+      std::fprintf(stderr, "the simulation became non-finite at t = %g s\n", info.time);
+      return false;
+    }
+    errorTime += static_cast<double>(info.meanDensityError) * info.dt;
+    r->peakMeanDensityError = std::max(r->peakMeanDensityError, info.meanDensityError);
+    solver->Download(&host);
+    front.push_back({info.time * toT, sim::SurgeFront(host, probe.wallX, dx, minPerBin) / a});
+  }
+  r->loopWall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  const sim::Totals& totals = solver->GetTotals();
+  r->steps = totals.steps;
+  r->dtClampedSteps = totals.dtClampedSteps;
+  r->clampedEvents = totals.clampedEvents;
+  r->simTime = solver->Time();
+  r->stepWall = totals.stepSeconds;
+  r->wallPerSimSecond = r->simTime > 0 ? r->stepWall / r->simTime : 0.0;
+  r->meanDensityError = r->simTime > 0 ? errorTime / r->simTime : 0.0;
+  r->finalZ = front.back().value;
+
+  const double tReached = front.back().t;
+  double sumSq = 0.0, maxAbs = 0.0, sumRel = 0.0;
+  int n = 0;
+  r->frontTMin = 1e30;
+  r->frontTMax = 0.0;
+  for (const Point& m : measured) {
+    if (m.t < tMin || m.t > tMax || m.t > tReached) continue;
+    const double rel = Interpolate(front, m.t) / m.value - 1.0;
+    sumSq += rel * rel;
+    sumRel += rel;
+    maxAbs = std::max(maxAbs, std::fabs(rel));
+    r->frontTMin = std::min(r->frontTMin, m.t);
+    r->frontTMax = std::max(r->frontTMax, m.t);
+    ++n;
+  }
+  r->frontPoints = n;
+  if (n > 0) {
+    r->frontRms = std::sqrt(sumSq / n);
+    r->frontMax = maxAbs;
+    r->frontBias = sumRel / n;
+  } else {
+    r->frontTMin = r->frontTMax = 0.0;
+  }
+  return true;
+}
+
+std::string Percent(double v) {
+  if (!std::isfinite(v)) return "n/a";
+  return Format("%.1f %%", 100.0 * v);
+}
+
+}  // namespace
+}  // namespace sphxr::bench
+
+int main(int argc, char** argv) {
+  using namespace sphxr;
+  using namespace sphxr::bench;
+  Args args;
+  if (!ParseArgs(argc, argv, &args)) return 2;
+  if (args.help) {
+    std::printf("%s", kUsage);
+    return 0;
+  }
+  SetLogLevel(LogLevel::kError);  // the soft stiffness warns about its sound speed: that is the point of the sweep
+
+  std::vector<Point> measured;
+  if (!ReadFront(args.measurements, &measured)) {
+    std::fprintf(stderr, "%s: cannot read the front series of the Martin & Moyce measurements\n",
+                 args.measurements.c_str());
+    return 1;
+  }
+
+  std::vector<Config> configs;
+  double tEnd = 0.19, tMin = 1.0, tMax = 3.3;
+  if (args.quick) {
+    configs = {{14, 1.0}, {20, 1.0}};
+    tEnd = 0.05;
+    tMin = 0.0;  // the smoke run ends at T = 0.93: compare what it reaches
+  } else {
+    for (int d : {14, 20, 26}) {
+      for (double k : {0.5, 1.0, 4.0}) configs.push_back({d, k});
+    }
+  }
+
+  const std::string model = CpuModel();
+  const int cpus = CpuCount();
+  const double loadStart = LoadAverage();
+  const std::string when = UtcTimestamp();
+  std::vector<Result> results;
+  for (const Config& c : configs) {
+    Result r;
+    if (!Run(args, c, tEnd, tMin, tMax, measured, &r)) return 1;
+    std::fprintf(stderr, "  %lld steps, %.1f s wall per simulated s, front RMS %s max %s, mean density error %.3f %%\n",
+                 static_cast<long long>(r.steps), r.wallPerSimSecond, Percent(r.frontRms).c_str(),
+                 Percent(r.frontMax).c_str(), 100.0 * r.meanDensityError);
+    results.push_back(r);
+  }
+  const double loadEnd = LoadAverage();
+
+  std::printf("\n## sphxr_bench_tradeoff%s\n\n", args.quick ? " (--quick: a smoke run, not a measurement)" : "");
+  std::printf("- scene: %s to t = %g s (T = %.2f), CPU backend, adaptive dt\n", args.scene.c_str(), tEnd,
+              tEnd * std::sqrt(2.0 * 9.81 / 0.05715));
+  std::printf("- front error over the Martin & Moyce points with %g <= T <= %g reached by the run\n", tMin, tMax);
+  std::printf("- machine: %s, nproc %d, solver threads %d; 1-min load average %.2f at start, %.2f at end; %s\n",
+              model.c_str(), cpus, results.empty() ? 0 : results[0].threads, loadStart, loadEnd, when.c_str());
+  if (!results.empty()) {
+    const sim::SolverParams& p = results[0].params;
+    std::printf("- the scene's other settings (shared by every run): support_factor %g, viscosity %g, boundary_viscosity "
+                "%g, floor_viscosity %g, cfl %g, max_dt %g s, exponent %g\n",
+                p.supportFactor, p.viscosity, p.boundaryViscosity,
+                results[0].floorViscosity >= 0 ? results[0].floorViscosity : p.boundaryViscosity, p.cfl, p.maxDt,
+                p.exponent);
+  }
+  if (loadStart > 0.5) {
+    std::printf("- **the machine was busy (load average %.2f before the run): the wall times are not representative; "
+                "the errors are**\n",
+                loadStart);
+  }
+  std::printf("\n");
+  std::printf("| spacing | stiffness | fluid | steps | wall s per simulated s | front RMS error | front max error | "
+              "front mean signed error | points | mean density error | final Z |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const Result& r : results) {
+    std::printf("| a/%d (%.3f mm) | x%g (%.0f Pa, c = %.1f m/s) | %d | %lld | %.1f | %s | %s | %s | %d | %.3f %% | %.3f |\n",
+                r.config.spacingDivisor, 1e3 * r.spacing, r.config.stiffnessFactor, r.stiffness, r.soundSpeed, r.fluid,
+                static_cast<long long>(r.steps), r.wallPerSimSecond, Percent(r.frontRms).c_str(),
+                Percent(r.frontMax).c_str(), Percent(r.frontBias).c_str(), r.frontPoints, 100.0 * r.meanDensityError, r.finalZ);
+  }
+
+  if (!args.csv.empty()) {
+    std::ofstream csv;
+    const std::string header =
+        "timestamp_utc,cpu_model,nproc,threads,load_avg_start,load_avg_end,mode,spacing_divisor,spacing_m,"
+        "stiffness_factor,stiffness_pa,sound_speed,fluid,boundary,steps,dt_clamped_steps,clamped_events,sim_time_s,"
+        "step_wall_s,loop_wall_s,wall_per_sim_s,front_rms_rel,front_max_rel,front_bias_rel,front_points,front_T_min,front_T_max,final_Z,"
+        "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_viscosity,cfl,"
+        "max_dt";
+    if (!OpenCsv(args.csv, header, /*append=*/false, &csv)) {
+      std::fprintf(stderr, "--csv %s: cannot open for writing\n", args.csv.c_str());
+      return 1;
+    }
+    csv.precision(9);
+    for (const Result& r : results) {
+      csv << when << ',' << CsvField(model) << ',' << cpus << ',' << r.threads << ',' << loadStart << ',' << loadEnd << ','
+          << (args.quick ? "quick" : "full") << ',' << r.config.spacingDivisor << ',' << r.spacing << ','
+          << r.config.stiffnessFactor << ',' << r.stiffness << ',' << r.soundSpeed << ',' << r.fluid << ',' << r.boundary
+          << ',' << r.steps << ',' << r.dtClampedSteps << ',' << r.clampedEvents << ',' << r.simTime << ','
+          << r.stepWall << ',' << r.loopWall << ',' << r.wallPerSimSecond << ',' << r.frontRms << ',' << r.frontMax
+          << ',' << r.frontBias << ',' << r.frontPoints << ',' << r.frontTMin << ',' << r.frontTMax << ',' << r.finalZ << ','
+          << r.meanDensityError << ',' << r.peakMeanDensityError << ',' << r.params.supportFactor << ','
+          << r.params.viscosity << ',' << r.params.boundaryViscosity << ','
+          << (r.floorViscosity >= 0 ? r.floorViscosity : r.params.boundaryViscosity) << ',' << r.params.cfl << ','
+          << r.params.maxDt << '\n';
+    }
+    std::printf("\nwrote %zu row(s) to %s\n", results.size(), args.csv.c_str());
+  }
+  return 0;
+}
