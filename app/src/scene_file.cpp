@@ -108,8 +108,9 @@ class Reader {
       }
       if (tank.contains("boundary_layers")) {
         if (!tank["boundary_layers"].is_number_integer()) return Error("tank.boundary_layers", "must be an integer");
-        s.boundaryLayers = tank["boundary_layers"].get<int>();
-        if (s.boundaryLayers < 1 || s.boundaryLayers > 4) return Error("tank.boundary_layers", "must be 1 to 4");
+        const int64_t layers = tank["boundary_layers"].get<int64_t>();
+        if (layers < 1 || layers > 4) return Error("tank.boundary_layers", "must be 1 to 4");
+        s.boundaryLayers = static_cast<int>(layers);
       }
     }
     if (root.contains("fluid")) {
@@ -185,7 +186,7 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
   json root;
   try {
     root = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers too large for a double
     return Status::Error(origin + ": not valid JSON: " + e.what());
   }
   Reader reader(out);

@@ -19,7 +19,8 @@ struct OmpTraits {
 }  // namespace
 
 std::unique_ptr<Backend> MakeCpuBackend(int threads) {
-  if (threads > 0) omp_set_num_threads(threads);
+  // 0 = all cores, also after an earlier solver in this process asked for fewer.
+  omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
   return std::make_unique<BackendImpl<OmpTraits>>();
 }
 

@@ -10,7 +10,7 @@ namespace {
 const std::array<ParamInfo, 10> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
-    {"support_factor", "", "kernel support radius in spacings (cubic spline)", 1.5, 4.0, &SolverParams::supportFactor},
+    {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
     {"rest_density", "kg/m^3", "density of the fluid at rest", 1.0, 1e5, &SolverParams::restDensity},
     {"stiffness", "Pa", "Tait stiffness B: p = B((rho/rho0)^gamma - 1); sound speed sqrt(gamma B / rho0)", 1.0, 1e10,
      &SolverParams::stiffness},

@@ -136,6 +136,35 @@ float WallDensityCorrection(const CubicSpline& kernel, float dx, int layers) {
   return static_cast<float>((1.0 - dx3 * fluidSum) / boundarySum);
 }
 
+float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers) {
+  // Normal (x) component of sum gradW_0j; gradW_0j = (x_0 - x_j) GradFactor(r), x_0 = 0.
+  const int reach = static_cast<int>(std::ceil(kernel.H / dx)) + 1;
+  auto gx = [&](int i, int j, int k) {
+    const float r = dx * std::sqrt(static_cast<float>(i * i + j * j + k * k));
+    return r > 0.0f ? -static_cast<float>(i) * dx * kernel.GradFactor(r) : 0.0f;
+  };
+  auto w = [&](int i, int j, int k) {
+    return kernel.W(dx * std::sqrt(static_cast<float>(i * i + j * j + k * k)));
+  };
+  double missing = 0.0;  // the fluid that is not there: x < 0
+  for (int i = -reach; i < 0; ++i)
+    for (int j = -reach; j <= reach; ++j)
+      for (int k = -reach; k <= reach; ++k) missing += gx(i, j, k);
+  double boundary = 0.0;  // sum_b V_b gradW_0b (V_b as in WallDensityCorrection)
+  for (int l = 1; l <= layers; ++l) {
+    double sheetNeighbours = 0.0;
+    for (int m = 1; m <= layers; ++m)
+      for (int j = -reach; j <= reach; ++j)
+        for (int k = -reach; k <= reach; ++k) sheetNeighbours += w(l - m, j, k);
+    const double volume = 1.0 / sheetNeighbours;
+    for (int j = -reach; j <= reach; ++j)
+      for (int k = -reach; k <= reach; ++k) boundary += volume * gx(-l, j, k);
+  }
+  const double dx3 = static_cast<double>(dx) * dx * dx;
+  // m sum_missing gradW = gamma_grad rho0 sum_b V_b gradW with m = rho0 dx^3.
+  return static_cast<float>(dx3 * missing / boundary);
+}
+
 GridShape MakeGridShape(const SceneSetup& scene) {
   const float support = scene.params.spacing * scene.params.supportFactor;
   const float margin = static_cast<float>(scene.boundaryLayers) * scene.params.spacing * 1.1f + 0.5f * support;

@@ -73,6 +73,13 @@ Status ValidateScene(const SceneSetup& scene) {
                            Str(scene.tank.max));
     }
   }
+  const float gamma = WallDensityCorrection(CubicSpline::Make(scene.params.spacing * scene.params.supportFactor),
+                                            scene.params.spacing, scene.boundaryLayers);
+  if (!(gamma > 0.0f)) {
+    return Status::Error(Format("solver.support_factor = %g with %d boundary layer(s) leaves no room for the walls' "
+                                "mass (the fluid lattice alone is over-dense): use a support factor of 2 or more",
+                                scene.params.supportFactor, scene.boundaryLayers));
+  }
   const GridShape grid = MakeGridShape(scene);
   const int dims[3] = {grid.nx, grid.ny, grid.nz};
   for (int a = 0; a < 3; ++a) {
@@ -126,6 +133,7 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.restDensity = p.restDensity;
   ph.invRestDensity = 1.0f / p.restDensity;
   ph.boundaryGamma = WallDensityCorrection(ph.kernel, p.spacing, scene.boundaryLayers);
+  ph.boundaryGradScale = WallGradientCorrection(ph.kernel, p.spacing, scene.boundaryLayers) / ph.boundaryGamma;
   ph.stiffness = p.stiffness;
   ph.exponent = p.exponent;
   ph.soundSpeed = std::sqrt(p.exponent * p.stiffness / p.restDensity);

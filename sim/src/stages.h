@@ -10,8 +10,9 @@
 //   4. density:   rho_i = sum_j m W_ij + sum_b Psi_b W_ib                     (Akinci et al. 2012, eq. 4-5)
 //                 p_i = B ((rho_i/rho0)^gamma - 1), clamped at 0             (B&T 2007, eq. 7)
 //   5. forces:    a_i = -sum_j m (p_i/rho_i^2 + p_j/rho_j^2 + Pi_ij) gradW_ij  (B&T 2007, eq. 6 and 10)
-//                       -sum_b Psi_b (2 p_i/rho_i^2 + Pi_ib) gradW_ib        (Akinci et al. 2012, eq. 10-11, with
-//                                                  pressure mirroring p_b = p_i, rho_b = rho_i in the symmetric form)
+//                       -sum_b Psi_b (s (p_i + p_b)/rho_i^2 + Pi_ib) gradW_ib (Akinci et al. 2012, eq. 10-11, in the
+//                             symmetric form; p_b = max(p_i, Shepard average of p around i); s: flat-wall
+//                             gradient consistency, sampling.h)
 //                       + g
 //                 Pi_ij = -2 alpha c h min(v_ij.x_ij, 0) / ((|x_ij|^2 + 0.01 h^2)(rho_i + rho_j))  (Monaghan 1992)
 //   6. integrate: symplectic Euler v += dt a, x += dt v; particles leaving the domain are clamped back
@@ -94,6 +95,7 @@ struct Physics {
   float restDensity;
   float invRestDensity;
   float boundaryGamma;  // Psi_b = gamma rho0 V_b: flat-wall rest-density correction (sampling.h)
+  float boundaryGradScale;  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
   float stiffness;      // Tait B
   float exponent;       // Tait gamma
   float soundSpeed;     // sqrt(B gamma / rho0)
@@ -208,21 +210,34 @@ struct ForceStage {
     const float eps = 0.01f * h * h;
     const float viscFluid = 2.0f * ph.alpha * ph.soundSpeed * h;
     Vec3 a{0.0f, 0.0f, 0.0f};
+    // Shepard average of the pressure around i (self included), for the wall term below.
+    float pAverage = fluid.pressure[i] * k.W(0.0f) / rhoi;
+    float weight = k.W(0.0f) / rhoi;
     ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t j, Vec3 d) {
       const float r2 = Dot(d, d);
       if (r2 >= k.H2 || r2 == 0.0f) return;  // r2 == 0: self, or a coincident particle (no direction)
       const float rhoj = fluid.density[j];
+      const float r = sqrtf(r2);
+      const float wj = k.W(r) / rhoj;
+      pAverage += fluid.pressure[j] * wj;
+      weight += wj;
       float term = pTermI + fluid.pressure[j] / (rhoj * rhoj);
       const Vec3 vij = vi - Xyz(fluid.velocity[j]);
       const float vx = Dot(vij, d);
       if (vx < 0.0f) term -= viscFluid * vx / ((r2 + eps) * (rhoi + rhoj));
-      a -= d * (ph.mass * term * k.GradFactor(sqrtf(r2)));
+      a -= d * (ph.mass * term * k.GradFactor(r));
     });
+    // Wall pressure: mirrored (p_b = p_i, Akinci et al. 2012), but never below the average pressure of
+    // i's fluid neighbours (the extrapolation of Adami et al. 2012, taken at i). Near the free surface
+    // p_i is clamped to 0 while the particles below it push it with their own p_j > 0; mirroring alone
+    // then gives the wall no strength and the particle sinks into it.
+    const float pWall = fmaxf(fluid.pressure[i], pAverage / weight);
+    const float wallPressureTerm = ph.boundaryGradScale * (pTermI + pWall / (rhoi * rhoi));
     const float viscWall = ph.soundSpeed * h / (2.0f * rhoi);
     ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
       const float r2 = Dot(d, d);
       if (r2 >= k.H2 || r2 == 0.0f) return;
-      float term = 2.0f * pTermI;  // pressure mirroring: p_b = p_i, rho_b = rho_i in the symmetric form
+      float term = wallPressureTerm;
       const float vx = Dot(vi, d);  // static walls: v_b = 0
       if (vx < 0.0f) term -= grid.boundaryAlpha[j] * viscWall * vx / (r2 + eps);
       a -= d * (grid.boundary[j].w * term * k.GradFactor(sqrtf(r2)));

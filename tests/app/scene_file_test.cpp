@@ -165,11 +165,9 @@ TEST(SceneFileTest, NonNumbersRefused) {
   ExpectRefused(R"({ "run": { "time": "long" }, )" + tank + "}", {"run.time", "must be a number"});
 }
 
-// Known bug (reported): a number literal too large for a double (1e999) makes nlohmann::json::parse throw
-// json::out_of_range (406), but ParseScene catches only json::parse_error, so the exception escapes and
-// `sphxr --headless --scene FILE` aborts (exit 134) instead of printing a one-line error.
-// Enable when ParseScene catches json::exception.
-TEST(SceneFileTest, DISABLED_NumberOverflowRefusedWithoutThrowing) {
+// A number literal too large for a double (1e999) makes nlohmann::json::parse throw json::out_of_range
+// (406), not a parse_error: it must still come back as a one-line error, not abort the program.
+TEST(SceneFileTest, NumberOverflowRefusedWithoutThrowing) {
   const std::string tank = R"("tank": { "min": [0,0,0], "max": [1,1,1] })";
   for (const std::string& text : {R"({ "solver": { "stiffness": 1e999 }, )" + tank + "}",
                                   R"({ "gravity": [0, -1e999, 0], )" + tank + "}"}) {
@@ -181,9 +179,8 @@ TEST(SceneFileTest, DISABLED_NumberOverflowRefusedWithoutThrowing) {
   }
 }
 
-// Known bug (reported): tank.boundary_layers is read with get<int>() after is_number_integer(), so
-// 4294967297 (2^32 + 1) narrows to 1 and is accepted; the range check must run on the 64-bit value.
-TEST(SceneFileTest, DISABLED_HugeIntegerBoundaryLayersRefused) {
+// 4294967297 (2^32 + 1) must not narrow to 1 and be accepted: the range check runs on the 64-bit value.
+TEST(SceneFileTest, HugeIntegerBoundaryLayersRefused) {
   ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "boundary_layers": 4294967297 } })",
                 {"tank.boundary_layers"});
 }

@@ -254,12 +254,11 @@ TEST(WallDensityCorrectionTest, GivesRestDensityNextToAFlatWall) {
   }
 }
 
-// Known bug (reported, not fixed here): solver.support_factor accepts 1.5 to 4, but below about 1.55 the
-// rest lattice alone is over-dense (dx^3 sum W = 1.093 at 1.5 on the full lattice), the half lattice in
-// front of a wall already exceeds rho0, and WallDensityCorrection returns a negative gamma (-0.62 for
-// one layer at 1.5): boundary particles get a negative mass Psi_b and the walls pull the fluid in.
-// Enable when the valid range or the correction is fixed.
-TEST(WallDensityCorrectionTest, DISABLED_PositiveOverTheWholeValidSupportRange) {
+// Below about 1.55 the rest lattice alone is over-dense (dx^3 sum W = 1.093 at 1.5 on the full lattice),
+// so WallDensityCorrection would return a negative gamma (-0.62 for one layer at 1.5) and the walls would
+// pull the fluid in. The valid range of solver.support_factor starts at 1.8, and Solver::Create refuses
+// a non-positive gamma.
+TEST(WallDensityCorrectionTest, PositiveOverTheWholeValidSupportRange) {
   const ParamInfo* info = FindSolverParam("support_factor");
   ASSERT_NE(info, nullptr);
   const float dx = 0.01f;

@@ -1,0 +1,105 @@
+// The dam break of scenes/dam_break.json against the measurements of Martin & Moyce (1952),
+// tests/data/martin_moyce_1952.csv (a copy of shared/data): surge front Z(T) and residual column
+// height H(tau). The front ignores spray (app::DamBreakMinPerBin, sim::ConnectedExtent).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "sphxr/app/scene_file.h"
+#include "sphxr/sim/measure.h"
+#include "sphxr/sim/solver.h"
+
+namespace sphxr {
+namespace {
+
+struct Point {
+  double t, value;
+};
+
+void ReadMeasurements(std::vector<Point>* front, std::vector<Point>* height) {
+  std::ifstream in(SPHXR_TEST_DATA_DIR "/martin_moyce_1952.csv");
+  ASSERT_TRUE(in) << "missing tests/data/martin_moyce_1952.csv";
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("series", 0) == 0) continue;
+    std::stringstream ss(line);
+    std::string series, t, v;
+    std::getline(ss, series, ',');
+    std::getline(ss, t, ',');
+    std::getline(ss, v, ',');
+    (series == "front" ? front : height)->push_back({std::stod(t), std::stod(v)});
+  }
+  ASSERT_FALSE(front->empty());
+  ASSERT_FALSE(height->empty());
+}
+
+double Interpolate(const std::vector<Point>& series, double t) {
+  for (size_t i = 1; i < series.size(); ++i) {
+    if (series[i].t >= t) {
+      const double w = (t - series[i - 1].t) / (series[i].t - series[i - 1].t);
+      return series[i - 1].value + w * (series[i].value - series[i - 1].value);
+    }
+  }
+  return series.back().value;
+}
+
+TEST(DamBreak, MatchesMartinMoyce1952) {
+  std::vector<Point> measuredFront, measuredHeight;
+  ReadMeasurements(&measuredFront, &measuredHeight);
+
+  app::SceneFile scene;
+  ASSERT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/dam_break.json", &scene).ok());
+  ASSERT_TRUE(scene.damBreak.has_value());
+  const app::DamBreakProbe probe = *scene.damBreak;
+  std::unique_ptr<sim::Solver> solver;
+  ASSERT_TRUE(sim::Solver::Create(scene.setup, sim::SolverConfig{}, &solver).ok());
+  const float dx = scene.setup.params.spacing;
+  const double a = probe.columnWidth, g = 9.81;
+  const int minPerBin = app::DamBreakMinPerBin(probe, dx);
+
+  // Simulated Z(T) and H(tau), sampled every step.
+  std::vector<Point> front, height;
+  const double tEnd = 3.05 / std::sqrt(g / a);  // tau = 3 plus a margin; covers T = 3.33 as well
+  sim::HostFluid host;
+  const int n = solver->FluidCount();
+  while (solver->Time() < tEnd) {
+    ASSERT_TRUE(solver->Step().ok());
+    ASSERT_TRUE(std::isfinite(solver->LastStep().maxSpeed)) << "non-finite at t = " << solver->Time();
+    solver->Download(&host);
+    const double t = solver->Time();
+    front.push_back({t * std::sqrt(2.0 * g / a), sim::SurgeFront(host, probe.wallX, dx, minPerBin) / a});
+    height.push_back({t * std::sqrt(g / a),
+                      sim::ColumnHeight(host, probe.floorY, probe.wallX, dx, std::max(1, minPerBin / 2)) / (2.0 * a)});
+  }
+  EXPECT_EQ(static_cast<int>(host.size()), n) << "particles lost";
+
+  double sumSq = 0.0;
+  int count = 0;
+  for (const Point& m : measuredFront) {
+    if (m.t < 1.0 || m.t > 3.3) continue;
+    const double z = Interpolate(front, m.t);
+    const double rel = (z - m.value) / m.value;
+    EXPECT_LE(std::fabs(rel), 0.12) << "surge front at T = " << m.t << ": simulated Z = " << z << ", measured " << m.value;
+    sumSq += rel * rel;
+    ++count;
+  }
+  ASSERT_GT(count, 5);
+  const double rms = std::sqrt(sumSq / count);
+  EXPECT_LE(rms, 0.08) << "RMS relative deviation of the surge front over 1 <= T <= 3.3";
+  RecordProperty("front_rms_percent", std::to_string(100.0 * rms));
+
+  for (const Point& m : measuredHeight) {
+    if (m.t > 3.0) continue;
+    const double h = Interpolate(height, m.t);
+    EXPECT_LE(std::fabs(h - m.value) / m.value, 0.10)
+        << "column height at tau = " << m.t << ": simulated H = " << h << ", measured " << m.value;
+  }
+}
+
+}  // namespace
+}  // namespace sphxr
