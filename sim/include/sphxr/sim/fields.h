@@ -4,18 +4,19 @@
 // can never be forgotten by the sort. Columns: type, name, what it holds.
 //
 // Hot fields (read in the 27-cell loops) come first; `id` is cold (read by export and tests only).
-// Bytes per fluid particle in these fields: 16+16+16+4+4+4 = 60.
+// Bytes per fluid particle in these fields: 16+16+16+4+4+4+4 = 64.
 #include <cstdint>
 #include <vector>
 
 #include "sphxr/sim/vec.h"
 
 #define SPHXR_FLUID_FIELDS(X)                                                   \
-  X(::sphxr::sim::Vec4, position)     /* m; w unused                        */ \
+  X(::sphxr::sim::Vec4, position)     /* m; w = 1 near a wall (density stage) */ \
   X(::sphxr::sim::Vec4, velocity)     /* m/s; w unused                      */ \
   X(::sphxr::sim::Vec4, acceleration) /* m/s^2 of the last force stage      */ \
   X(float, density)                   /* kg/m^3, summation density          */ \
   X(float, pressure)                  /* Pa, Tait equation of state         */ \
+  X(float, pressureTerm)              /* p / rho^2, for the force stage     */ \
   X(uint32_t, id)                     /* stable particle identity           */
 
 namespace sphxr::sim {
