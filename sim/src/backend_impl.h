@@ -95,11 +95,11 @@ class BackendImpl final : public Backend {
 
     // 4. density and pressure
     const FluidView fv = Fluid();
-    thrust::for_each_n(policy, first, n, DensityStage{View(), fv, physics});
+    thrust::for_each_n(policy, first, n, DensityStage{View(), fv, Neighbours(physics), physics});
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // 5. forces
-    thrust::for_each_n(policy, first, n, ForceStage{View(), fv, physics});
+    thrust::for_each_n(policy, first, n, ForceStage{View(), fv, Neighbours(physics), physics});
     if (Status s = lap(Stage::kForces); !s) return s;
 
     // 6. integrate, then the statistics the next time step needs
@@ -207,6 +207,15 @@ class BackendImpl final : public Backend {
 #undef SPHXR_REORDER_FIELD
   }
 
+  /// The neighbour-list scratch, sized for this step's particle count and kernel.
+  NeighbourList Neighbours(const Physics& physics) {
+    const int capacity = physics.maxNeighbours;
+    const size_t n = static_cast<size_t>(FluidCount());
+    if (m_neighbourIndex.size() != n * static_cast<size_t>(capacity)) m_neighbourIndex.resize(n * capacity);
+    if (m_neighbourCount.size() != n) m_neighbourCount.resize(n);
+    return NeighbourList{Raw(m_neighbourIndex), Raw(m_neighbourCount), capacity};
+  }
+
   FluidView Fluid() {
     FluidView v;
 #define SPHXR_VIEW_OF(type, name) v.name = Raw(m_fluid.name);
@@ -240,6 +249,7 @@ class BackendImpl final : public Backend {
   Vector<float> m_scratchFloat;
   Vector<uint32_t> m_scratchU32;
   Vector<uint32_t> m_fluidStart, m_fluidEnd, m_boundaryStart, m_boundaryEnd;
+  Vector<uint32_t> m_neighbourIndex, m_neighbourCount;  // per-step scratch (stages.h NeighbourList)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
 };

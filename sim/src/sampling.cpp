@@ -165,6 +165,11 @@ float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers) {
   return static_cast<float>(dx3 * missing / boundary);
 }
 
+int NeighbourCapacity(float supportFactor) {
+  const double lattice = 4.0 / 3.0 * 3.14159265358979 * supportFactor * supportFactor * supportFactor;
+  return static_cast<int>(std::ceil(1.4 * lattice));
+}
+
 GridShape MakeGridShape(const SceneSetup& scene) {
   const float support = scene.params.spacing * scene.params.supportFactor;
   const float margin = static_cast<float>(scene.boundaryLayers) * scene.params.spacing * 1.1f + 0.5f * support;

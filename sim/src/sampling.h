@@ -34,6 +34,10 @@ float WallDensityCorrection(const CubicSpline& kernel, float dx, int layers);
 /// 4.7 % above it at 2.5 dx, where using the density factor let particles sink into the walls.
 float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers);
 
+/// Neighbour-list slots per fluid particle: 1.4 x the rest-lattice count (4/3) pi support_factor^3,
+/// room for 40 % compression or clustering before a particle falls back to scanning its cells.
+int NeighbourCapacity(float supportFactor);
+
 /// The grid over the tank plus the boundary layers, cells of the kernel support.
 GridShape MakeGridShape(const SceneSetup& scene);
 

@@ -134,6 +134,7 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.invRestDensity = 1.0f / p.restDensity;
   ph.boundaryGamma = WallDensityCorrection(ph.kernel, p.spacing, scene.boundaryLayers);
   ph.boundaryGradScale = WallGradientCorrection(ph.kernel, p.spacing, scene.boundaryLayers) / ph.boundaryGamma;
+  ph.maxNeighbours = NeighbourCapacity(p.supportFactor);
   ph.stiffness = p.stiffness;
   ph.exponent = p.exponent;
   ph.soundSpeed = std::sqrt(p.exponent * p.stiffness / p.restDensity);

@@ -37,6 +37,16 @@ struct FluidView {
   int count;
 };
 
+/// Per-step scratch (not particle state, so not in the field list: rebuilt after every sort): the
+/// fluid neighbours j != i within the support that the density stage found, in the order of its cell
+/// scan, maxNeighbours slots per particle. The force stage walks this list instead of scanning the 27
+/// cells again; a particle with more neighbours (count > maxNeighbours) falls back to the scan.
+struct NeighbourList {
+  uint32_t* index;  // [i * maxNeighbours + k]
+  uint32_t* count;  // per particle; > maxNeighbours means "overflowed, scan the cells"
+  int maxNeighbours;
+};
+
 /// The uniform grid over the domain: cells of size >= the kernel support; two particle sets
 /// (fluid, re-sorted every step; boundary, sorted once) with their own cell ranges.
 struct GridView {
@@ -116,7 +126,8 @@ struct Physics {
   float restDensity;
   float invRestDensity;
   float boundaryGamma;  // Psi_b = gamma rho0 V_b: flat-wall rest-density correction (sampling.h)
-  float boundaryGradScale;  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
+  float boundaryGradScale;
+  int maxNeighbours;    // neighbour-list slots per particle (NeighbourList)  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
   float stiffness;      // Tait B
   float exponent;       // Tait gamma
   float soundSpeed;     // sqrt(B gamma / rho0)
@@ -196,15 +207,27 @@ struct BoundaryVolumeStage {
 struct DensityStage {
   GridView grid;
   FluidView fluid;
+  NeighbourList list;
   Physics ph;
   SPHXR_HD void operator()(int i) const {
     const Vec3 xi = Xyz(fluid.position[i]);
     const CubicSpline k = ph.kernel;
     float sumFluid = 0.0f;
-    ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t, Vec3 d) {
+    uint32_t found = 0;
+    uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+    const uint32_t self = static_cast<uint32_t>(i);
+    const uint32_t capacity = static_cast<uint32_t>(list.maxNeighbours);
+    ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t j, Vec3 d) {
       const float r2 = Dot(d, d);
-      if (r2 < k.H2) sumFluid += k.W(sqrtf(r2));
+      if (r2 < k.H2) {
+        sumFluid += k.W(sqrtf(r2));
+        if (j != self) {
+          if (found < capacity) slots[found] = j;
+          ++found;
+        }
+      }
     });
+    list.count[i] = found;
     float sumBoundary = 0.0f;
     ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
       const float r2 = Dot(d, d);
@@ -225,6 +248,7 @@ struct DensityStage {
 struct ForceStage {
   GridView grid;
   FluidView fluid;
+  NeighbourList list;
   Physics ph;
   SPHXR_HD void operator()(int i) const {
     const Vec3 xi = Xyz(fluid.position[i]);
@@ -240,7 +264,7 @@ struct ForceStage {
     const bool nearWall = fluid.position[i].w != 0.0f;
     float pAverage = fluid.pressure[i] * k.W(0.0f) / rhoi;
     float weight = k.W(0.0f) / rhoi;
-    ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t j, Vec3 d) {
+    auto fluidNeighbour = [&](uint32_t j, Vec3 d) {
       const float r2 = Dot(d, d);
       if (r2 >= k.H2 || r2 == 0.0f) return;  // r2 == 0: self, or a coincident particle (no direction)
       const float rhoj = fluid.density[j];
@@ -255,7 +279,18 @@ struct ForceStage {
       const float vx = Dot(vij, d);
       if (vx < 0.0f) term -= viscFluid * vx / ((r2 + eps) * (rhoi + rhoj));
       a -= d * (ph.mass * term * k.GradFactor(r));
-    });
+    };
+    const uint32_t found = list.count[i];
+    if (found <= static_cast<uint32_t>(list.maxNeighbours)) {
+      const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+      for (uint32_t n = 0; n < found; ++n) {
+        const uint32_t j = slots[n];
+        const Vec4 pj = fluid.position[j];
+        fluidNeighbour(j, Vec3{xi.x - pj.x, xi.y - pj.y, xi.z - pj.z});
+      }
+    } else {
+      ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, fluidNeighbour);
+    }
     // Wall pressure: mirrored (p_b = p_i, Akinci et al. 2012), but never below the average pressure of
     // i's fluid neighbours (the extrapolation of Adami et al. 2012, taken at i). Near the free surface
     // p_i is clamped to 0 while the particles below it push it with their own p_j > 0; mirroring alone

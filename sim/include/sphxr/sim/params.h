@@ -66,6 +66,7 @@ struct ParticleCounts {
   int64_t fluid = 0;
   int64_t boundary = 0;
   int64_t gridCells = 0;
+  int64_t neighbourSlots = 0;  // per fluid particle (4 bytes each)
 };
 ParticleCounts CountParticles(const SceneSetup& scene);
 
