@@ -37,6 +37,7 @@ class BackendImpl final : public Backend {
     m_fluidEnd.resize(cells);
     m_boundaryStart.resize(cells);
     m_boundaryEnd.resize(cells);
+    m_boundaryNear.resize(cells);
     Upload(fluid);
 
     // Boundary: sort once by cell code, build its cell ranges, then its volumes.
@@ -62,6 +63,9 @@ class BackendImpl final : public Backend {
       thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
                          BoundaryVolumeStage{g, Raw(sorted), Raw(m_boundary), physics.boundaryGamma * physics.restDensity, physics.kernel});
     }
+    // Which cells have boundary particles in their 27-cell neighbourhood (the walls never move).
+    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), static_cast<int>(cells),
+                       BoundaryNearStage{View(), Raw(m_boundaryNear)});
     Traits::Sync();
     return Status::Ok();
   }
@@ -237,6 +241,7 @@ class BackendImpl final : public Backend {
     g.fluidEnd = Raw(m_fluidEnd);
     g.boundaryStart = Raw(m_boundaryStart);
     g.boundaryEnd = Raw(m_boundaryEnd);
+    g.boundaryNear = Raw(m_boundaryNear);
     g.boundary = Raw(m_boundary);
     g.boundaryAlpha = Raw(m_boundaryAlpha);
     return g;
@@ -249,6 +254,7 @@ class BackendImpl final : public Backend {
   Vector<float> m_scratchFloat;
   Vector<uint32_t> m_scratchU32;
   Vector<uint32_t> m_fluidStart, m_fluidEnd, m_boundaryStart, m_boundaryEnd;
+  Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;  // per-step scratch (stages.h NeighbourList)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;

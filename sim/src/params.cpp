@@ -52,7 +52,7 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
   // Neighbour lists: 4 B per slot and a count (sim/src/stages.h NeighbourList).
   const int64_t fluid = counts.fluid * (64 + 8 + 16 + 8 + 64 + 4 * counts.neighbourSlots + 4);
   const int64_t boundary = counts.boundary * (16 + 40 + 16);
-  const int64_t grid = counts.gridCells * 16;
+  const int64_t grid = counts.gridCells * 17;  // 4 ranges of 4 B and the near-boundary flag
   return fluid + boundary + grid;
 }
 

@@ -60,6 +60,7 @@ struct GridView {
   const uint32_t* boundaryEnd;
   const Vec4* boundary;  // xyz position, w = Psi_b (kg)
   const float* boundaryAlpha;  // artificial viscosity alpha of each boundary particle's wall
+  const uint8_t* boundaryNear; // per cell: 1 when a boundary particle lies in its 27 cells
 
   SPHXR_HD SPHXR_INLINE int Clampi(int v, int hi) const { return v < 0 ? 0 : (v > hi ? hi : v); }
   SPHXR_HD SPHXR_INLINE void CellOf(Vec3 p, int* cx, int* cy, int* cz) const {
@@ -184,6 +185,23 @@ struct CellRangeStage {
   }
 };
 
+// ---- cells near the boundary (once): any boundary particle in the 27 cells around cell c ------------
+struct BoundaryNearStage {
+  GridView grid;
+  uint8_t* out;
+  SPHXR_HD void operator()(int c) const {
+    const int cx = c % grid.nx, cy = (c / grid.nx) % grid.ny, cz = c / (grid.nx * grid.ny);
+    uint8_t near = 0;
+    for (int z = cz - 1; z <= cz + 1; ++z)
+      for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x) {
+          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
+          if (grid.boundaryStart[grid.Linear(x, y, z)] != kEmptyCell) near = 1;
+        }
+    out[c] = near;
+  }
+};
+
 // ---- boundary volumes (once, Akinci et al. 2012 eq. 4: V_b = 1 / sum_k W_bk; Psi_b = gamma rho0 V_b) --
 struct BoundaryVolumeStage {
   GridView grid;
@@ -229,10 +247,14 @@ struct DensityStage {
     });
     list.count[i] = found;
     float sumBoundary = 0.0f;
-    ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
-      const float r2 = Dot(d, d);
-      if (r2 < k.H2) sumBoundary += grid.boundary[j].w * k.W(sqrtf(r2));
-    });
+    int cx, cy, cz;
+    grid.CellOf(xi, &cx, &cy, &cz);
+    if (grid.boundaryNear[grid.Linear(cx, cy, cz)]) {
+      ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
+        const float r2 = Dot(d, d);
+        if (r2 < k.H2) sumBoundary += grid.boundary[j].w * k.W(sqrtf(r2));
+      });
+    }
     const float rho = ph.mass * sumFluid + sumBoundary;
     fluid.density[i] = rho;
     const float pressure = TaitPressure(ph, rho);
