@@ -50,6 +50,22 @@ void SampleShell(const Aabb& box, float dx, int layers, bool outward, bool openT
   }
 }
 
+// The number of points SampleShell emits, without visiting them (a scene is counted, and may be
+// refused, before anything is allocated: walking a fine lattice took 25 s for a 1 m tank at 0.5 mm).
+int64_t ShellCount(const Aabb& box, float dx, int layers, bool outward, bool openTop) {
+  const float ext[3] = {box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z};
+  int64_t n[3];
+  for (int a = 0; a < 3; ++a) n[a] = std::max<int64_t>(1, std::llround(ext[a] / dx));
+  const int64_t out = outward ? layers - 1 : 0;
+  const int64_t in = outward ? 0 : layers - 1;
+  const int64_t yTop = openTop ? n[1] : n[1] + out;
+  const int64_t total = (n[0] + 2 * out + 1) * (yTop + out + 1) * (n[2] + 2 * out + 1);
+  const int64_t insideX = std::max<int64_t>(0, n[0] - 2 * in - 1);
+  const int64_t insideY = openTop ? std::max<int64_t>(0, yTop - in) : std::max<int64_t>(0, n[1] - 2 * in - 1);
+  const int64_t insideZ = std::max<int64_t>(0, n[2] - 2 * in - 1);
+  return total - insideX * insideY * insideZ;
+}
+
 }  // namespace
 
 int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
@@ -59,6 +75,10 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
     const int64_t nx = FitCount(block.box.max.x - block.box.min.x, dx);
     const int64_t ny = FitCount(block.box.max.y - block.box.min.y, dx);
     const int64_t nz = FitCount(block.box.max.z - block.box.min.z, dx);
+    if (!out && scene.obstacles.empty()) {  // counting only: the lattice is full
+      count += nx * ny * nz;
+      continue;
+    }
     for (int64_t k = 0; k < nz; ++k) {
       for (int64_t j = 0; j < ny; ++j) {
         for (int64_t i = 0; i < nx; ++i) {
@@ -98,15 +118,22 @@ int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out, std::vec
   tank.min = tank.min - Vec3{half, half, half};
   tank.max = tank.max + Vec3{half, half, half};
   if (scene.openTop) tank.max.y = scene.tank.max.y;
+  std::vector<Aabb> inner;
+  for (const Aabb& o : scene.obstacles) {
+    Aabb b = o;
+    const Vec3 c = (o.min + o.max) * 0.5f;
+    b.min = Vec3{std::min(c.x, o.min.x + half), std::min(c.y, o.min.y + half), std::min(c.z, o.min.z + half)};
+    b.max = Vec3{std::max(c.x, o.max.x - half), std::max(c.y, o.max.y - half), std::max(c.z, o.max.z - half)};
+    inner.push_back(b);
+  }
+  if (!out && !viscosity) {  // counting only
+    count = ShellCount(tank, dx, scene.boundaryLayers, /*outward=*/true, scene.openTop);
+    for (const Aabb& b : inner) count += ShellCount(b, dx, scene.boundaryLayers, /*outward=*/false, false);
+    return count;
+  }
   SampleShell(tank, dx, scene.boundaryLayers, /*outward=*/true, scene.openTop, emit);
   tankPass = false;
-  for (const Aabb& o : scene.obstacles) {
-    Aabb inner = o;
-    const Vec3 c = (o.min + o.max) * 0.5f;
-    inner.min = Vec3{std::min(c.x, o.min.x + half), std::min(c.y, o.min.y + half), std::min(c.z, o.min.z + half)};
-    inner.max = Vec3{std::max(c.x, o.max.x - half), std::max(c.y, o.max.y - half), std::max(c.z, o.max.z - half)};
-    SampleShell(inner, dx, scene.boundaryLayers, /*outward=*/false, false, emit);
-  }
+  for (const Aabb& b : inner) SampleShell(b, dx, scene.boundaryLayers, /*outward=*/false, false, emit);
   return count;
 }
 
