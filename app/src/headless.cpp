@@ -303,7 +303,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     std::printf(" %s %.3f", sim::StageName(static_cast<sim::Stage>(s)), summary->stageMsPerStep[s]);
   }
   std::printf("\n");
-  std::printf("  density error   mean %.3f %% (peak over run %.3f %%), max %.3f %% at the end\n",
+  std::printf("  density error   mean compression %.3f %% (peak over run %.3f %%); largest |rho/rho0 - 1| %.3f %% at the "
+              "end (spray and surface particles are light)\n",
               100.0 * summary->meanDensityError, 100.0 * summary->peakMeanDensityError, 100.0 * summary->maxDensityError);
   std::printf("  max speed       %.3f m/s over the run\n", summary->maxSpeed);
   std::printf("  particles lost  %lld (clamped back into the tank: %lld times)\n", static_cast<long long>(summary->lost),
