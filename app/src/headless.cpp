@@ -86,7 +86,8 @@ DamBreakMeasure MeasureDamBreak(const DamBreakProbe& probe, const sim::HostFluid
 std::string UsageText() {
   return "usage: sphxr [--headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
          "             [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
-         "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--progress | --no-progress]\n"
+         "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off]\n"
+         "             [--progress | --no-progress]\n"
          "\n"
          "  --headless        run without a window (the only mode until the renderer lands)\n"
          "  --scene FILE      JSON scene (default: " SPHXR_SCENES_DIR "/dam_break.json)\n"
@@ -98,7 +99,8 @@ std::string UsageText() {
          "  --set KEY=VALUE   a solver parameter of the scene's \"solver\" section, e.g. --set stiffness=2e5\n"
          "  --export-every K  write the particles every K steps to DIR (PLY or VTK: ParaView, Blender)\n"
          "  --stats FILE.csv  one CSV row per step (time, dt, speeds, density errors, probes)\n"
-         "  --validate        check every stage for non-finite values; stop at the first, naming it\n";
+         "  --validate        check every stage for non-finite values; stop at the first, naming it\n"
+         "  --reuse on|off    activity-based reuse (the scene's \"reuse\" section sets its parameters)\n";
 }
 
 Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
@@ -119,6 +121,11 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       out->mode = Mode::kDesktop;
     } else if (arg == "--xr") {
       out->mode = Mode::kXr;
+    } else if (arg == "--reuse") {
+      if (Status s = value(&v); !s) return s;
+      const std::string r = v;
+      if (r != "on" && r != "off") return Status::Error("--reuse " + r + ": must be on or off");
+      out->reuse = r == "on" ? 1 : 0;
     } else if (arg == "--validate") {
       out->validate = true;
     } else if (arg == "--progress") {
@@ -183,6 +190,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (Status s = SetSolverParam(&scene.setup, set); !s) return s;
   }
   if (options.spacing > 0.0f) scene.setup.params.spacing = options.spacing;
+  if (options.reuse >= 0) scene.setup.reuse.enabled = options.reuse == 1;
 
   double targetTime = options.time;
   int64_t targetSteps = options.steps;
@@ -222,7 +230,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
 
   const bool probeEveryStep = scene.damBreak.has_value() && stats.is_open();
   if (stats) {
-    stats << "step,time,dt,max_speed,mean_density_error,max_density_error,clamped";
+    stats << "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction";
     if (probeEveryStep) stats << ",front_Z,height_H";
     stats << "\n";
   }
@@ -242,6 +250,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (Status s = exportNow(0); !s) return s;
   }
 
+  double activeSum = 0.0;
   const auto begin = std::chrono::steady_clock::now();
   while (targetSteps > 0 ? solver->GetTotals().steps < targetSteps : solver->Time() < targetTime - 1e-9) {
     if (Status s = solver->Step(); !s) return s;
@@ -249,6 +258,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     const int64_t step = solver->GetTotals().steps;
     summary->peakMeanDensityError = std::max(summary->peakMeanDensityError, info.meanDensityError);
     summary->maxSpeed = std::max(summary->maxSpeed, info.maxSpeed);
+    activeSum += info.activeFraction;
     if (!std::isfinite(info.maxSpeed)) {
       return Status::Error(Format("the simulation became non-finite at step %lld (t = %.4g s); rerun with --validate "
                                   "to find the stage and particle, and lower solver.fixed_dt or raise solver.stiffness",
@@ -256,7 +266,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
     if (stats) {
       stats << step << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
-            << info.maxDensityError << ',' << info.clamped;
+            << info.maxDensityError << ',' << info.clamped << ',' << info.activeFraction;
       if (probeEveryStep) {
         solver->Download(&host);
         const DamBreakMeasure m = MeasureDamBreak(*scene.damBreak, host, spacing);
@@ -283,6 +293,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   summary->meanDensityError = solver->LastStep().meanDensityError;
   summary->maxDensityError = solver->LastStep().maxDensityError;
   summary->clampedEvents = totals.clampedEvents;
+  summary->meanActiveFraction = totals.steps > 0 ? activeSum / static_cast<double>(totals.steps) : 1.0;
   solver->Download(&host);
   summary->lost = summary->fluid - static_cast<int64_t>(host.size());
   if (scene.damBreak) {
@@ -307,6 +318,12 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
               "end (spray and surface particles are light)\n",
               100.0 * summary->meanDensityError, 100.0 * summary->peakMeanDensityError, 100.0 * summary->maxDensityError);
   std::printf("  max speed       %.3f m/s over the run\n", summary->maxSpeed);
+  if (scene.setup.reuse.enabled) {
+    std::printf("  reuse           on: %.1f %% of the particles computed per step on average (delta1 %g, delta2 %g, "
+                "threshold %g, idle %d)\n",
+                100.0 * summary->meanActiveFraction, scene.setup.reuse.delta1, scene.setup.reuse.delta2,
+                scene.setup.reuse.threshold, scene.setup.reuse.idle);
+  }
   std::printf("  particles lost  %lld (clamped back into the tank: %lld times)\n", static_cast<long long>(summary->lost),
               static_cast<long long>(summary->clampedEvents));
   if (scene.damBreak) {

@@ -59,7 +59,7 @@ class Reader {
 
   Status Parse(const json& root) {
     if (!root.is_object()) return Error("(root)", "a scene must be a JSON object");
-    CheckKeys(root, "", {"name", "description", "solver", "gravity", "tank", "fluid", "obstacles", "run", "probe"});
+    CheckKeys(root, "", {"name", "description", "solver", "gravity", "tank", "fluid", "obstacles", "run", "probe", "reuse"});
     sim::SceneSetup& s = m_out->setup;
     if (root.contains("name")) {
       if (!root["name"].is_string()) return Error("name", "must be a string");
@@ -138,6 +138,34 @@ class Reader {
         sim::Aabb box;
         if (Status st = Box(obstacles[i], key, &box); !st) return st;
         s.obstacles.push_back(box);
+      }
+    }
+    if (root.contains("reuse")) {
+      // A reuse section turns reuse on unless it says "enabled": false.
+      const json& reuse = root["reuse"];
+      if (!reuse.is_object()) return Error("reuse", "must be an object");
+      CheckKeys(reuse, "reuse", {"enabled", "delta1", "delta2", "threshold", "idle", "pressure_scale", "cell_count"});
+      sim::ReuseParams& r = s.reuse;
+      r.enabled = true;
+      if (reuse.contains("enabled")) {
+        if (!reuse["enabled"].is_boolean()) return Error("reuse.enabled", "must be true or false");
+        r.enabled = reuse["enabled"].get<bool>();
+      }
+      const std::pair<const char*, float*> numbers[] = {{"delta1", &r.delta1},       {"delta2", &r.delta2},
+                                                        {"threshold", &r.threshold}, {"pressure_scale", &r.pressureScale},
+                                                        {"cell_count", &r.cellCount}};
+      for (const auto& [key, member] : numbers) {
+        if (!reuse.contains(key)) continue;
+        double v;
+        if (Status st = Number(reuse[key], std::string("reuse.") + key, &v); !st) return st;
+        if (v < 0 || v > 1e9) return Error(std::string("reuse.") + key, "must be from 0 to 1e9");
+        *member = static_cast<float>(v);
+      }
+      if (reuse.contains("idle")) {
+        if (!reuse["idle"].is_number_integer()) return Error("reuse.idle", "must be an integer (steps)");
+        const int64_t idle = reuse["idle"].get<int64_t>();
+        if (idle < 0 || idle > 1000) return Error("reuse.idle", "must be 0 to 1000 steps");
+        r.idle = static_cast<int>(idle);
       }
     }
     if (root.contains("run")) {

@@ -4,6 +4,7 @@
 // (built by nvcc). Sorting, fills, gathers and reductions come from thrust (CCCL); nothing of that
 // kind is hand-written. Include this from exactly one translation unit per system.
 #include <thrust/copy.h>
+#include <thrust/iterator/counting_iterator.h>
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/gather.h>
@@ -97,19 +98,41 @@ class BackendImpl final : public Backend {
     CellRanges();
     if (Status s = lap(Stage::kGrid); !s) return s;
 
-    // 4. density and pressure
+    // 3b. activity (reuse): classify, then compact the particles that compute this step
     const FluidView fv = Fluid();
-    thrust::for_each_n(policy, first, n, DensityStage{View(), fv, Neighbours(physics), physics});
+    int computing = n;
+    if (physics.reuseEnabled) {
+      thrust::for_each_n(policy, first, n, ActivityStage{View(), fv, physics});
+      m_computeList.resize(n);
+      auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),
+                                 ComputesThisStep{Raw(m_fluid.idle), physics.reuseIdle});
+      computing = static_cast<int>(end - m_computeList.begin());
+      if (Status s = lap(Stage::kActivity); !s) return s;
+    }
+
+    // 4. density and pressure (skipped particles cost nothing: the stages run over the compacted list)
+    const DensityStage density{View(), fv, Neighbours(physics), physics};
+    if (physics.reuseEnabled) {
+      thrust::for_each_n(policy, first, computing, OverList<DensityStage>{Raw(m_computeList), density});
+    } else {
+      thrust::for_each_n(policy, first, n, density);
+    }
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // 5. forces
-    thrust::for_each_n(policy, first, n, ForceStage{View(), fv, Neighbours(physics), physics});
+    const ForceStage forces{View(), fv, Neighbours(physics), physics};
+    if (physics.reuseEnabled) {
+      thrust::for_each_n(policy, first, computing, OverList<ForceStage>{Raw(m_computeList), forces});
+    } else {
+      thrust::for_each_n(policy, first, n, forces);
+    }
     if (Status s = lap(Stage::kForces); !s) return s;
 
     // 6. integrate, then the statistics the next time step needs
     thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
     *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics.invRestDensity},
                                     StepReduction{}, StepReductionCombine{});
+    out->computed = computing;
     return lap(Stage::kIntegrate);
   }
 
@@ -150,6 +173,7 @@ class BackendImpl final : public Backend {
     m_scratchVec4.resize(n);
     m_scratchFloat.resize(n);
     m_scratchU32.resize(n);
+    m_scratchI32.resize(n);
   }
 
   int FluidCount() const override { return static_cast<int>(m_fluid.position.size()); }
@@ -175,8 +199,9 @@ class BackendImpl final : public Backend {
   Vector<T>& Scratch() {
     if constexpr (std::is_same_v<T, Vec4>) return m_scratchVec4;
     else if constexpr (std::is_same_v<T, float>) return m_scratchFloat;
+    else if constexpr (std::is_same_v<T, int32_t>) return m_scratchI32;
     else {
-      static_assert(std::is_same_v<T, uint32_t> || std::is_same_v<T, int32_t>, "add a scratch buffer for this type");
+      static_assert(std::is_same_v<T, uint32_t>, "add a scratch buffer for this type");
       return m_scratchU32;
     }
   }
@@ -253,9 +278,11 @@ class BackendImpl final : public Backend {
   Vector<Vec4> m_scratchVec4;
   Vector<float> m_scratchFloat;
   Vector<uint32_t> m_scratchU32;
+  Vector<int32_t> m_scratchI32;
   Vector<uint32_t> m_fluidStart, m_fluidEnd, m_boundaryStart, m_boundaryEnd;
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
-  Vector<uint32_t> m_neighbourIndex, m_neighbourCount;  // per-step scratch (stages.h NeighbourList)
+  Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
+  Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step  // per-step scratch (stages.h NeighbourList)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
 };

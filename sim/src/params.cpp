@@ -46,11 +46,11 @@ ParticleCounts CountParticles(const SceneSetup& scene) {
 }
 
 int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
-  // Fluid: the field list (64 B) + sort keys and order (8) + reorder scratch of the widest field (16)
+  // Fluid: the field list (68 B) + sort keys and order (8) + reorder scratch of the widest field (16)
   // + the sort's temporary storage (about keys and values again, 8). Boundary: 16 B, plus its sort at
   // start-up (~40 B transient). Grid: 4 ranges of 4 B per cell. Host copy at creation: the same again.
   // Neighbour lists: 4 B per slot and a count (sim/src/stages.h NeighbourList).
-  const int64_t fluid = counts.fluid * (64 + 8 + 16 + 8 + 64 + 4 * counts.neighbourSlots + 4);
+  const int64_t fluid = counts.fluid * (68 + 8 + 16 + 8 + 68 + 4 * counts.neighbourSlots + 4);
   const int64_t boundary = counts.boundary * (16 + 40 + 16);
   const int64_t grid = counts.gridCells * 17;  // 4 ranges of 4 B and the near-boundary flag
   return fluid + boundary + grid;

@@ -50,6 +50,19 @@ Status ValidateScene(const SceneSetup& scene) {
   if (!std::isfinite(scene.floorViscosity) || scene.floorViscosity > 10.0f) {
     return Status::Error(Format("tank.floor_viscosity = %g is invalid: must be from 0 to 10", scene.floorViscosity));
   }
+  {
+    const ReuseParams& r = scene.reuse;
+    const float values[] = {r.delta1, r.delta2, r.threshold, r.pressureScale, r.cellCount};
+    const char* names[] = {"delta1", "delta2", "threshold", "pressure_scale", "cell_count"};
+    for (int k = 0; k < 5; ++k) {
+      if (!std::isfinite(values[k]) || values[k] < 0.0f || values[k] > 1e9f) {
+        return Status::Error(Format("reuse.%s = %g is invalid: must be a number from 0 to 1e9", names[k], values[k]));
+      }
+    }
+    if (r.idle < 0 || r.idle > 1000) {
+      return Status::Error(Format("reuse.idle = %d is invalid: must be 0 to 1000 steps", r.idle));
+    }
+  }
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
   if (scene.boundaryLayers < 1 || scene.boundaryLayers > 4) {
     return Status::Error(Format("tank.boundary_layers = %d is invalid: must be 1 to 4", scene.boundaryLayers));
@@ -135,6 +148,17 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.boundaryGamma = WallDensityCorrection(ph.kernel, p.spacing, scene.boundaryLayers);
   ph.boundaryGradScale = WallGradientCorrection(ph.kernel, p.spacing, scene.boundaryLayers) / ph.boundaryGamma;
   ph.maxNeighbours = NeighbourCapacity(p.supportFactor);
+  const ReuseParams& r = scene.reuse;
+  ph.reuseEnabled = r.enabled;
+  ph.reuseDelta1 = r.delta1;
+  ph.reuseDelta2 = r.delta2;
+  ph.reuseThreshold = r.threshold;
+  ph.reuseIdle = r.idle;
+  // P_pc: the Tait pressure at 1 % compression unless the scene sets it (our copy of the paper stops
+  // before its parameter values); N_CPN: the rest lattice's particles per cell, (cell / dx)^3.
+  const float pc = r.pressureScale > 0.0f ? r.pressureScale : p.stiffness * (std::pow(1.01f, p.exponent) - 1.0f);
+  ph.reuseInvPressureScale = 1.0f / pc;
+  ph.reuseCellCount = r.cellCount > 0.0f ? r.cellCount : p.supportFactor * p.supportFactor * p.supportFactor;
   ph.stiffness = p.stiffness;
   ph.exponent = p.exponent;
   ph.soundSpeed = std::sqrt(p.exponent * p.stiffness / p.restDensity);
@@ -180,6 +204,7 @@ const char* StageName(Stage stage) {
     case Stage::kCells: return "cells";
     case Stage::kSort: return "sort";
     case Stage::kGrid: return "grid";
+    case Stage::kActivity: return "activity";
     case Stage::kDensity: return "density";
     case Stage::kForces: return "forces";
     case Stage::kIntegrate: return "integrate";
@@ -244,6 +269,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
         fluid.velocity[i] = MakeVec4(block.velocity);
         fluid.id[i] = static_cast<uint32_t>(i);
         fluid.density[i] = scene.params.restDensity;
+        fluid.idle[i] = -1;  // every particle computes its first step
       }
     }
   }
@@ -339,6 +365,7 @@ Status Solver::Step() {
   m_last.meanDensityError = n > 0 ? static_cast<float>(red.sumCompression / n) : 0.0f;
   m_last.maxDensityError = red.maxDensityError;
   m_last.clamped = red.clamped;
+  m_last.activeFraction = n > 0 ? static_cast<float>(red.computed) / static_cast<float>(n) : 1.0f;
   m_totals.steps += 1;
   m_totals.clampedEvents += red.clamped;
   m_totals.stepSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();

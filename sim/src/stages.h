@@ -128,7 +128,15 @@ struct Physics {
   float invRestDensity;
   float boundaryGamma;  // Psi_b = gamma rho0 V_b: flat-wall rest-density correction (sampling.h)
   float boundaryGradScale;
-  int maxNeighbours;    // neighbour-list slots per particle (NeighbourList)  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
+  int maxNeighbours;    // neighbour-list slots per particle (NeighbourList)
+  // Activity-based reuse (Huang et al. 2013, section 3.3); used only when the reuse stage runs.
+  bool reuseEnabled;
+  float reuseDelta1;
+  float reuseDelta2;
+  float reuseThreshold;
+  int reuseIdle;
+  float reuseInvPressureScale;  // 1 / P_pc
+  float reuseCellCount;         // N_CPN  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
   float stiffness;      // Tait B
   float exponent;       // Tait gamma
   float soundSpeed;     // sqrt(B gamma / rho0)
@@ -219,6 +227,58 @@ struct BoundaryVolumeStage {
     });
     out[b] = MakeVec4(xb, psiScale / sum);
   }
+};
+
+// ---- stage 3b: activity (reuse on) ---------------------------------------------------------------
+// Idle count IC: -1 active. A particle with IC > 0 reuses this step (density, pressure, acceleration
+// stay as they are) and counts down; at IC = 0, or when active, it computes this step and is classified
+// with its previous pressure and the crowding of its cells: ACT_i < T gives IC = IDLE, else -1. So a
+// particle never reuses more than IDLE consecutive steps. After this stage, "computes this step" is
+// exactly IC == -1 or IC == IDLE (ComputesThisStep).
+struct ActivityStage {
+  GridView grid;
+  FluidView fluid;
+  Physics ph;
+  SPHXR_HD void operator()(int i) const {
+    const int32_t ic = fluid.idle[i];
+    if (ic > 0) {
+      fluid.idle[i] = ic - 1;
+      return;
+    }
+    int cx, cy, cz;
+    grid.CellOf(Xyz(fluid.position[i]), &cx, &cy, &cz);
+    int cells = 0;
+    uint32_t particles = 0;
+    for (int z = cz - 1; z <= cz + 1; ++z)
+      for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x) {
+          ++cells;  // cells outside the grid count as empty: a particle there is at an edge, keep it active
+          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
+          // Wall particles count too: water along a wall is crowded, not sparse, although the cells
+          // beyond the wall hold no fluid.
+          const uint32_t c = grid.Linear(x, y, z);
+          if (grid.fluidStart[c] != kEmptyCell) particles += grid.fluidEnd[c] - grid.fluidStart[c];
+          if (grid.boundaryStart[c] != kEmptyCell) particles += grid.boundaryEnd[c] - grid.boundaryStart[c];
+        }
+    const float meanCount = static_cast<float>(particles) / static_cast<float>(cells);
+    const float act = ph.reuseDelta1 * fluid.pressure[i] * ph.reuseInvPressureScale +
+                      ph.reuseDelta2 * ph.reuseCellCount / fmaxf(meanCount, 1e-6f);
+    fluid.idle[i] = (act < ph.reuseThreshold && ph.reuseIdle > 0) ? ph.reuseIdle : -1;
+  }
+};
+
+struct ComputesThisStep {
+  const int32_t* idle;
+  int32_t idleSteps;
+  SPHXR_HD bool operator()(int i) const { return idle[i] == -1 || idle[i] == idleSteps; }
+};
+
+/// Runs a per-particle stage over a compacted list of particle indices.
+template <class Stage>
+struct OverList {
+  const uint32_t* list;
+  Stage stage;
+  SPHXR_HD void operator()(int k) const { stage(static_cast<int>(list[k])); }
 };
 
 // ---- stage 4: density and pressure ---------------------------------------------------------------
@@ -373,6 +433,7 @@ struct StepReduction {
   float maxDensityError = 0.0f;
   double sumCompression = 0.0;
   int32_t clamped = 0;
+  int32_t computed = 0;  // particles that computed density and forces this step (set by the backend)
 };
 
 struct StepReductionOp {

@@ -94,7 +94,7 @@ TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
   const std::map<std::string, std::string> values = {
       {"--scene", "a.json"}, {"--time", "1"},         {"--steps", "5"},          {"--device", "cpu"},
       {"--threads", "1"},    {"--spacing", "0.01"},   {"--set", "cfl=0.3"},      {"--export-every", "2"},
-      {"--out", "d"},        {"--export-format", "ply"}, {"--stats", "f.csv"}};
+      {"--out", "d"},        {"--export-format", "ply"}, {"--stats", "f.csv"}, {"--reuse", "on"}};
   const std::string usage = UsageText();
   std::set<std::string> flags;
   const std::regex flag("--[a-z][a-z-]*");
@@ -248,7 +248,7 @@ TEST(HeadlessTest, RunsASmallSceneWithStatsAndExports) {
   const std::vector<std::string> lines = Lines(test::ReadFile(csv));
   ASSERT_EQ(lines.size(), 21u) << "header + 20 steps expected in " << csv;
   const std::vector<std::string> header = Split(lines[0], ',');
-  EXPECT_EQ(lines[0], "step,time,dt,max_speed,mean_density_error,max_density_error,clamped");
+  EXPECT_EQ(lines[0], "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction");
   double timeSum = 0.0;
   for (size_t i = 1; i < lines.size(); ++i) {
     const std::vector<std::string> cells = Split(lines[i], ',');

@@ -25,6 +25,7 @@ struct Options {
   std::string exportFormat = "ply";  // ply | vtk
   std::string statsPath;    // per-step CSV
   bool validate = false;
+  int reuse = -1;           // -1 = as the scene says, 0 = off, 1 = on (the scene's or default parameters)
   std::vector<std::string> sets;  // solver parameter overrides "key=value"
   int progress = -1;        // -1 = when stderr is a terminal
   bool help = false;
@@ -47,6 +48,7 @@ struct RunSummary {
   float maxDensityError = 0.0f;      // of the last step
   float peakMeanDensityError = 0.0f; // over the run
   float maxSpeed = 0.0f;             // over the run
+  double meanActiveFraction = 1.0;   // reuse: mean over the steps of the fraction that computed
   int64_t clampedEvents = 0;
   int64_t lost = 0;                  // particles missing at the end (always 0: clamped, never removed)
   int64_t exports = 0;

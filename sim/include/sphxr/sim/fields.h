@@ -4,7 +4,7 @@
 // can never be forgotten by the sort. Columns: type, name, what it holds.
 //
 // Hot fields (read in the 27-cell loops) come first; `id` is cold (read by export and tests only).
-// Bytes per fluid particle in these fields: 16+16+16+4+4+4+4 = 64.
+// Bytes per fluid particle in these fields: 16+16+16+4+4+4+4+4 = 68.
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +17,7 @@
   X(float, density)                   /* kg/m^3, summation density          */ \
   X(float, pressure)                  /* Pa, Tait equation of state         */ \
   X(float, pressureTerm)              /* p / rho^2, for the force stage     */ \
+  X(int32_t, idle)                    /* reuse idle count IC: -1 active     */ \
   X(uint32_t, id)                     /* stable particle identity           */
 
 namespace sphxr::sim {

@@ -46,6 +46,20 @@ struct FluidBlock {
   Vec3 velocity;  // initial velocity, m/s
 };
 
+/// Activity-based property reuse (Huang et al. 2013, section 3.3): ACT_i = delta1 P_i / P_pc +
+/// delta2 N_CPN / N_i with P_i the previous step's pressure and N_i the mean particle count of the 27
+/// cells around i; ACT_i < threshold makes i inactive for `idle` steps, in which it keeps its density,
+/// pressure and acceleration. Disabled, the step is exactly the plain WCSPH step.
+struct ReuseParams {
+  bool enabled = false;
+  float delta1 = 1.0f;
+  float delta2 = 1.0f;
+  float threshold = 1.2f;
+  int idle = 3;                  // IDLE: consecutive steps a particle reuses its values
+  float pressureScale = 0.0f;    // P_pc, Pa; 0 = the Tait pressure at 1 % compression
+  float cellCount = 0.0f;        // N_CPN; 0 = (cell size / spacing)^3, the rest lattice's count
+};
+
 struct SceneSetup {
   SolverParams params;
   Vec3 gravity{0.0f, -9.81f, 0.0f};
@@ -59,6 +73,7 @@ struct SceneSetup {
   int boundaryLayers = 1;        // layers of boundary particles behind each wall
   std::vector<FluidBlock> fluid;
   std::vector<Aabb> obstacles;   // solid boxes inside the tank, surfaces sampled
+  ReuseParams reuse;             // no "reuse" section in the scene: disabled
 };
 
 /// Counts the particles a scene will create, without allocating them (for validation).

@@ -29,7 +29,7 @@ struct SolverConfig {
 };
 
 /// Stages of one step, each timed.
-enum class Stage : int { kCells, kSort, kGrid, kDensity, kForces, kIntegrate, kCount };
+enum class Stage : int { kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kCount };
 const char* StageName(Stage stage);
 
 struct StepInfo {
@@ -39,6 +39,7 @@ struct StepInfo {
   float meanDensityError = 0.0f; // mean of max(0, rho/rho0 - 1) over fluid particles
   float maxDensityError = 0.0f;  // max of |rho/rho0 - 1| over fluid particles
   int32_t clamped = 0;           // fluid particles pushed back into the domain this step
+  float activeFraction = 1.0f;   // fraction of fluid particles that computed density and forces (reuse)
 };
 
 struct Totals {
