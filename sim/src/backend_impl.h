@@ -110,22 +110,23 @@ class BackendImpl final : public Backend {
       if (Status s = lap(Stage::kActivity); !s) return s;
     }
 
-    // 4. density and pressure (skipped particles cost nothing: the stages run over the compacted list)
-    const DensityStage density{View(), fv, Neighbours(physics), physics};
-    if (physics.reuseEnabled) {
-      thrust::for_each_n(policy, first, computing, OverList<DensityStage>{Raw(m_computeList), density});
-    } else {
-      thrust::for_each_n(policy, first, n, density);
-    }
+    // Density and forces run over every particle, or with reuse over the compacted list only:
+    // skipped particles cost nothing.
+    auto overComputing = [&](const auto& stage) {
+      using S = std::decay_t<decltype(stage)>;
+      if (physics.reuseEnabled) {
+        thrust::for_each_n(policy, first, computing, OverList<S>{Raw(m_computeList), stage});
+      } else {
+        thrust::for_each_n(policy, first, n, stage);
+      }
+    };
+
+    // 4. density and pressure
+    overComputing(DensityStage{View(), fv, Neighbours(physics), physics});
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // 5. forces
-    const ForceStage forces{View(), fv, Neighbours(physics), physics};
-    if (physics.reuseEnabled) {
-      thrust::for_each_n(policy, first, computing, OverList<ForceStage>{Raw(m_computeList), forces});
-    } else {
-      thrust::for_each_n(policy, first, n, forces);
-    }
+    overComputing(ForceStage{View(), fv, Neighbours(physics), physics});
     if (Status s = lap(Stage::kForces); !s) return s;
 
     // 6. integrate, then the statistics the next time step needs

@@ -137,59 +137,69 @@ int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out, std::vec
   return count;
 }
 
-float WallDensityCorrection(const CubicSpline& kernel, float dx, int layers) {
-  // Rest lattice of spacing dx; the fluid particle at the origin, fluid at x >= 0, boundary sheets at
-  // x = -1 .. -layers (in spacings). Sums run over a cube wide enough for the kernel support.
-  const int reach = static_cast<int>(std::ceil(kernel.H / dx)) + 1;
-  auto w = [&](int i, int j, int k) {
-    return kernel.W(dx * std::sqrt(static_cast<float>(i * i + j * j + k * k)));
-  };
-  double fluidSum = 0.0;  // sum_j W_0j over the fluid half space
-  for (int i = 0; i <= reach; ++i)
-    for (int j = -reach; j <= reach; ++j)
-      for (int k = -reach; k <= reach; ++k) fluidSum += w(i, j, k);
-  double boundarySum = 0.0;  // sum_b V_b W_0b
-  for (int l = 1; l <= layers; ++l) {
-    double sheetNeighbours = 0.0;  // sum_k W_bk for b in sheet -l (an infinite wall)
-    for (int m = 1; m <= layers; ++m)
-      for (int j = -reach; j <= reach; ++j)
-        for (int k = -reach; k <= reach; ++k) sheetNeighbours += w(l - m, j, k);
-    const double volume = 1.0 / sheetNeighbours;
-    for (int j = -reach; j <= reach; ++j)
-      for (int k = -reach; k <= reach; ++k) boundarySum += volume * w(-l, j, k);
+namespace {
+
+// The rest lattice of spacing dx around a fluid particle at the origin: fluid at x >= 0, boundary
+// sheets at x = -1 .. -layers (in spacings), each boundary particle with Akinci's volume
+// V_b = 1 / sum_k W_bk over an infinite wall of those sheets. Sums run over a cube wide enough for
+// the kernel support.
+struct RestLattice {
+  const CubicSpline& kernel;
+  float dx;
+  int layers;
+  int reach = static_cast<int>(std::ceil(kernel.H / dx)) + 1;
+
+  float W(int i, int j, int k) const { return kernel.W(dx * std::sqrt(static_cast<float>(i * i + j * j + k * k))); }
+  // Normal (x) component of gradW_0j = (x_0 - x_j) GradFactor(r) for x_j = (i, j, k) dx.
+  float GradX(int i, int j, int k) const {
+    const float r = dx * std::sqrt(static_cast<float>(i * i + j * j + k * k));
+    return r > 0.0f ? -static_cast<float>(i) * dx * kernel.GradFactor(r) : 0.0f;
   }
-  const double dx3 = static_cast<double>(dx) * dx * dx;
+  // sum over the fluid lattice points with first index in [iFrom, iTo] of f(i, j, k).
+  template <class F>
+  double SumFluid(int iFrom, int iTo, F f) const {
+    double sum = 0.0;
+    for (int i = iFrom; i <= iTo; ++i)
+      for (int j = -reach; j <= reach; ++j)
+        for (int k = -reach; k <= reach; ++k) sum += f(i, j, k);
+    return sum;
+  }
+  // sum_b V_b f(b) over the boundary sheets.
+  template <class F>
+  double SumBoundary(F f) const {
+    double sum = 0.0;
+    for (int l = 1; l <= layers; ++l) {
+      double sheetNeighbours = 0.0;  // sum_k W_bk for b in sheet -l
+      for (int m = 1; m <= layers; ++m)
+        for (int j = -reach; j <= reach; ++j)
+          for (int k = -reach; k <= reach; ++k) sheetNeighbours += W(l - m, j, k);
+      const double volume = 1.0 / sheetNeighbours;
+      for (int j = -reach; j <= reach; ++j)
+        for (int k = -reach; k <= reach; ++k) sum += volume * f(-l, j, k);
+    }
+    return sum;
+  }
+  double Dx3() const { return static_cast<double>(dx) * dx * dx; }
+};
+
+}  // namespace
+
+float WallDensityCorrection(const CubicSpline& kernel, float dx, int layers) {
+  const RestLattice lattice{kernel, dx, layers};
+  auto w = [&](int i, int j, int k) { return lattice.W(i, j, k); };
+  const double fluidSum = lattice.SumFluid(0, lattice.reach, w);  // sum_j W_0j over the fluid half space
+  const double boundarySum = lattice.SumBoundary(w);             // sum_b V_b W_0b
   // rho0 = m sum W_f + gamma rho0 sum V_b W_b with m = rho0 dx^3.
-  return static_cast<float>((1.0 - dx3 * fluidSum) / boundarySum);
+  return static_cast<float>((1.0 - lattice.Dx3() * fluidSum) / boundarySum);
 }
 
 float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers) {
-  // Normal (x) component of sum gradW_0j; gradW_0j = (x_0 - x_j) GradFactor(r), x_0 = 0.
-  const int reach = static_cast<int>(std::ceil(kernel.H / dx)) + 1;
-  auto gx = [&](int i, int j, int k) {
-    const float r = dx * std::sqrt(static_cast<float>(i * i + j * j + k * k));
-    return r > 0.0f ? -static_cast<float>(i) * dx * kernel.GradFactor(r) : 0.0f;
-  };
-  auto w = [&](int i, int j, int k) {
-    return kernel.W(dx * std::sqrt(static_cast<float>(i * i + j * j + k * k)));
-  };
-  double missing = 0.0;  // the fluid that is not there: x < 0
-  for (int i = -reach; i < 0; ++i)
-    for (int j = -reach; j <= reach; ++j)
-      for (int k = -reach; k <= reach; ++k) missing += gx(i, j, k);
-  double boundary = 0.0;  // sum_b V_b gradW_0b (V_b as in WallDensityCorrection)
-  for (int l = 1; l <= layers; ++l) {
-    double sheetNeighbours = 0.0;
-    for (int m = 1; m <= layers; ++m)
-      for (int j = -reach; j <= reach; ++j)
-        for (int k = -reach; k <= reach; ++k) sheetNeighbours += w(l - m, j, k);
-    const double volume = 1.0 / sheetNeighbours;
-    for (int j = -reach; j <= reach; ++j)
-      for (int k = -reach; k <= reach; ++k) boundary += volume * gx(-l, j, k);
-  }
-  const double dx3 = static_cast<double>(dx) * dx * dx;
+  const RestLattice lattice{kernel, dx, layers};
+  auto gx = [&](int i, int j, int k) { return lattice.GradX(i, j, k); };
+  const double missing = lattice.SumFluid(-lattice.reach, -1, gx);  // the fluid that is not there: x < 0
+  const double boundary = lattice.SumBoundary(gx);                  // sum_b V_b gradW_0b
   // m sum_missing gradW = gamma_grad rho0 sum_b V_b gradW with m = rho0 dx^3.
-  return static_cast<float>(dx3 * missing / boundary);
+  return static_cast<float>(lattice.Dx3() * missing / boundary);
 }
 
 int NeighbourCapacity(float supportFactor) {
