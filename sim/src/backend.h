@@ -8,7 +8,9 @@
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/solver.h"
+#include "body_stages.h"
 #include "stages.h"
+#include "surface_extractor.h"
 
 namespace sphxr::sim {
 
@@ -39,6 +41,19 @@ class Backend {
   virtual void Upload(const HostFluid& fluid) = 0;
   virtual int FluidCount() const = 0;
   virtual int BoundaryCount() const = 0;
+
+  // Moving boundaries (body_stages.h). Without InitBodies a step has no body work at all.
+  /// Body-frame particles (w = Psi_b), the body of each, its alpha, and every body's primitives.
+  virtual void InitBodies(const std::vector<Vec4>& local, const std::vector<uint32_t>& bodyOf,
+                          const std::vector<float>& alpha, const std::vector<ShapePrimitive>& shapes) = 0;
+  /// The bodies' motion during the next Step (one state per body).
+  virtual void SetBodyStates(const std::vector<BodyState>& states) = 0;
+  /// Force and torque (about each body's start-of-step origin) of the fluid on each body in the last step.
+  virtual void BodyLoads(std::vector<BodyLoad>* out) const = 0;
+  /// World positions (w = Psi_b) and velocities (w = alpha) of the body particles in the last step.
+  virtual void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const = 0;
+  /// The HPMC stages on this backend's system (surface_impl.h); building from the particles re-grids them.
+  virtual SurfaceExtractor* Surface() = 0;
 };
 
 std::unique_ptr<Backend> MakeCpuBackend(int threads);

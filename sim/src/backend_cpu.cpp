@@ -14,6 +14,7 @@ struct OmpTraits {
   static auto Policy() { return thrust::omp::par; }
   static void Sync() {}
   static constexpr const char* kName = "cpu";
+  static constexpr bool kOnDevice = false;  // where the surface mesh lives
 };
 
 }  // namespace

@@ -14,6 +14,7 @@ struct CudaTraits {
   static auto Policy() { return thrust::cuda::par; }
   static void Sync() { cudaDeviceSynchronize(); }
   static constexpr const char* kName = "cuda";
+  static constexpr bool kOnDevice = true;  // where the surface mesh lives
 };
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <type_traits>
 
 #include "backend.h"
+#include "surface_impl.h"
 
 namespace sphxr::sim {
 
@@ -98,6 +99,13 @@ class BackendImpl final : public Backend {
     CellRanges();
     if (Status s = lap(Stage::kGrid); !s) return s;
 
+    // 3a. moving boundaries (paddles): place, sort, cell ranges, near-cell flags
+    const bool bodies = !m_hostStates.empty();
+    if (bodies) {
+      PlaceBodies();
+      if (Status s = lap(Stage::kBodies); !s) return s;
+    }
+
     // 3b. activity (reuse): classify, then compact the particles that compute this step
     const FluidView fv = Fluid();
     int computing = n;
@@ -126,11 +134,27 @@ class BackendImpl final : public Backend {
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // 5. forces
-    overComputing(ForceStage{View(), fv, Neighbours(physics), physics});
+    if (bodies && m_bodyPressureTerm.size() != static_cast<size_t>(n)) m_bodyPressureTerm.resize(n);
+    overComputing(ForceStage{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr});
     if (Status s = lap(Stage::kForces); !s) return s;
+
+    // 5b. the fluid's force on each body particle (the reaction)
+    if (bodies) {
+      thrust::for_each_n(policy, first, static_cast<int>(m_bodyPos.size()),
+                         BodyReactionStage{View(), fv, physics, Raw(m_bodyPressureTerm), Raw(m_bodyForce)});
+      if (Status s = lap(Stage::kBodies); !s) return s;
+    }
 
     // 6. integrate, then the statistics the next time step needs
     thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
+    // 6b. push fluid out of the bodies at their end-of-step pose
+    if (bodies) {
+      if (Status s = lap(Stage::kIntegrate); !s) return s;
+      thrust::for_each_n(policy, first, n,
+                         PushOutStage{fv, Raw(m_bodyStates), Raw(m_shapes), static_cast<int>(m_hostStates.size()),
+                                      physics.bodyClearance});
+      if (Status s = lap(Stage::kBodies); !s) return s;
+    }
     *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics.invRestDensity},
                                     StepReduction{}, StepReductionCombine{});
     out->computed = computing;
@@ -179,6 +203,65 @@ class BackendImpl final : public Backend {
 
   int FluidCount() const override { return static_cast<int>(m_fluid.position.size()); }
   int BoundaryCount() const override { return static_cast<int>(m_boundary.size()); }
+  SurfaceExtractor* Surface() override { return &m_surface; }
+
+  void InitBodies(const std::vector<Vec4>& local, const std::vector<uint32_t>& bodyOf, const std::vector<float>& alpha,
+                  const std::vector<ShapePrimitive>& shapes) override {
+    const size_t nb = local.size();
+    m_bodyLocal.assign(local.begin(), local.end());
+    m_bodyOfLocal.assign(bodyOf.begin(), bodyOf.end());
+    m_bodyAlpha.assign(alpha.begin(), alpha.end());
+    m_shapes.assign(shapes.begin(), shapes.end());
+    m_bodyKeys.resize(nb);
+    m_bodyOrder.resize(nb);
+    m_bodyPos.resize(nb);
+    m_bodyVel.resize(nb);
+    m_bodyOf.resize(nb);
+    m_bodyForce.resize(nb);
+    thrust::fill(m_bodyForce.begin(), m_bodyForce.end(), Vec4{});
+    const size_t cells = static_cast<size_t>(m_shape.Cells());
+    m_bodyStart.resize(cells);
+    m_bodyEnd.resize(cells);
+    m_movingNear.resize(cells);
+    thrust::fill(m_movingNear.begin(), m_movingNear.end(), uint8_t{0});
+  }
+
+  void SetBodyStates(const std::vector<BodyState>& states) override {
+    m_hostStates = states;
+    m_bodyStates.assign(states.begin(), states.end());
+  }
+
+  void BodyLoads(std::vector<BodyLoad>* out) const override {
+    out->assign(m_hostStates.size(), BodyLoad{});
+    if (m_hostStates.empty()) return;
+    std::vector<Vec4> force(m_bodyForce.size()), position(m_bodyPos.size());
+    std::vector<uint32_t> of(m_bodyOf.size());
+    thrust::copy(m_bodyForce.begin(), m_bodyForce.end(), force.begin());
+    thrust::copy(m_bodyPos.begin(), m_bodyPos.end(), position.begin());
+    thrust::copy(m_bodyOf.begin(), m_bodyOf.end(), of.begin());
+    // Serial sums in the sorted order: the same result on every run and thread count.
+    std::vector<double> sums(6 * m_hostStates.size(), 0.0);
+    for (size_t b = 0; b < force.size(); ++b) {
+      const uint32_t k = of[b];
+      if (k >= m_hostStates.size()) continue;
+      const Vec3 f = Xyz(force[b]);
+      const Vec3 t = Cross(Xyz(position[b]) - m_hostStates[k].position, f);
+      double* s = &sums[6 * k];
+      s[0] += f.x, s[1] += f.y, s[2] += f.z, s[3] += t.x, s[4] += t.y, s[5] += t.z;
+    }
+    for (size_t k = 0; k < out->size(); ++k) {
+      const double* s = &sums[6 * k];
+      (*out)[k].force = Vec3{static_cast<float>(s[0]), static_cast<float>(s[1]), static_cast<float>(s[2])};
+      (*out)[k].torque = Vec3{static_cast<float>(s[3]), static_cast<float>(s[4]), static_cast<float>(s[5])};
+    }
+  }
+
+  void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const override {
+    position->resize(m_bodyPos.size());
+    velocity->resize(m_bodyVel.size());
+    thrust::copy(m_bodyPos.begin(), m_bodyPos.end(), position->begin());
+    thrust::copy(m_bodyVel.begin(), m_bodyVel.end(), velocity->begin());
+  }
 
  private:
   struct Fields {
@@ -222,6 +305,39 @@ class BackendImpl final : public Backend {
     thrust::fill(Traits::Policy(), m_fluidStart.begin(), m_fluidStart.end(), kEmptyCell);
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), n,
                        CellRangeStage{View(), Raw(m_fluid.position), Raw(m_keys), Raw(m_fluidStart), Raw(m_fluidEnd), n});
+  }
+
+  /// Moving boundaries at their start-of-step pose: cell codes, stable sort, world positions and rigid
+  /// velocities in sorted order, cell ranges, and the near-cell flags over each body's bounding box.
+  void PlaceBodies() {
+    auto policy = Traits::Policy();
+    const thrust::counting_iterator<int> first(0);
+    const int nb = static_cast<int>(m_bodyLocal.size());
+    thrust::for_each_n(policy, first, nb,
+                       BodyCellStage{View(), Raw(m_bodyStates), Raw(m_bodyLocal), Raw(m_bodyOfLocal), Raw(m_bodyKeys),
+                                     Raw(m_bodyOrder)});
+    thrust::stable_sort_by_key(policy, m_bodyKeys.begin(), m_bodyKeys.end(), m_bodyOrder.begin());
+    thrust::for_each_n(policy, first, nb,
+                       BodyPlaceStage{Raw(m_bodyStates), Raw(m_bodyLocal), Raw(m_bodyOfLocal), Raw(m_bodyAlpha),
+                                      Raw(m_bodyOrder), Raw(m_bodyPos), Raw(m_bodyVel), Raw(m_bodyOf)});
+    thrust::fill(policy, m_bodyStart.begin(), m_bodyStart.end(), kEmptyCell);
+    thrust::for_each_n(policy, first, nb,
+                       CellRangeStage{View(), Raw(m_bodyPos), Raw(m_bodyKeys), Raw(m_bodyStart), Raw(m_bodyEnd), nb});
+    thrust::fill(policy, m_movingNear.begin(), m_movingNear.end(), uint8_t{0});
+    const GridView g = View();
+    for (const BodyState& s : m_hostStates) {
+      const float r = s.boundRadius;
+      int lo[3], hi[3];
+      g.CellOf(s.position - Vec3{r, r, r}, &lo[0], &lo[1], &lo[2]);
+      g.CellOf(s.position + Vec3{r, r, r}, &hi[0], &hi[1], &hi[2]);
+      const int top[3] = {g.nx - 1, g.ny - 1, g.nz - 1};
+      MovingNearStage stage{g, {}, {}, Raw(m_movingNear)};
+      for (int a = 0; a < 3; ++a) {
+        stage.lo[a] = lo[a] > 0 ? lo[a] - 1 : 0;
+        stage.dims[a] = (hi[a] < top[a] ? hi[a] + 1 : top[a]) - stage.lo[a] + 1;
+      }
+      thrust::for_each_n(policy, first, stage.dims[0] * stage.dims[1] * stage.dims[2], stage);
+    }
   }
 
   /// Applies the sort permutation to every field of the list (one gather and one O(1) swap each).
@@ -270,6 +386,12 @@ class BackendImpl final : public Backend {
     g.boundaryNear = Raw(m_boundaryNear);
     g.boundary = Raw(m_boundary);
     g.boundaryAlpha = Raw(m_boundaryAlpha);
+    g.bodyCount = static_cast<int>(m_hostStates.size());
+    g.bodyStart = Raw(m_bodyStart);
+    g.bodyEnd = Raw(m_bodyEnd);
+    g.body = Raw(m_bodyPos);
+    g.bodyVelocity = Raw(m_bodyVel);
+    g.movingNear = Raw(m_movingNear);
     return g;
   }
 
@@ -286,6 +408,26 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step  // per-step scratch (stages.h NeighbourList)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
+  // Moving boundaries (body_stages.h): canonical body-frame particles, their sorted world copies.
+  Vector<Vec4> m_bodyLocal;        // body frame, w = Psi_b
+  Vector<uint32_t> m_bodyOfLocal;  // body index of each canonical particle
+  Vector<float> m_bodyAlpha;       // alpha of each canonical particle
+  Vector<ShapePrimitive> m_shapes;
+  Vector<BodyState> m_bodyStates;
+  std::vector<BodyState> m_hostStates;  // empty: no bodies, no body work
+  Vector<uint32_t> m_bodyKeys, m_bodyOrder, m_bodyOf;
+  Vector<Vec4> m_bodyPos, m_bodyVel, m_bodyForce;  // sorted
+  Vector<uint32_t> m_bodyStart, m_bodyEnd;
+  Vector<uint8_t> m_movingNear;
+  Vector<float> m_bodyPressureTerm;  // per fluid particle (ForceStage -> BodyReactionStage)
+  // The surface reads the particles through a fresh grid: the integrate stage moved them after the
+  // step's sort. Re-sorting here does not change the next step (its stable sort then keeps this order).
+  SurfaceImpl<Traits> m_surface{[this] {
+    CellCodes();
+    SortAndReorder();
+    CellRanges();
+    return SurfaceParticles{Raw(m_fluid.position), FluidCount(), View()};
+  }};
 };
 
 }  // namespace sphxr::sim

@@ -57,3 +57,35 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
 }
 
 }  // namespace sphxr::sim
+
+namespace sphxr::sim {
+
+// The presets, chosen from the sweep in docs/reuse.md (bench/reuse_sweep.cpp).
+bool ApplyReusePreset(const std::string& name, ReuseParams* reuse) {
+  struct Preset {
+    const char* name;
+    float delta1, delta2, threshold;
+    int idle;
+    float accelTolerance;  // |g|
+  };
+  static const Preset kPresets[] = {
+      {"accurate", 0.25f, 1.0f, 1.2f, 1, 0.3f},
+      {"balanced", 0.25f, 1.0f, 1.3f, 3, 1.0f},
+      {"fast", 0.25f, 1.0f, 1.5f, 5, 2.0f},
+  };
+  for (const Preset& p : kPresets) {
+    if (name != p.name) continue;
+    reuse->enabled = true;
+    reuse->delta1 = p.delta1;
+    reuse->delta2 = p.delta2;
+    reuse->threshold = p.threshold;
+    reuse->idle = p.idle;
+    reuse->accelTolerance = p.accelTolerance;
+    return true;
+  }
+  return false;
+}
+
+const char* ReusePresetNames() { return "accurate, balanced, fast"; }
+
+}  // namespace sphxr::sim

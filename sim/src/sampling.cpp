@@ -66,6 +66,13 @@ int64_t ShellCount(const Aabb& box, float dx, int layers, bool outward, bool ope
   return total - insideX * insideY * insideZ;
 }
 
+// Within `margin` of a moving body's solid at its initial pose.
+bool InsideBody(const RigidBodySetup& body, Vec3 p, float margin) {
+  const Vec3 local = Rotate(Conjugate(Normalized(body.pose.orientation)), p - body.pose.position);
+  Vec3 n;
+  return UnionDistance(body.shapes.data(), static_cast<int>(body.shapes.size()), local, &n) < margin;
+}
+
 }  // namespace
 
 int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
@@ -75,18 +82,31 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
     const int64_t nx = FitCount(block.box.max.x - block.box.min.x, dx);
     const int64_t ny = FitCount(block.box.max.y - block.box.min.y, dx);
     const int64_t nz = FitCount(block.box.max.z - block.box.min.z, dx);
-    if (!out && scene.obstacles.empty()) {  // counting only: the lattice is full
+    if (!out && scene.obstacles.empty() && scene.bodies.empty()) {  // counting only: the lattice is full
       count += nx * ny * nz;
       continue;
     }
+    // Hydrostatic start: the layer at depth d below the block's top sits where a column compressed to
+    // the Tait density rho(s) = rho0 (1 + rho0 g s / B)^(1/gamma) puts it: y = top - int_0^d rho0/rho ds
+    // (closed form). Only the vertical component of gravity compresses.
+    const float top = block.box.min.y + static_cast<float>(ny) * dx;
+    const double a = scene.params.restDensity * std::max(0.0, -static_cast<double>(scene.gravity.y)) /
+                     scene.params.stiffness;
+    const double e = 1.0 - 1.0 / scene.params.exponent;
+    auto layerY = [&](int64_t j) -> float {
+      const float y = block.box.min.y + (static_cast<float>(j) + 0.5f) * dx;
+      if (!block.hydrostatic || a <= 0.0) return y;
+      const double d = top - y;
+      return static_cast<float>(top - (std::pow(1.0 + a * d, e) - 1.0) / (a * e));
+    };
     for (int64_t k = 0; k < nz; ++k) {
       for (int64_t j = 0; j < ny; ++j) {
         for (int64_t i = 0; i < nx; ++i) {
-          const Vec3 p{block.box.min.x + (static_cast<float>(i) + 0.5f) * dx,
-                       block.box.min.y + (static_cast<float>(j) + 0.5f) * dx,
+          const Vec3 p{block.box.min.x + (static_cast<float>(i) + 0.5f) * dx, layerY(j),
                        block.box.min.z + (static_cast<float>(k) + 0.5f) * dx};
           bool blocked = false;
           for (const Aabb& o : scene.obstacles) blocked = blocked || InsideExpanded(o, p, 0.5f * dx);
+          for (const RigidBodySetup& b : scene.bodies) blocked = blocked || InsideBody(b, p, 0.5f * dx);
           if (blocked) continue;
           ++count;
           if (out) out->push_back(MakeVec4(p));

@@ -39,6 +39,48 @@ int64_t AvailableHostBytes() {
   return static_cast<int64_t>(pages) * pageSize * 3 / 4;  // leave a quarter to the OS and the renderer
 }
 
+Status ValidateReuse(const ReuseParams& r) {
+  const float values[] = {r.delta1, r.delta2, r.threshold, r.pressureScale, r.cellCount, r.accelTolerance};
+  const char* names[] = {"delta1", "delta2", "threshold", "pressure_scale", "cell_count", "accel_tolerance"};
+  for (int k = 0; k < 6; ++k) {
+    if (!std::isfinite(values[k]) || values[k] < 0.0f || values[k] > 1e9f) {
+      return Status::Error(Format("reuse.%s = %g is invalid: must be a number from 0 to 1e9", names[k], values[k]));
+    }
+  }
+  if (r.idle < 0 || r.idle > 1000) {
+    return Status::Error(Format("reuse.idle = %d is invalid: must be 0 to 1000 steps", r.idle));
+  }
+  return Status::Ok();
+}
+
+bool Finite(Quat q) { return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z); }
+
+Status ValidateBodies(const SceneSetup& scene) {
+  if (scene.bodies.size() > 64) return Status::Error(Format("%zu moving bodies: at most 64", scene.bodies.size()));
+  for (size_t k = 0; k < scene.bodies.size(); ++k) {
+    const RigidBodySetup& b = scene.bodies[k];
+    const std::string key = Format("body %zu", k);
+    if (b.shapes.empty()) return Status::Error(key + ": has no shape");
+    if (b.points.empty()) return Status::Error(key + ": has no boundary particles (its shapes are too small to sample)");
+    for (const ShapePrimitive& p : b.shapes) {
+      const bool box = p.kind == ShapePrimitive::Kind::kBox;
+      if (!Finite(p.a) || !Finite(p.b) || !std::isfinite(p.radius)) return Status::Error(key + ": non-finite shape");
+      if (box && !(p.b.x > 0.0f && p.b.y > 0.0f && p.b.z > 0.0f)) {
+        return Status::Error(key + ": a box needs positive half extents, got " + Str(p.b));
+      }
+      if (!box && !(p.radius > 0.0f)) return Status::Error(Format("%s: a capsule needs a positive radius, got %g", key.c_str(), p.radius));
+    }
+    for (const Vec3& x : b.points) {
+      if (!Finite(x)) return Status::Error(key + ": non-finite boundary particle");
+    }
+    if (!std::isfinite(b.viscosity) || b.viscosity > 10.0f) {
+      return Status::Error(Format("%s: viscosity = %g is invalid: must be from 0 to 10 (negative: the walls')", key.c_str(), b.viscosity));
+    }
+    if (!Finite(b.pose.position) || !Finite(b.pose.orientation)) return Status::Error(key + ": non-finite pose");
+  }
+  return Status::Ok();
+}
+
 Status ValidateScene(const SceneSetup& scene) {
   for (const ParamInfo& p : SolverParamInfos()) {
     const float v = scene.params.*p.member;
@@ -50,19 +92,7 @@ Status ValidateScene(const SceneSetup& scene) {
   if (!std::isfinite(scene.floorViscosity) || scene.floorViscosity > 10.0f) {
     return Status::Error(Format("tank.floor_viscosity = %g is invalid: must be from 0 to 10", scene.floorViscosity));
   }
-  {
-    const ReuseParams& r = scene.reuse;
-    const float values[] = {r.delta1, r.delta2, r.threshold, r.pressureScale, r.cellCount};
-    const char* names[] = {"delta1", "delta2", "threshold", "pressure_scale", "cell_count"};
-    for (int k = 0; k < 5; ++k) {
-      if (!std::isfinite(values[k]) || values[k] < 0.0f || values[k] > 1e9f) {
-        return Status::Error(Format("reuse.%s = %g is invalid: must be a number from 0 to 1e9", names[k], values[k]));
-      }
-    }
-    if (r.idle < 0 || r.idle > 1000) {
-      return Status::Error(Format("reuse.idle = %d is invalid: must be 0 to 1000 steps", r.idle));
-    }
-  }
+  if (Status s = ValidateReuse(scene.reuse); !s) return s;
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
   if (scene.boundaryLayers < 1 || scene.boundaryLayers > 4) {
     return Status::Error(Format("tank.boundary_layers = %d is invalid: must be 1 to 4", scene.boundaryLayers));
@@ -86,6 +116,7 @@ Status ValidateScene(const SceneSetup& scene) {
                            Str(scene.tank.max));
     }
   }
+  if (Status s = ValidateBodies(scene); !s) return s;
   const float gamma = WallDensityCorrection(CubicSpline::Make(scene.params.spacing * scene.params.supportFactor),
                                             scene.params.spacing, scene.boundaryLayers);
   if (!(gamma > 0.0f)) {
@@ -148,6 +179,9 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.boundaryGamma = WallDensityCorrection(ph.kernel, p.spacing, scene.boundaryLayers);
   ph.boundaryGradScale = WallGradientCorrection(ph.kernel, p.spacing, scene.boundaryLayers) / ph.boundaryGamma;
   ph.maxNeighbours = NeighbourCapacity(p.supportFactor);
+  // Moving bodies are one-sheet shells (interaction::SamplePaddle): their own flat-wall corrections.
+  ph.bodyGradScale = WallGradientCorrection(ph.kernel, p.spacing, 1) / WallDensityCorrection(ph.kernel, p.spacing, 1);
+  ph.bodyClearance = 0.25f * p.spacing;
   const ReuseParams& r = scene.reuse;
   ph.reuseEnabled = r.enabled;
   ph.reuseDelta1 = r.delta1;
@@ -159,6 +193,12 @@ Physics MakePhysics(const SceneSetup& scene) {
   const float pc = r.pressureScale > 0.0f ? r.pressureScale : p.stiffness * (std::pow(1.01f, p.exponent) - 1.0f);
   ph.reuseInvPressureScale = 1.0f / pc;
   ph.reuseCellCount = r.cellCount > 0.0f ? r.cellCount : p.supportFactor * p.supportFactor * p.supportFactor;
+  {
+    const float g2 = Dot(scene.gravity, scene.gravity);
+    const float tol = r.accelTolerance * std::sqrt(g2 > 0.0f ? g2 : 9.81f * 9.81f);
+    ph.reuseAccelTolerance2 = r.accelTolerance > 0.0f ? tol * tol : 3.0e38f;
+    ph.reuseCooldown = r.idle + 1;
+  }
   ph.stiffness = p.stiffness;
   ph.exponent = p.exponent;
   ph.soundSpeed = std::sqrt(p.exponent * p.stiffness / p.restDensity);
@@ -208,6 +248,7 @@ const char* StageName(Stage stage) {
     case Stage::kDensity: return "density";
     case Stage::kForces: return "forces";
     case Stage::kIntegrate: return "integrate";
+    case Stage::kBodies: return "bodies";
     default: return "?";
   }
 }
@@ -278,6 +319,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
 
   const Physics physics = MakePhysics(scene);
   if (Status s = solver->m_backend->Init(MakeGridShape(scene), physics, fluid, boundary); !s) return s;
+  if (!scene.bodies.empty()) solver->InitBodies(physics);
   WarnAboutSettings(scene, physics.soundSpeed);
   *out = std::move(solver);
   return Status::Ok();
@@ -293,8 +335,9 @@ float Solver::StableDt() const {
   const float h = 0.5f * p.spacing * p.supportFactor;
   const float c = std::sqrt(p.exponent * p.stiffness / p.restDensity);
   float dt = p.maxDt;
-  // Acoustic CFL condition (Monaghan 1992; Becker & Teschner 2007, sec. 5).
-  dt = std::min(dt, p.cfl * h / (c + m_last.maxSpeed));
+  // Acoustic CFL condition (Monaghan 1992; Becker & Teschner 2007, sec. 5), with the fastest point of a
+  // moving body: it then moves less than cfl * h per step, so it cannot jump over fluid particles.
+  dt = std::min(dt, p.cfl * h / (c + std::max(m_last.maxSpeed, MaxBodySpeed())));
   // Force condition: a particle must not move more than ~h/16 per step under its acceleration.
   const float accel = std::max(m_maxAccel, Length(m_scene.gravity));
   if (accel > 0.0f) dt = std::min(dt, 0.25f * std::sqrt(h / accel));
@@ -355,7 +398,38 @@ Status Solver::Step() {
 
   StepReduction red;
   const Physics physics = MakePhysics(m_scene);
+  std::vector<BodyState> states;
+  if (!m_bodies.empty()) {
+    // Each body moves from its pose now to its interpolated pose at the end of the step; its particles
+    // carry the rigid velocity that takes them there.
+    const double end = m_last.time + dt;
+    size_t firstShape = 0;
+    for (BodyMotion& b : m_bodies) {
+      const RigidPose to = BodyPoseAt(b, end);
+      BodyState st{};
+      st.position = b.pose.position;
+      st.orientation = b.pose.orientation;
+      st.velocity = (to.position - b.pose.position) * (1.0f / dt);
+      st.angular = RotationVector(Mul(to.orientation, Conjugate(b.pose.orientation))) * (1.0f / dt);
+      st.endPosition = to.position;
+      st.endOrientation = to.orientation;
+      st.boundRadius = b.boundRadius;
+      st.firstShape = static_cast<int>(firstShape);
+      st.shapeCount = static_cast<int>(b.shapes.size());
+      firstShape += b.shapes.size();
+      states.push_back(st);
+    }
+    m_backend->SetBodyStates(states);
+  }
   if (Status s = m_backend->Step(dt, physics, &red, m_totals.stageSeconds.data(), hook); !s) return s;
+  if (!m_bodies.empty()) {
+    m_backend->BodyLoads(&m_bodyLoads);
+    for (size_t k = 0; k < m_bodies.size(); ++k) {
+      m_bodies[k].pose = RigidPose{states[k].endPosition, states[k].endOrientation};
+      m_bodies[k].velocity = states[k].velocity;
+      m_bodies[k].angular = states[k].angular;
+    }
+  }
 
   m_last.time += dt;
   m_last.dt = dt;
@@ -368,6 +442,8 @@ Status Solver::Step() {
   m_last.activeFraction = n > 0 ? static_cast<float>(red.computed) / static_cast<float>(n) : 1.0f;
   m_totals.steps += 1;
   m_totals.clampedEvents += red.clamped;
+  m_last.pushedOut = red.pushed;
+  m_totals.pushedOutEvents += red.pushed;
   m_totals.stepSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return Status::Ok();
 }
@@ -386,6 +462,114 @@ Status Solver::Upload(const HostFluid& fluid) {
 #undef SPHXR_CHECK_SIZE
   m_backend->Upload(fluid);
   return Status::Ok();
+}
+
+Status Solver::SetReuse(const ReuseParams& reuse) {
+  if (Status s = ValidateReuse(reuse); !s) return s;
+  m_scene.reuse = reuse;
+  HostFluid fluid;
+  m_backend->Download(&fluid);
+  std::fill(fluid.idle.begin(), fluid.idle.end(), -1);
+  m_backend->Upload(fluid);
+  return Status::Ok();
+}
+
+void Solver::InitBodies(const Physics& physics) {
+  // Boundary particles of every body with Akinci et al.'s (2012, eq. 4) volume V_b = 1 / sum_k W_bk over
+  // the body's own particles (a rigid body's sampling never changes, so once), Psi_b = gamma rho0 V_b
+  // with the one-sheet flat-wall correction gamma (sampling.h).
+  const float dx = m_scene.params.spacing;
+  const float psiScale = WallDensityCorrection(physics.kernel, dx, 1) * physics.restDensity;
+  std::vector<Vec4> local;
+  std::vector<uint32_t> bodyOf;
+  std::vector<float> alpha;
+  std::vector<ShapePrimitive> shapes;
+  for (size_t k = 0; k < m_scene.bodies.size(); ++k) {
+    const RigidBodySetup& setup = m_scene.bodies[k];
+    const std::vector<Vec3>& pts = setup.points;
+    const float a = setup.viscosity >= 0.0f ? setup.viscosity : m_scene.params.boundaryViscosity;
+    float radius = 0.0f;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      float sum = 0.0f;
+      for (const Vec3& q : pts) {
+        const Vec3 d = pts[i] - q;
+        const float r2 = Dot(d, d);
+        if (r2 < physics.kernel.H2) sum += physics.kernel.W(std::sqrt(r2));
+      }
+      local.push_back(MakeVec4(pts[i], psiScale / sum));
+      bodyOf.push_back(static_cast<uint32_t>(k));
+      alpha.push_back(a);
+      radius = std::max(radius, Length(pts[i]));
+    }
+    for (const ShapePrimitive& p : setup.shapes) {
+      const bool box = p.kind == ShapePrimitive::Kind::kBox;
+      radius = std::max(radius, box ? Length(p.a) + Length(p.b) : std::max(Length(p.a), Length(p.b)) + p.radius);
+      shapes.push_back(p);
+    }
+    BodyMotion m;
+    m.pose = RigidPose{setup.pose.position, Normalized(setup.pose.orientation)};
+    m.from = m.to = m.pose;
+    m.boundRadius = radius;
+    m.shapes = setup.shapes;
+    m_bodies.push_back(m);
+  }
+  m_bodyLoads.assign(m_bodies.size(), BodyLoad{});
+  m_backend->InitBodies(local, bodyOf, alpha, shapes);
+}
+
+RigidPose Solver::BodyPoseAt(const BodyMotion& body, double time) const {
+  if (time >= body.toTime || body.toTime <= body.fromTime) return body.to;
+  const float u = static_cast<float>(std::max(0.0, (time - body.fromTime) / (body.toTime - body.fromTime)));
+  return RigidPose{body.from.position + (body.to.position - body.from.position) * u,
+                   Slerp(body.from.orientation, body.to.orientation, u)};
+}
+
+float Solver::MaxBodySpeed() const {
+  float speed = 0.0f;
+  for (const BodyMotion& b : m_bodies) {
+    if (m_last.time >= b.toTime) continue;
+    const float span = static_cast<float>(b.toTime - b.fromTime);
+    const float linear = Length(b.to.position - b.from.position) / span;
+    const float angular = Length(RotationVector(Mul(b.to.orientation, Conjugate(b.from.orientation)))) / span;
+    speed = std::max(speed, linear + angular * b.boundRadius);
+  }
+  return speed;
+}
+
+Status Solver::SetBodyTarget(int body, const RigidPose& target, double targetTime) {
+  if (body < 0 || body >= BodyCount()) return Status::Error(Format("SetBodyTarget: no body %d (%d bodies)", body, BodyCount()));
+  if (!Finite(target.position) || !Finite(target.orientation) || !std::isfinite(targetTime)) {
+    return Status::Error(Format("SetBodyTarget: non-finite target for body %d", body));
+  }
+  BodyMotion& b = m_bodies[body];
+  const RigidPose to{target.position, Normalized(target.orientation)};
+  if (targetTime <= m_last.time) {  // relocate now, at rest
+    b.pose = b.from = b.to = to;
+    b.fromTime = b.toTime = m_last.time;
+    b.velocity = b.angular = Vec3{};
+    return Status::Ok();
+  }
+  b.from = b.pose;
+  b.fromTime = m_last.time;
+  b.to = to;
+  b.toTime = targetTime;
+  return Status::Ok();
+}
+
+void Solver::DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const {
+  if (m_bodies.empty()) {
+    position->clear();
+    velocity->clear();
+    return;
+  }
+  m_backend->DownloadBodies(position, velocity);
+}
+
+float Solver::BodyDistance(int body, Vec3 point) const {
+  const BodyMotion& b = m_bodies[body];
+  const Vec3 p = Rotate(Conjugate(b.pose.orientation), point - b.pose.position);
+  Vec3 n;
+  return UnionDistance(b.shapes.data(), static_cast<int>(b.shapes.size()), p, &n);
 }
 
 Solver::GridInfo Solver::Grid() const {

@@ -61,6 +61,20 @@ struct GridView {
   const Vec4* boundary;  // xyz position, w = Psi_b (kg)
   const float* boundaryAlpha;  // artificial viscosity alpha of each boundary particle's wall
   const uint8_t* boundaryNear; // per cell: 1 when a boundary particle lies in its 27 cells
+  // Moving boundaries (paddles, body_stages.h): particles re-sorted every step with their own ranges.
+  int bodyCount;                  // 0: no moving boundary; the pointers below are then unused
+  const uint32_t* bodyStart;
+  const uint32_t* bodyEnd;
+  const Vec4* body;               // xyz world position, w = Psi_b (kg)
+  const Vec4* bodyVelocity;       // xyz rigid velocity v + w x r (m/s), w = alpha of the body
+  const uint8_t* movingNear;      // per cell: 1 when a moving boundary particle lies in its 27 cells
+
+  SPHXR_HD SPHXR_INLINE bool MovingNear(Vec3 p) const {
+    if (bodyCount == 0) return false;
+    int cx, cy, cz;
+    CellOf(p, &cx, &cy, &cz);
+    return movingNear[Linear(cx, cy, cz)] != 0;
+  }
 
   SPHXR_HD SPHXR_INLINE int Clampi(int v, int hi) const { return v < 0 ? 0 : (v > hi ? hi : v); }
   SPHXR_HD SPHXR_INLINE void CellOf(Vec3 p, int* cx, int* cy, int* cz) const {
@@ -136,7 +150,11 @@ struct Physics {
   float reuseThreshold;
   int reuseIdle;
   float reuseInvPressureScale;  // 1 / P_pc
-  float reuseCellCount;         // N_CPN  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
+  float reuseCellCount;         // N_CPN
+  float reuseAccelTolerance2;   // (tolerance)^2, m^2/s^4: a larger change of acceleration keeps i active
+  int reuseCooldown;            // steps a particle so flagged stays active before it is classified again
+  float bodyGradScale;          // as boundaryGradScale, for the one-sheet shells of moving bodies
+  float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
   float stiffness;      // Tait B
   float exponent;       // Tait gamma
   float soundSpeed;     // sqrt(B gamma / rho0)
@@ -233,16 +251,27 @@ struct BoundaryVolumeStage {
 // Idle count IC: -1 active. A particle with IC > 0 reuses this step (density, pressure, acceleration
 // stay as they are) and counts down; at IC = 0, or when active, it computes this step and is classified
 // with its previous pressure and the crowding of its cells: ACT_i < T gives IC = IDLE, else -1. So a
-// particle never reuses more than IDLE consecutive steps. After this stage, "computes this step" is
-// exactly IC == -1 or IC == IDLE (ComputesThisStep).
+// particle never reuses more than IDLE consecutive steps. IC < -1: flagged by the force stage (its
+// acceleration changed by more than the tolerance), active for -1 - IC more steps before it is
+// classified again. After this stage, "computes this step" is exactly IC < 0 or IC == IDLE
+// (ComputesThisStep).
 struct ActivityStage {
   GridView grid;
   FluidView fluid;
   Physics ph;
   SPHXR_HD void operator()(int i) const {
+    // Paddles: a particle near a moving boundary always computes (its neighbourhood changes every step).
+    if (grid.MovingNear(Xyz(fluid.position[i]))) {
+      fluid.idle[i] = -1;
+      return;
+    }
     const int32_t ic = fluid.idle[i];
-    if (ic > 0) {
+    if (ic > 0) {  // reuses this step
       fluid.idle[i] = ic - 1;
+      return;
+    }
+    if (ic < -1) {  // flagged by the force stage: active, cooling down
+      fluid.idle[i] = ic + 1;
       return;
     }
     int cx, cy, cz;
@@ -270,7 +299,7 @@ struct ActivityStage {
 struct ComputesThisStep {
   const int32_t* idle;
   int32_t idleSteps;
-  SPHXR_HD bool operator()(int i) const { return idle[i] == -1 || idle[i] == idleSteps; }
+  SPHXR_HD bool operator()(int i) const { return idle[i] < 0 || idle[i] == idleSteps; }
 };
 
 /// Runs a per-particle stage over a compacted list of particle indices.
@@ -315,6 +344,12 @@ struct DensityStage {
         if (r2 < k.H2) sumBoundary += grid.boundary[j].w * k.W(sqrtf(r2));
       });
     }
+    if (grid.MovingNear(xi)) {  // moving boundaries (paddles): the same sum (Akinci et al. 2012, eq. 5)
+      ForEachInCells(grid, grid.bodyStart, grid.bodyEnd, grid.body, xi, [&](uint32_t j, Vec3 d) {
+        const float r2 = Dot(d, d);
+        if (r2 < k.H2) sumBoundary += grid.body[j].w * k.W(sqrtf(r2));
+      });
+    }
     const float rho = ph.mass * sumFluid + sumBoundary;
     fluid.density[i] = rho;
     const float pressure = TaitPressure(ph, rho);
@@ -326,12 +361,35 @@ struct DensityStage {
   }
 };
 
+/// Sum over the moving boundary particles b near xi of Psi_b (s_b pairTerm + Pi_ib) gradW_ib, with the
+/// relative velocity v_i - v_b in the viscosity (Akinci et al. 2012, eq. 10-11 as for the walls).
+SPHXR_HD SPHXR_INLINE Vec3 BodyAcceleration(const GridView& grid, const Physics& ph, Vec3 xi, Vec3 vi, float rhoi,
+                                            float pairTerm, const uint32_t* start, const uint32_t* end) {
+  const CubicSpline k = ph.kernel;
+  const float h = ph.smoothing;
+  const float eps = 0.01f * h * h;
+  const float viscWall = ph.soundSpeed * h / (2.0f * rhoi);
+  const float pressure = ph.bodyGradScale * pairTerm;
+  Vec3 sum{0.0f, 0.0f, 0.0f};
+  ForEachInCells(grid, start, end, grid.body, xi, [&](uint32_t j, Vec3 d) {
+    const float r2 = Dot(d, d);
+    if (r2 >= k.H2 || r2 == 0.0f) return;
+    const Vec4 vb = grid.bodyVelocity[j];
+    float term = pressure;
+    const float vx = Dot(vi - Xyz(vb), d);
+    if (vx < 0.0f) term -= vb.w * viscWall * vx / (r2 + eps);
+    sum += d * (grid.body[j].w * term * k.GradFactor(sqrtf(r2)));
+  });
+  return sum;
+}
+
 // ---- stage 5: pressure, viscosity and gravity ----------------------------------------------------
 struct ForceStage {
   GridView grid;
   FluidView fluid;
   NeighbourList list;
   Physics ph;
+  float* bodyPressureTerm = nullptr;  // per particle near a moving body: p_i/rho_i^2 + p_b/rho_i^2 (for its reaction)
   SPHXR_HD void operator()(int i) const {
     const Vec3 xi = Xyz(fluid.position[i]);
     const Vec3 vi = Xyz(fluid.velocity[i]);
@@ -389,8 +447,23 @@ struct ForceStage {
         if (vx < 0.0f) term -= grid.boundaryAlpha[j] * viscWall * vx / (r2 + eps);
         a -= d * (grid.boundary[j].w * term * k.GradFactor(sqrtf(r2)));
       });
+      // Moving boundaries (paddles): the same terms with the relative velocity v_i - v_b, so a moving
+      // paddle pushes (pressure) and drags (viscosity) the water. BodyReactionStage applies the opposite.
+      if (grid.MovingNear(xi)) {
+        const float pairTerm = pTermI + pWall / (rhoi * rhoi);
+        if (bodyPressureTerm) bodyPressureTerm[i] = pairTerm;
+        a -= BodyAcceleration(grid, ph, xi, vi, rhoi, pairTerm, grid.bodyStart, grid.bodyEnd);
+      }
     }
     a += ph.gravity;
+    if (ph.reuseEnabled) {
+      // Our rule beyond the paper (docs/reuse.md): a particle whose acceleration changed by more than the
+      // tolerance since its last computation (over the steps it reused, or over one step) was not calm;
+      // it stays active for a cooldown before it is classified again. Without it, reuse at a CFL-limited
+      // step acts as a multiple of that step on the pressure waves and the calm region blows up.
+      const Vec3 da = a - Xyz(fluid.acceleration[i]);
+      if (Dot(da, da) > ph.reuseAccelTolerance2) fluid.idle[i] = -1 - ph.reuseCooldown;
+    }
     fluid.acceleration[i] = MakeVec4(a);
   }
 };
@@ -434,6 +507,7 @@ struct StepReduction {
   double sumCompression = 0.0;
   int32_t clamped = 0;
   int32_t computed = 0;  // particles that computed density and forces this step (set by the backend)
+  int32_t pushed = 0;    // fluid particles pushed out of a moving body this step (body_stages.h)
 };
 
 struct StepReductionOp {
@@ -448,7 +522,9 @@ struct StepReductionOp {
     const float err = fluid.density[i] * invRestDensity - 1.0f;
     r.maxDensityError = fabsf(err);
     r.sumCompression = err > 0.0f ? err : 0.0f;
-    r.clamped = a.w != 0.0f ? 1 : 0;
+    // acceleration.w: 1 clamped into the domain, 2 pushed out of a moving body, 3 both.
+    r.clamped = (a.w == 1.0f || a.w == 3.0f) ? 1 : 0;
+    r.pushed = a.w >= 2.0f ? 1 : 0;
     return r;
   }
 };
@@ -461,6 +537,7 @@ struct StepReductionCombine {
     r.maxDensityError = fmaxf(a.maxDensityError, b.maxDensityError);
     r.sumCompression = a.sumCompression + b.sumCompression;
     r.clamped = a.clamped + b.clamped;
+    r.pushed = a.pushed + b.pushed;
     return r;
   }
 };

@@ -48,12 +48,19 @@ double Interpolate(const std::vector<Point>& series, double t) {
   return series.back().value;
 }
 
-TEST(DamBreak, MatchesMartinMoyce1952) {
+// The same bounds with reuse off (the core solver) and with the `balanced` reuse preset (issue 3).
+class DamBreak : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DamBreak, MatchesMartinMoyce1952) {
   std::vector<Point> measuredFront, measuredHeight;
   ReadMeasurements(&measuredFront, &measuredHeight);
 
   app::SceneFile scene;
   ASSERT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/dam_break.json", &scene).ok());
+  const std::string preset = GetParam();
+  if (preset != "off") {
+    ASSERT_TRUE(sim::ApplyReusePreset(preset, &scene.setup.reuse));
+  }
   ASSERT_TRUE(scene.damBreak.has_value());
   const app::DamBreakProbe probe = *scene.damBreak;
   std::unique_ptr<sim::Solver> solver;
@@ -77,6 +84,9 @@ TEST(DamBreak, MatchesMartinMoyce1952) {
                       sim::ColumnHeight(host, probe.floorY, probe.wallX, dx, std::max(1, minPerBin / 2)) / (2.0 * a)});
   }
   EXPECT_EQ(static_cast<int>(host.size()), n) << "particles lost";
+  if (preset != "off") {
+    RecordProperty("mean_active_fraction", std::to_string(solver->LastStep().activeFraction));
+  }
 
   double sumSq = 0.0;
   int count = 0;
@@ -100,6 +110,9 @@ TEST(DamBreak, MatchesMartinMoyce1952) {
         << "column height at tau = " << m.t << ": simulated H = " << h << ", measured " << m.value;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Reuse, DamBreak, ::testing::Values("off", "balanced"),
+                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
 }  // namespace
 }  // namespace sphxr

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "sphxr/sim/rigid.h"
 #include "sphxr/sim/vec.h"
 
 namespace sphxr::sim {
@@ -44,6 +45,9 @@ struct Aabb {
 struct FluidBlock {
   Aabb box;
   Vec3 velocity;  // initial velocity, m/s
+  /// Start in hydrostatic equilibrium: each layer is compressed to the Tait density of its depth below
+  /// the block's top, so a pool starts at rest instead of ringing from a zero-pressure lattice.
+  bool hydrostatic = false;
 };
 
 /// Activity-based property reuse (Huang et al. 2013, section 3.3): ACT_i = delta1 P_i / P_pc +
@@ -58,7 +62,17 @@ struct ReuseParams {
   int idle = 3;                  // IDLE: consecutive steps a particle reuses its values
   float pressureScale = 0.0f;    // P_pc, Pa; 0 = the Tait pressure at 1 % compression
   float cellCount = 0.0f;        // N_CPN; 0 = (cell size / spacing)^3, the rest lattice's count
+  /// Our rule beyond the paper: a particle whose acceleration changed by more than this many |g| since
+  /// its last computation stays active for IDLE + 1 steps before it is classified again (0 = off).
+  float accelTolerance = 0.1f;
 };
+
+/// The presets chosen from the measured trade (docs/reuse.md): "accurate", "balanced", "fast".
+/// Each sets delta1, delta2, threshold, idle and the acceleration tolerance and turns reuse on; the derived constants
+/// (pressure_scale, cell_count) are left as they are. False for an unknown name.
+bool ApplyReusePreset(const std::string& name, ReuseParams* reuse);
+/// The preset names, for help texts and errors: "accurate, balanced, fast".
+const char* ReusePresetNames();
 
 struct SceneSetup {
   SolverParams params;
@@ -74,6 +88,8 @@ struct SceneSetup {
   std::vector<FluidBlock> fluid;
   std::vector<Aabb> obstacles;   // solid boxes inside the tank, surfaces sampled
   ReuseParams reuse;             // no "reuse" section in the scene: disabled
+  /// Kinematic rigid bodies (paddles) moving through the fluid; fluid is not seeded inside them.
+  std::vector<RigidBodySetup> bodies;
 };
 
 /// Counts the particles a scene will create, without allocating them (for validation).

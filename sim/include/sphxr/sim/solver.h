@@ -10,6 +10,8 @@
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/params.h"
+#include "sphxr/sim/rigid.h"
+#include "sphxr/sim/surface.h"
 
 namespace sphxr::sim {
 
@@ -29,7 +31,9 @@ struct SolverConfig {
 };
 
 /// Stages of one step, each timed.
-enum class Stage : int { kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kCount };
+/// kBodies: the moving boundaries' own work (placing and sorting their particles, the reaction on them,
+/// the push-out); their terms inside the density and force loops count to those stages.
+enum class Stage : int { kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kCount };
 const char* StageName(Stage stage);
 
 struct StepInfo {
@@ -40,17 +44,20 @@ struct StepInfo {
   float maxDensityError = 0.0f;  // max of |rho/rho0 - 1| over fluid particles
   int32_t clamped = 0;           // fluid particles pushed back into the domain this step
   float activeFraction = 1.0f;   // fraction of fluid particles that computed density and forces (reuse)
+  int32_t pushedOut = 0;         // fluid particles pushed out of a moving body this step
 };
 
 struct Totals {
   int64_t steps = 0;
   int64_t clampedEvents = 0;     // sum of StepInfo::clamped
   int64_t dtClampedSteps = 0;    // steps where a fixed dt was clamped to the CFL limit
+  int64_t pushedOutEvents = 0;   // sum of StepInfo::pushedOut
   std::array<double, static_cast<int>(Stage::kCount)> stageSeconds{};
   double stepSeconds = 0.0;      // wall time in Step()
 };
 
 class Backend;
+struct Physics;
 
 class Solver {
  public:
@@ -78,6 +85,9 @@ class Solver {
   /// Copies all fluid fields to the host (current sorted order; use `id` for identity).
   void Download(HostFluid* out) const;
   void DownloadBoundary(HostBoundary* out) const;
+  /// Changes the reuse parameters from the next step on (the panel, the benchmarks). Every particle
+  /// starts active again (idle counts reset), so no particle reuses values from before the change.
+  Status SetReuse(const ReuseParams& reuse);
   /// Replaces the fluid state (tests, restarts). Sizes must match FluidCount().
   Status Upload(const HostFluid& fluid);
   /// Neighbour-grid view for tests: cell index of a point, and the particle ranges.
@@ -87,6 +97,35 @@ class Solver {
     int dims[3];
   };
   GridInfo Grid() const;
+  // ---- moving bodies (SceneSetup::bodies, rigid.h): kinematic, driven by targets --------------------
+  int BodyCount() const { return static_cast<int>(m_bodies.size()); }
+  /// The body moves from its current pose (now) to `target` at `targetTime`, position linear and rotation
+  /// slerp, evaluated at every step's end; it holds `target` after that time. Each step its boundary
+  /// particles carry the rigid velocity that takes them there. A target time not after Time() relocates
+  /// the body at once, at rest (no velocity from the jump). Errors: bad index, non-finite values.
+  Status SetBodyTarget(int body, const RigidPose& target, double targetTime);
+  RigidPose BodyPose(int body) const { return m_bodies[body].pose; }
+  /// Linear velocity of the body origin and angular velocity during the last step.
+  Vec3 BodyVelocity(int body) const { return m_bodies[body].velocity; }
+  Vec3 BodyAngularVelocity(int body) const { return m_bodies[body].angular; }
+  /// Force and torque of the fluid on the body in the last step (zero before the first).
+  const BodyLoad& LastBodyLoad(int body) const { return m_bodyLoads[body]; }
+  /// The body's boundary particles in the last step: world positions (w = Psi) and velocities (w = alpha).
+  void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const;
+  /// Signed distance of a world point to body `body`'s solid at its current pose (negative inside).
+  float BodyDistance(int body, Vec3 point) const;
+
+  /// The water surface by histogram-pyramid marching cubes (docs/surface.md), from the current particles.
+  /// Into the solver's own mesh buffer (grown when needed, reported in stats and the log); the view is
+  /// valid until the next extraction.
+  Status ExtractSurface(const SurfaceParams& params, SurfaceMeshView* view, SurfaceStats* stats = nullptr);
+  /// The same, copied to the host.
+  Status ExtractSurface(const SurfaceParams& params, SurfaceMesh* mesh, SurfaceStats* stats = nullptr);
+  /// In two phases, for a renderer that writes into its own (mapped) buffer: BuildSurface samples the
+  /// field and builds the pyramid (stats->vertices is the mesh's size); WriteSurface then fills target,
+  /// which must hold that many vertices (device memory on the CUDA backend, host memory on the CPU).
+  Status BuildSurface(const SurfaceParams& params, SurfaceStats* stats);
+  Status WriteSurface(const SurfaceTarget& target, SurfaceStats* stats);
   /// Test access to the backend (tests include the private headers on purpose).
   Backend* BackendForTests() { return m_backend.get(); }
 
@@ -99,6 +138,19 @@ class Solver {
   StepInfo m_last;
   Totals m_totals;
   float m_maxAccel = 0.0f;
+  struct BodyMotion {
+    RigidPose pose;              // now
+    RigidPose from, to;          // the current target segment
+    double fromTime = 0.0, toTime = 0.0;
+    Vec3 velocity, angular;      // during the last step
+    float boundRadius = 0.0f;
+    std::vector<ShapePrimitive> shapes;
+  };
+  std::vector<BodyMotion> m_bodies;
+  std::vector<BodyLoad> m_bodyLoads;
+  RigidPose BodyPoseAt(const BodyMotion& body, double time) const;
+  float MaxBodySpeed() const;
+  void InitBodies(const Physics& physics);
   bool m_dtClampLogged = false;
 };
 

@@ -1,0 +1,47 @@
+#!/usr/bin/env python3
+"""Draws docs/reuse.png from docs/reuse.csv (bench/reuse.cpp): speed-up of the whole step against the
+deviation from the reuse-off run, one panel per scene, presets marked.
+usage: plot_reuse.py docs/reuse.csv docs/reuse.png"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def main():
+    src, dst = sys.argv[1], sys.argv[2]
+    rows = list(csv.DictReader(open(src)))
+    scenes = [("deep_tank", "surface_rms_spacings", "free-surface RMS vs reuse off (spacings)"),
+              ("dam_break_1m", "front_deviation", "surge-front deviation vs reuse off")]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    for ax, (scene, key, label) in zip(axes, scenes):
+        rs = [r for r in rows if r["scene"] == scene and r["setting"] != "off"]
+        if not rs:
+            ax.set_title(scene + " (no data)")
+            continue
+        for r in rs:
+            x = float(r[key]) * (100.0 if key == "front_deviation" else 1.0)
+            y = float(r["speedup"])
+            guard_off = float(r["accel_tolerance"]) == 0.0
+            if r["setting"] in ("accurate", "balanced", "fast"):
+                ax.plot(x, y, "o", ms=9, color={"accurate": "tab:green", "balanced": "tab:blue",
+                                                  "fast": "tab:red"}[r["setting"]], label=r["setting"])
+            elif guard_off:
+                ax.plot(x, y, "x", ms=9, color="k", label="guard off (T 1.2, IDLE 1)")
+            else:
+                ax.plot(x, y, ".", ms=7, color="0.5")
+        ax.axhline(1.0, color="0.7", lw=0.8)
+        ax.set_xlabel(label + (" (%)" if key == "front_deviation" else ""))
+        ax.set_ylabel("speed-up of the whole step (reuse off = 1)")
+        ax.set_title("%s, %s particles" % (scene, rs[0]["fluid"]))
+        ax.legend(fontsize=8, loc="best")
+    fig.suptitle("Activity-based reuse: speed against accuracy (%s, %s threads)" % (rows[0]["cpu_model"], rows[0]["threads"]))
+    fig.tight_layout()
+    fig.savefig(dst, dpi=110)
+
+
+if __name__ == "__main__":
+    main()

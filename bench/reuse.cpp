@@ -1,0 +1,362 @@
+// sphxr_bench_reuse: the trade of activity-based reuse (Huang et al. 2013, section 3.3), measured.
+//
+// Two scenes: scenes/deep_tank.json (a 36-spacing-deep pool, 51,840 particles, starting hydrostatic,
+// with a block dropped into one corner) and scenes/dam_break_1m.json (50,653 particles). Each is run
+// with reuse off (the reference) and with every setting of the sweep (delta1, delta2, threshold T,
+// IDLE, the acceleration tolerance), all from the same initial state, on the CPU backend, to the same simulated time with the
+// scenes' fixed time step, so the steps of all runs fall at the same simulated times. Per run:
+//   - step_ms: median wall time of Solver::Step over the run (the whole step, every stage);
+//   - speedup: the reference's median step time divided by the run's. The reference is run twice,
+//     first and last, and the mean of its two medians is used (the machine is shared; both are in
+//     the CSV so the drift is visible);
+//   - active: mean over the steps of the fraction of particles that computed density and forces;
+//   - mean_density_error: time average of the per-step mean compression, mean of max(0, rho/rho0 - 1);
+//     peak_density_error: the largest per-step mean compression in the run;
+//   - surface_rms: the free-surface height field against the reference's at fixed simulated times: the
+//     height of a column (one spacing square, over x and z) is the highest particle in it whose density
+//     is above half the rest density (spray excluded); RMS over the columns that hold water in both runs,
+//     in spacings, averaged over the sample times;
+//   - front_dev: the surge front (sim::SurgeFront from the tank's back wall) against the reference's,
+//     largest relative deviation over the sample times (dam break only);
+//   - max_speed, lost/clamped counts, NaN: the run's health.
+// --csv writes one row per run (docs/reuse.csv); bench/plot_reuse.py draws docs/reuse.png.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <omp.h>
+
+#include "bench_util.h"
+#include "sphxr/app/scene_file.h"
+#include "sphxr/common/log.h"
+#include "sphxr/sim/measure.h"
+#include "sphxr/sim/solver.h"
+
+#ifndef SPHXR_SCENES_DIR
+#define SPHXR_SCENES_DIR "scenes"
+#endif
+
+namespace sphxr::bench {
+namespace {
+
+struct Setting {
+  std::string name;  // "off", a preset name, or "sweep"
+  bool enabled = false;
+  float delta1 = 1, delta2 = 1, threshold = 1.2f;
+  int idle = 3;
+  float tolerance = 0.1f;  // reuse.accel_tolerance, in |g| (0: the guard off)
+};
+
+struct Args {
+  bool quick = false;
+  int threads = 0;
+  std::string csv;
+  std::string only;  // "deep_tank" or "dam_break_1m": one scene only
+  double time = 0.0; // 0: the default per scene
+  bool help = false;
+};
+
+const char* kUsage =
+    "usage: sphxr_bench_reuse [--quick] [--threads N] [--csv FILE] [--scene deep_tank|dam_break_1m] [--time T]\n"
+    "  --quick         off, the three presets and 2 more settings, to t = 0.1 s (a smoke run)\n"
+    "  --threads N     CPU backend threads (default 0 = all cores)\n"
+    "  --csv FILE      write one row per run to FILE (overwritten)\n"
+    "  --scene NAME    one of the two scenes only\n"
+    "  --time T        simulated seconds per run (default 0.3 deep_tank, 0.5 dam_break_1m)\n";
+
+bool ParseArgs(int argc, char** argv, Args* out) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&](std::string* v) {
+      if (i + 1 >= argc) return false;
+      *v = argv[++i];
+      return true;
+    };
+    std::string v;
+    if (a == "--quick") {
+      out->quick = true;
+    } else if (a == "--threads" && next(&v)) {
+      out->threads = std::atoi(v.c_str());
+    } else if (a == "--csv" && next(&v)) {
+      out->csv = v;
+    } else if (a == "--scene" && next(&v)) {
+      if (v != "deep_tank" && v != "dam_break_1m") return false;
+      out->only = v;
+    } else if (a == "--time" && next(&v)) {
+      out->time = std::atof(v.c_str());
+      if (!(out->time > 0.0)) return false;
+    } else if (a == "--help" || a == "-h") {
+      out->help = true;
+    } else {
+      return false;
+    }
+  }
+  return true;
+}
+
+Setting Sweep(float d1, float d2, float t, int idle, float tol) {
+  Setting s;
+  s.tolerance = tol;
+  s.name = "sweep";
+  s.enabled = true;
+  s.delta1 = d1;
+  s.delta2 = d2;
+  s.threshold = t;
+  s.idle = idle;
+  return s;
+}
+
+Setting Preset(const char* name) {
+  sim::ReuseParams r;
+  sim::ApplyReusePreset(name, &r);
+  Setting s = Sweep(r.delta1, r.delta2, r.threshold, r.idle, r.accelTolerance);
+  s.name = name;
+  return s;
+}
+
+/// The sweep: one factor at a time around (delta1 0.25, delta2 1, T 1.3, IDLE 3, tolerance 1 g), the
+/// guard off once (to show why it exists), then the presets.
+std::vector<Setting> Settings(bool quick) {
+  std::vector<Setting> s;
+  if (quick) {
+    s = {Sweep(1, 1, 1.2f, 1, 0.0f), Sweep(0.25f, 1, 1.3f, 3, 1.0f)};
+  } else {
+    s.push_back(Sweep(1, 1, 1.2f, 1, 0.0f));
+    for (float tol : {0.1f, 0.3f, 1.0f, 2.0f, 5.0f}) s.push_back(Sweep(0.25f, 1, 1.3f, 3, tol));
+    for (int idle : {1, 2, 5, 8}) s.push_back(Sweep(0.25f, 1, 1.3f, idle, 1.0f));
+    for (float t : {1.1f, 1.2f, 1.5f, 2.0f}) s.push_back(Sweep(0.25f, 1, t, 3, 1.0f));
+    for (float d1 : {0.0f, 0.5f, 1.0f}) s.push_back(Sweep(d1, 1, 1.3f, 3, 1.0f));
+    for (float d2 : {0.8f, 1.2f}) s.push_back(Sweep(0.25f, d2, 1.3f, 3, 1.0f));
+  }
+  for (const char* p : {"accurate", "balanced", "fast"}) s.push_back(Preset(p));
+  return s;
+}
+
+/// Column heights (one spacing square over x and z): the highest particle with rho > rho0 / 2.
+struct HeightField {
+  int nx = 0, nz = 0;
+  std::vector<float> h;  // NaN: no water
+};
+
+HeightField Heights(const sim::HostFluid& f, const sim::SceneSetup& scene) {
+  const float dx = scene.params.spacing;
+  HeightField hf;
+  hf.nx = std::max(1, static_cast<int>(std::ceil((scene.tank.max.x - scene.tank.min.x) / dx)));
+  hf.nz = std::max(1, static_cast<int>(std::ceil((scene.tank.max.z - scene.tank.min.z) / dx)));
+  hf.h.assign(static_cast<size_t>(hf.nx) * hf.nz, std::nanf(""));
+  const float half = 0.5f * scene.params.restDensity;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (!(f.density[i] > half)) continue;
+    const int cx = std::clamp(static_cast<int>((f.position[i].x - scene.tank.min.x) / dx), 0, hf.nx - 1);
+    const int cz = std::clamp(static_cast<int>((f.position[i].z - scene.tank.min.z) / dx), 0, hf.nz - 1);
+    float& h = hf.h[static_cast<size_t>(cz) * hf.nx + cx];
+    if (std::isnan(h) || f.position[i].y > h) h = f.position[i].y;
+  }
+  return hf;
+}
+
+/// RMS difference of two height fields in spacings, over the columns with water in both.
+double HeightRms(const HeightField& a, const HeightField& b, float dx) {
+  double sum = 0.0;
+  int64_t n = 0;
+  for (size_t k = 0; k < a.h.size(); ++k) {
+    if (std::isnan(a.h[k]) || std::isnan(b.h[k])) continue;
+    const double d = (a.h[k] - b.h[k]) / dx;
+    sum += d * d;
+    ++n;
+  }
+  return n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
+}
+
+struct Sample {
+  double time;
+  HeightField heights;
+  float front;
+};
+
+struct Result {
+  Setting setting;
+  int fluid = 0;
+  int64_t steps = 0;
+  double stepMs = 0, active = 0, meanErr = 0, peakErr = 0, maxSpeed = 0;
+  int64_t clamped = 0;
+  bool finite = true;
+  std::vector<Sample> samples;
+  double surfaceRms = 0, frontDev = 0;
+  double loadStart = 0, loadEnd = 0;
+};
+
+struct SceneCase {
+  std::string name;
+  std::string path;
+  double time;
+  std::vector<double> sampleTimes;
+  bool dam;
+};
+
+bool Run(const SceneCase& sc, const Setting& setting, int threads, Result* r) {
+  r->setting = setting;
+  app::SceneFile scene;
+  if (Status s = app::LoadScene(sc.path, &scene); !s) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
+    return false;
+  }
+  scene.setup.reuse.enabled = setting.enabled;
+  scene.setup.reuse.delta1 = setting.delta1;
+  scene.setup.reuse.delta2 = setting.delta2;
+  scene.setup.reuse.threshold = setting.threshold;
+  scene.setup.reuse.idle = setting.idle;
+  scene.setup.reuse.accelTolerance = setting.tolerance;
+  sim::SolverConfig config;
+  config.device = sim::Device::kCpu;
+  config.threads = threads;
+  std::unique_ptr<sim::Solver> solver;
+  if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
+    return false;
+  }
+  r->fluid = solver->FluidCount();
+  const float dx = scene.setup.params.spacing;
+  const int minPerBin = std::max(1, static_cast<int>(0.1f * (scene.setup.tank.max.z - scene.setup.tank.min.z) / dx));
+  r->loadStart = LoadAverage();
+  std::vector<double> stepMs;
+  double errTime = 0.0, errSum = 0.0, activeSum = 0.0;
+  size_t nextSample = 0;
+  sim::HostFluid host;
+  while (solver->Time() < sc.time - 1e-9) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (Status s = solver->Step(); !s) {
+      std::fprintf(stderr, "%s\n", s.message().c_str());
+      return false;
+    }
+    stepMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    const sim::StepInfo& info = solver->LastStep();
+    if (!std::isfinite(info.maxSpeed) || !std::isfinite(info.meanDensityError)) r->finite = false;
+    errSum += info.meanDensityError * info.dt;
+    errTime += info.dt;
+    activeSum += info.activeFraction;
+    r->peakErr = std::max<double>(r->peakErr, info.meanDensityError);
+    r->maxSpeed = std::max<double>(r->maxSpeed, info.maxSpeed);
+    r->clamped += info.clamped;
+    if (nextSample < sc.sampleTimes.size() && solver->Time() >= sc.sampleTimes[nextSample] - 1e-7) {
+      solver->Download(&host);
+      Sample smp;
+      smp.time = solver->Time();
+      smp.heights = Heights(host, scene.setup);
+      smp.front = sim::SurgeFront(host, scene.setup.tank.min.x, dx, minPerBin);
+      r->samples.push_back(std::move(smp));
+      ++nextSample;
+    }
+  }
+  r->loadEnd = LoadAverage();
+  r->steps = static_cast<int64_t>(stepMs.size());
+  r->stepMs = Median(stepMs);
+  r->active = stepMs.empty() ? 1.0 : activeSum / static_cast<double>(stepMs.size());
+  r->meanErr = errTime > 0 ? errSum / errTime : 0.0;
+  return true;
+}
+
+void Compare(const Result& ref, Result* r, float dx) {
+  double rms = 0.0, front = 0.0;
+  const size_t n = std::min(ref.samples.size(), r->samples.size());
+  for (size_t k = 0; k < n; ++k) {
+    rms += HeightRms(ref.samples[k].heights, r->samples[k].heights, dx);
+    if (ref.samples[k].front > 0) {
+      front = std::max(front, std::fabs(static_cast<double>(r->samples[k].front) / ref.samples[k].front - 1.0));
+    }
+  }
+  r->surfaceRms = n ? rms / static_cast<double>(n) : 0.0;
+  r->frontDev = front;
+}
+
+}  // namespace
+}  // namespace sphxr::bench
+
+int main(int argc, char** argv) {
+  using namespace sphxr;
+  using namespace sphxr::bench;
+  Args args;
+  if (!ParseArgs(argc, argv, &args) || args.help) {
+    std::fputs(kUsage, args.help ? stdout : stderr);
+    return args.help ? 0 : 2;
+  }
+  SetLogLevel(LogLevel::kWarn);
+  if (args.threads > 0) omp_set_num_threads(args.threads);
+  std::vector<SceneCase> cases;
+  const double quickTime = 0.1;
+  if (args.only.empty() || args.only == "deep_tank") {
+    const double t = args.quick ? quickTime : (args.time > 0 ? args.time : 0.3);
+    cases.push_back({"deep_tank", SPHXR_SCENES_DIR "/deep_tank.json", t, {0.4 * t, 0.7 * t, t}, false});
+  }
+  if (args.only.empty() || args.only == "dam_break_1m") {
+    const double t = args.quick ? quickTime : (args.time > 0 ? args.time : 0.5);
+    cases.push_back({"dam_break_1m", SPHXR_SCENES_DIR "/dam_break_1m.json", t, {t / 3, 2 * t / 3, t}, true});
+  }
+  std::ofstream csv;
+  if (!args.csv.empty() &&
+      !OpenCsv(args.csv,
+               "timestamp_utc,cpu_model,nproc,threads,scene,fluid,setting,enabled,delta1,delta2,threshold,idle,accel_tolerance,"
+               "sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,speedup,active_fraction,"
+               "mean_density_error,peak_density_error,surface_rms_spacings,front_deviation,max_speed,clamped,"
+               "finite,load_avg_start,load_avg_end",
+               false, &csv)) {
+    std::fprintf(stderr, "cannot write %s\n", args.csv.c_str());
+    return 1;
+  }
+  const std::string when = UtcTimestamp();
+  const std::string cpu = CpuModel();
+  const int threads = args.threads > 0 ? args.threads : omp_get_max_threads();
+  std::printf("# sphxr_bench_reuse on %s, %d cores, %d threads, %s\n", cpu.c_str(), CpuCount(), threads, when.c_str());
+  for (const SceneCase& sc : cases) {
+    Setting off;
+    off.name = "off";
+    Result ref, refLast;
+    std::fprintf(stderr, "%s: reference (reuse off) to t = %g s ...\n", sc.name.c_str(), sc.time);
+    if (!Run(sc, off, args.threads, &ref)) return 1;
+    std::vector<Result> results;
+    for (const Setting& s : Settings(args.quick)) {
+      std::fprintf(stderr, "%s: %s delta1 %g delta2 %g T %g IDLE %d tolerance %g ...\n", sc.name.c_str(),
+                   s.name.c_str(), s.delta1, s.delta2, s.threshold, s.idle, s.tolerance);
+      Result r;
+      if (!Run(sc, s, args.threads, &r)) return 1;
+      results.push_back(std::move(r));
+    }
+    std::fprintf(stderr, "%s: reference again (timing drift) ...\n", sc.name.c_str());
+    if (!Run(sc, off, args.threads, &refLast)) return 1;
+    const double refMs = 0.5 * (ref.stepMs + refLast.stepMs);
+    app::SceneFile scene;
+    if (Status s = app::LoadScene(sc.path, &scene); !s) return 1;
+    const float dx = scene.setup.params.spacing;
+    std::printf("\n## %s: %d particles, %.2f s simulated, reference %.2f / %.2f ms per step (first / last run)\n",
+                sc.name.c_str(), ref.fluid, sc.time, ref.stepMs, refLast.stepMs);
+    std::printf("%-9s %6s %6s %6s %5s %5s %8s %7s %7s %9s %9s %8s %8s %6s\n", "setting", "delta1", "delta2", "T", "IDLE", "tol",
+                "step_ms", "speedup", "active", "mean_err%", "peak_err%", "surf_rms", "front%", "vmax");
+    results.insert(results.begin(), ref);
+    for (Result& r : results) {
+      Compare(ref, &r, dx);
+      const double speedup = r.stepMs > 0 ? refMs / r.stepMs : 0.0;
+      std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %8.2f %7.2f %7.3f %9.3f %9.3f %8.3f %8.2f %6.2f%s\n",
+                  r.setting.name.c_str(), r.setting.delta1, r.setting.delta2, r.setting.threshold, r.setting.idle,
+                  r.setting.tolerance,
+                  r.stepMs, speedup, r.active, 100 * r.meanErr, 100 * r.peakErr, r.surfaceRms, 100 * r.frontDev,
+                  r.maxSpeed, r.finite ? "" : "  NaN!");
+      if (csv) {
+        csv << when << ',' << CsvField(cpu) << ',' << CpuCount() << ',' << threads << ',' << sc.name << ',' << r.fluid
+            << ',' << r.setting.name << ',' << (r.setting.enabled ? 1 : 0) << ',' << r.setting.delta1 << ','
+            << r.setting.delta2 << ',' << r.setting.threshold << ',' << r.setting.idle << ',' << r.setting.tolerance << ','
+            << sc.time << ','
+            << r.steps << ',' << r.stepMs << ',' << ref.stepMs << ',' << refLast.stepMs << ',' << speedup << ','
+            << r.active << ',' << r.meanErr << ',' << r.peakErr << ',' << r.surfaceRms << ','
+            << (sc.dam ? r.frontDev : std::nan("")) << ',' << r.maxSpeed << ',' << r.clamped << ','
+            << (r.finite ? 1 : 0) << ',' << r.loadStart << ',' << r.loadEnd << '\n';
+      }
+    }
+    std::fflush(stdout);
+  }
+  return 0;
+}

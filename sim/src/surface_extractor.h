@@ -1,0 +1,43 @@
+#pragma once
+// The interface between the Solver and a backend's HPMC stages (surface_impl.h, one template for both
+// systems). Two phases, so that a renderer can size its own buffer between them: Build* samples the
+// field and builds the pyramid (the apex is the vertex count); Write* walks the pyramid into memory.
+#include <cstdint>
+#include <vector>
+
+#include "kernel.h"
+#include "sphxr/common/status.h"
+#include "sphxr/sim/surface.h"
+
+namespace sphxr::sim {
+
+/// Resolved parameters of an extraction from the particles (defaults applied by the Solver).
+struct SurfaceJob {
+  float cellSize;      // m
+  float isoLevel;
+  float margin;        // m
+  float volume;        // m / rho0 of one fluid particle
+  CubicSpline kernel;  // the solver's kernel
+  int64_t maxSamples;  // refuse a lattice with more samples than this
+};
+
+class SurfaceExtractor {
+ public:
+  virtual ~SurfaceExtractor() = default;
+  /// Field from the backend's particles (bounding box + margin), then the pyramid.
+  virtual Status BuildFromParticles(const SurfaceJob& job, SurfaceStats* stats) = 0;
+  /// The pyramid over a given host field of grid.Samples() values (tests, benchmarks).
+  virtual Status BuildFromField(const SurfaceGrid& grid, const std::vector<float>& field, float isoLevel,
+                                SurfaceStats* stats) = 0;
+  /// Vertices of the last build (the apex).
+  virtual int64_t VertexCount() const = 0;
+  /// Traversal into caller memory of this backend's memory space; an error when capacity is too small.
+  virtual Status WriteTo(const SurfaceTarget& target, SurfaceStats* stats) = 0;
+  /// Traversal into the extractor's own buffer, grown (and logged) when the mesh does not fit.
+  virtual Status WriteOwned(SurfaceMeshView* view, SurfaceStats* stats) = 0;
+  /// Host copies of the last mesh written to the own buffer, and of the last field.
+  virtual void DownloadMesh(SurfaceMesh* out) const = 0;
+  virtual void DownloadField(SurfaceGrid* grid, std::vector<float>* field) const = 0;
+};
+
+}  // namespace sphxr::sim
