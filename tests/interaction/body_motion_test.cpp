@@ -1,0 +1,90 @@
+// The solver's kinematic bodies (sim/include/sphxr/sim/rigid.h): a target segment is followed across the
+// substeps with position linear and rotation slerp, and every boundary particle carries v + w x r.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sphxr/interaction/paddle.h"
+#include "sphxr/sim/rigid.h"
+#include "sphxr/sim/solver.h"
+#include "support.h"
+
+namespace sphxr::sim {
+namespace {
+
+TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
+  SceneSetup scene = test::TankScene({0, 0, 0}, {0.3f, 0.2f, 0.2f}, 0.01f);
+  scene.fluid.push_back(test::Block({0, 0, 0}, {0.3f, 0.05f, 0.2f}));
+  RigidBodySetup body;
+  body.shapes = interaction::BladeOnHandle(0.05f, 0.01f, 0.06f, 0.05f, 0.012f);
+  body.points = interaction::SamplePaddle(body.shapes, scene.params.spacing);
+  body.pose.position = Vec3{0.1f, 0.15f, 0.1f};  // above the water
+  scene.bodies.push_back(body);
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  ASSERT_EQ(solver->BodyCount(), 1);
+
+  // 0.05 s: move 5 cm along x and turn 90 degrees about y.
+  const double duration = 0.05;
+  const Vec3 from = body.pose.position, to = from + Vec3{0.05f, 0.0f, 0.0f};
+  const float half = 0.25f * 3.14159265f;
+  const Quat q1{std::cos(half), 0.0f, std::sin(half), 0.0f};
+  ASSERT_TRUE(solver->SetBodyTarget(0, RigidPose{to, q1}, duration).ok());
+  std::vector<Vec4> pos, vel;
+  int steps = 0;
+  while (solver->Time() < duration - 1e-9) {
+    ASSERT_TRUE(test::StepN(*solver, 1));
+    ++steps;
+    const double t = solver->Time();
+    const float u = static_cast<float>(std::min(1.0, t / duration));
+    const RigidPose p = solver->BodyPose(0);
+    EXPECT_NEAR(p.position.x, from.x + 0.05f * u, 2e-6f) << "t = " << t;
+    // slerp from identity: a rotation by u * 90 degrees about y
+    EXPECT_NEAR(p.orientation.w, std::cos(half * u), 2e-5f);
+    EXPECT_NEAR(p.orientation.y, std::sin(half * u), 2e-5f);
+    // During the step: v = 1 m/s along x (the last step may end past the target and hold), w = pi/2 / 0.05 s.
+    if (t <= duration) {
+      EXPECT_NEAR(solver->BodyVelocity(0).x, 1.0f, 1e-3f);
+      EXPECT_NEAR(solver->BodyAngularVelocity(0).y, 0.5f * 3.14159265f / 0.05f, 0.05f);
+    }
+    // Every particle: v + w x r with r from the origin at the start of the step.
+    solver->DownloadBodies(&pos, &vel);
+    const Vec3 v = solver->BodyVelocity(0), w = solver->BodyAngularVelocity(0);
+    const Vec3 origin = p.position - v * solver->LastStep().dt;  // the start-of-step origin
+    for (size_t k = 0; k < pos.size(); k += 7) {
+      const Vec3 expected = v + Cross(w, Xyz(pos[k]) - origin);
+      ASSERT_NEAR(vel[k].x, expected.x, 1e-3f);
+      ASSERT_NEAR(vel[k].y, expected.y, 1e-3f);
+      ASSERT_NEAR(vel[k].z, expected.z, 1e-3f);
+    }
+  }
+  EXPECT_GT(steps, 5) << "several substeps per segment";
+  // Held after the target time, at rest.
+  ASSERT_TRUE(test::StepN(*solver, 3));
+  EXPECT_EQ(solver->BodyPose(0).position.x, to.x);
+  EXPECT_EQ(Length(solver->BodyVelocity(0)), 0.0f);
+  // A target time not after now relocates at once, at rest.
+  ASSERT_TRUE(solver->SetBodyTarget(0, RigidPose{from, Quat{}}, solver->Time()).ok());
+  EXPECT_EQ(solver->BodyPose(0).position.x, from.x);
+  EXPECT_FALSE(solver->SetBodyTarget(1, RigidPose{}, 1.0).ok());
+  EXPECT_FALSE(solver->SetBodyTarget(0, RigidPose{Vec3{NAN, 0, 0}, Quat{}}, 1.0).ok());
+}
+
+TEST(BodyMotion, BadBodiesAreRefused) {
+  SceneSetup scene = test::TankScene({0, 0, 0}, {0.3f, 0.2f, 0.2f}, 0.01f);
+  RigidBodySetup body;
+  body.shapes = interaction::BladeOnHandle();
+  scene.bodies.push_back(body);  // no points
+  std::unique_ptr<Solver> solver;
+  Status s = Solver::Create(scene, test::TestConfig(), &solver);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("boundary particles"), std::string::npos) << s.message();
+  scene.bodies[0].points = {Vec3{0, 0, 0}};
+  scene.bodies[0].shapes[0].radius = -1.0f;
+  s = Solver::Create(scene, test::TestConfig(), &solver);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("radius"), std::string::npos) << s.message();
+}
+
+}  // namespace
+}  // namespace sphxr::sim
