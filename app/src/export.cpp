@@ -124,4 +124,49 @@ Status WriteVtk(const std::string& path, const sim::HostFluid& fluid) {
   return Status::Ok();
 }
 
+Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh) {
+  File f;
+  if (Status s = OpenForWrite(path, &f); !s) return s;
+  const int64_t n = mesh.VertexCount();
+  std::fprintf(f.get(),
+               "ply\nformat binary_little_endian 1.0\ncomment sphxr water surface (triangle soup)\nelement vertex %lld\n"
+               "property float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+               "property float nz\nelement face %lld\nproperty list uchar uint vertex_indices\nend_header\n",
+               static_cast<long long>(n), static_cast<long long>(n / 3));
+  for (int64_t v = 0; v < n; ++v) {
+    std::fwrite(&mesh.positions[static_cast<size_t>(3 * v)], 4, 3, f.get());
+    std::fwrite(&mesh.normals[static_cast<size_t>(3 * v)], 4, 3, f.get());
+  }
+  for (int64_t t = 0; t < n / 3; ++t) {
+    const unsigned char three = 3;
+    const uint32_t index[3] = {static_cast<uint32_t>(3 * t), static_cast<uint32_t>(3 * t + 1),
+                               static_cast<uint32_t>(3 * t + 2)};
+    std::fwrite(&three, 1, 1, f.get());
+    std::fwrite(index, 4, 3, f.get());
+  }
+  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  return Status::Ok();
+}
+
+Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh) {
+  File f;
+  if (Status s = OpenForWrite(path, &f); !s) return s;
+  const int64_t n = mesh.VertexCount();
+  std::fprintf(f.get(), "# sphxr water surface: %lld triangles\n", static_cast<long long>(n / 3));
+  for (int64_t v = 0; v < n; ++v) {
+    const float* p = &mesh.positions[static_cast<size_t>(3 * v)];
+    std::fprintf(f.get(), "v %.7g %.7g %.7g\n", p[0], p[1], p[2]);
+  }
+  for (int64_t v = 0; v < n; ++v) {
+    const float* q = &mesh.normals[static_cast<size_t>(3 * v)];
+    std::fprintf(f.get(), "vn %.6g %.6g %.6g\n", q[0], q[1], q[2]);
+  }
+  for (int64_t t = 0; t < n / 3; ++t) {
+    const long long a = 3 * t + 1, b = a + 1, c = a + 2;  // OBJ counts from 1
+    std::fprintf(f.get(), "f %lld//%lld %lld//%lld %lld//%lld\n", a, a, b, b, c, c);
+  }
+  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  return Status::Ok();
+}
+
 }  // namespace sphxr::app

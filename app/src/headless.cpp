@@ -12,6 +12,8 @@
 #include <memory>
 
 #include "sphxr/app/export.h"
+#include "sphxr/app/pictures.h"
+#include "sphxr/app/quality.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/sim/measure.h"
@@ -84,23 +86,42 @@ DamBreakMeasure MeasureDamBreak(const DamBreakProbe& probe, const sim::HostFluid
 }  // namespace
 
 std::string UsageText() {
-  return "usage: sphxr [--headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
+  return "usage: sphxr [--desktop | --headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
          "             [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
-         "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off]\n"
-         "             [--progress | --no-progress]\n"
+         "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
+         "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
+         "             [--progress | --no-progress] [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
+         "             [--image-size WxH] [--render water|particles] [--quality auto|scene] [--gl-debug]\n"
          "\n"
-         "  --headless        run without a window (the only mode until the renderer lands)\n"
+         "  --desktop         a window with the water, a panel and a mouse-driven hand (the default when a\n"
+         "                    display is present); --window-size WxH, --frame-limit N, --no-vsync\n"
+         "  --headless        run without a window (the default without a display)\n"
+         "  --quality Q       auto: measure this machine and pick the spacing that runs in real time\n"
+         "                    (the window's default); scene: the scene's spacing (the headless default)\n"
          "  --scene FILE      JSON scene (default: " SPHXR_SCENES_DIR "/dam_break.json)\n"
          "  --time S          simulated seconds to run (default: the scene's run.time)\n"
          "  --steps N         number of steps instead of a time\n"
          "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda\n"
          "  --threads T       CPU backend threads (0 = all cores)\n"
          "  --spacing H       particle spacing in m (rescales the particle count of the scene)\n"
-         "  --set KEY=VALUE   a solver parameter of the scene's \"solver\" section, e.g. --set stiffness=2e5\n"
+         "  --set KEY=VALUE   a parameter of the scene's \"solver\" section (stiffness=2e5) or \"reuse\" section\n"
+         "                    (reuse.threshold=0.8)\n"
          "  --export-every K  write the particles every K steps to DIR (PLY or VTK: ParaView, Blender)\n"
+         "  --export-surface-every K  write the water surface (HPMC mesh, the scene's \"surface\" section) every K\n"
+         "                    steps to DIR as surface_NNNNNN.ply (binary, with normals) or .obj (--surface-format)\n"
          "  --stats FILE.csv  one CSV row per step (time, dt, speeds, density errors, probes)\n"
          "  --validate        check every stage for non-finite values; stop at the first, naming it\n"
-         "  --reuse on|off    activity-based reuse (the scene's \"reuse\" section sets its parameters)\n";
+         "  --reuse on|off|accurate|balanced|fast\n"
+         "                    activity-based reuse: on/off keeps the scene's \"reuse\" parameters, a preset\n"
+         "                    replaces them (docs/reuse.md); --set reuse.threshold=1.3 etc. override them\n"
+
+         "  --screenshot FILE.png  a picture of the last state (OpenGL through EGL, no display needed);\n"
+         "                    with --desktop, the window (panel included) when it closes\n"
+         "  --frames DIR      a PNG every 1/F simulated seconds (--fps F, default 30); DIR/movie.mp4 when\n"
+         "                    ffmpeg is on the PATH\n"
+         "  --image-size WxH  size of the pictures (default 1280x720)\n"
+         "  --render MODE     water (default) or particles (coloured by speed)\n"
+         "  --gl-debug        OpenGL debug output on (as in debug builds): any GL error aborts, naming the call\n";
 }
 
 Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
@@ -124,8 +145,12 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     } else if (arg == "--reuse") {
       if (Status s = value(&v); !s) return s;
       const std::string r = v;
-      if (r != "on" && r != "off") return Status::Error("--reuse " + r + ": must be on or off");
-      out->reuse = r == "on" ? 1 : 0;
+      sim::ReuseParams probe;
+      if (r != "on" && r != "off" && !sim::ApplyReusePreset(r, &probe)) {
+        return Status::Error("--reuse " + r + ": must be on, off or a preset (" + sim::ReusePresetNames() + ")");
+      }
+      out->reuse = r == "off" ? 0 : 1;
+      out->reusePreset = (r == "on" || r == "off") ? "" : r;
     } else if (arg == "--validate") {
       out->validate = true;
     } else if (arg == "--progress") {
@@ -170,6 +195,61 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       if (out->exportFormat != "ply" && out->exportFormat != "vtk") {
         return Status::Error(arg + " " + v + ": must be ply or vtk");
       }
+    } else if (arg == "--export-surface-every") {
+      if (Status s = value(&v); !s) return s;
+      if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->exportSurfaceEvery); !s) return s;
+    } else if (arg == "--surface-format") {
+      if (Status s = value(&v); !s) return s;
+      out->surfaceFormat = v;
+      if (out->surfaceFormat != "ply" && out->surfaceFormat != "obj") {
+        return Status::Error(arg + " " + v + ": must be ply or obj");
+      }
+    } else if (arg == "--screenshot") {
+      if (Status s = value(&v); !s) return s;
+      out->screenshotPath = v;
+    } else if (arg == "--frames") {
+      if (Status s = value(&v); !s) return s;
+      out->framesDir = v;
+    } else if (arg == "--fps") {
+      if (Status s = value(&v); !s) return s;
+      if (Status s = ParseDouble(arg, v, 0.1, 1000.0, &out->fps); !s) return s;
+    } else if (arg == "--image-size") {
+      if (Status s = value(&v); !s) return s;
+      int w = 0, h = 0;
+      char tail = 0;
+      if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192) {
+        return Status::Error(arg + " " + v + ": must be WIDTHxHEIGHT, each from 16 to 8192 (e.g. 1280x720)");
+      }
+      out->imageWidth = w;
+      out->imageHeight = h;
+    } else if (arg == "--window-size") {
+      if (Status s = value(&v); !s) return s;
+      int w = 0, h = 0;
+      char tail = 0;
+      if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 8192 || h > 8192) {
+        return Status::Error(arg + " " + v + ": must be WIDTHxHEIGHT, each from 64 to 8192 (e.g. 1280x720)");
+      }
+      out->windowWidth = w;
+      out->windowHeight = h;
+    } else if (arg == "--frame-limit") {
+      if (Status s = value(&v); !s) return s;
+      int64_t n = 0;
+      if (Status s = ParseInt(arg, v, 1, 1 << 30, &n); !s) return s;
+      out->frameLimit = static_cast<int>(n);
+    } else if (arg == "--quality") {
+      if (Status s = value(&v); !s) return s;
+      const std::string q = v;
+      if (q != "auto" && q != "scene") return Status::Error("--quality " + q + ": must be auto or scene");
+      out->quality = q == "auto" ? 1 : 0;
+    } else if (arg == "--gl-debug") {
+      out->glDebug = true;
+    } else if (arg == "--no-vsync") {
+      out->vsync = false;
+    } else if (arg == "--render") {
+      if (Status s = value(&v); !s) return s;
+      const std::string r = v;
+      if (r != "water" && r != "particles") return Status::Error("--render " + r + ": must be water or particles");
+      out->particleImages = r == "particles";
     } else if (arg == "--stats") {
       if (Status s = value(&v); !s) return s;
       out->statsPath = v;
@@ -186,11 +266,21 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
   if (Status s = LoadScene(options.scenePath, &scene); !s) return s;
+  // A preset from the command line replaces the scene's reuse parameters; --set reuse.* then overrides.
+  if (!options.reusePreset.empty()) sim::ApplyReusePreset(options.reusePreset, &scene.setup.reuse);
   for (const std::string& set : options.sets) {
     if (Status s = SetSolverParam(&scene.setup, set); !s) return s;
   }
   if (options.spacing > 0.0f) scene.setup.params.spacing = options.spacing;
   if (options.reuse >= 0) scene.setup.reuse.enabled = options.reuse == 1;
+  if (options.quality == 1 && options.spacing <= 0.0f) {
+    sim::SolverConfig probe;
+    probe.device = options.device;
+    probe.threads = options.threads;
+    QualityChoice choice;
+    if (Status s = ChooseQuality(scene.setup, probe, 1.0, 1.0, &choice); !s) return Status::Error(options.scenePath + ": " + s.message());
+    scene.setup.params.spacing = choice.spacing;
+  }
 
   double targetTime = options.time;
   int64_t targetSteps = options.steps;
@@ -208,10 +298,32 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     stats.open(options.statsPath);
     if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
   }
-  if (options.exportEvery > 0) {
+  if (options.exportEvery > 0 || options.exportSurfaceEvery > 0) {
     std::error_code ec;
     std::filesystem::create_directories(options.outDir, ec);
     if (ec) return Status::Error("--out " + options.outDir + ": cannot create the directory: " + ec.message());
+  }
+  // Pictures: the GL context is made before the run, so a machine without EGL fails in a second.
+  std::unique_ptr<OfflinePictures> pictures;
+  if (!options.screenshotPath.empty() || !options.framesDir.empty()) {
+    if (!options.framesDir.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(options.framesDir, ec);
+      if (ec) return Status::Error("--frames " + options.framesDir + ": cannot create the directory: " + ec.message());
+    }
+    if (Status s = OfflinePictures::Create(options.imageWidth, options.imageHeight, &pictures, options.glDebug); !s) {
+      return Status::Error("--screenshot/--frames: " + s.message());
+    }
+  }
+  const render::RenderMode pictureMode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
+
+  // Paddles (scene "paddles" section): sampled at the final spacing, added to the scene as moving bodies.
+  std::unique_ptr<interaction::PaddleSystem> paddles;
+  if (!scene.paddles.empty()) {
+    if (Status s = interaction::PaddleSystem::Create(scene.paddles, scene.setup, &paddles); !s) {
+      return Status::Error(options.scenePath + ": " + s.message());
+    }
+    paddles->AddBodies(&scene.setup);
   }
 
   sim::SolverConfig config;
@@ -221,6 +333,11 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   std::unique_ptr<sim::Solver> solver;
   if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) return Status::Error(options.scenePath + ": " + s.message());
 
+  if (paddles) {
+    if (Status s = paddles->Attach(solver.get()); !s) return s;
+    summary->paddles = paddles->Count();
+    for (int k = 0; k < paddles->Count(); ++k) summary->paddleParticles += paddles->ParticleCount(k);
+  }
   const float spacing = scene.setup.params.spacing;
   summary->fluid = solver->FluidCount();
   summary->boundary = solver->BoundaryCount();
@@ -232,6 +349,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (stats) {
     stats << "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction";
     if (probeEveryStep) stats << ",front_Z,height_H";
+    if (paddles) {
+      stats << ",pushed_out";
+      for (int k = 0; k < paddles->Count(); ++k) stats << Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
+    }
     stats << "\n";
   }
 
@@ -249,11 +370,61 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (options.exportEvery > 0) {
     if (Status s = exportNow(0); !s) return s;
   }
+  sim::SurfaceMesh surfaceMesh;
+  double surfaceSeconds = 0.0;
+  auto exportSurface = [&](int64_t step) -> Status {
+    const auto t0 = std::chrono::steady_clock::now();
+    sim::SurfaceStats stats;
+    if (Status s = solver->ExtractSurface(scene.surface.value_or(sim::SurfaceParams{}), &surfaceMesh, &stats); !s) {
+      return Status::Error(options.scenePath + ": " + s.message());
+    }
+    surfaceSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    char name[64];
+    std::snprintf(name, sizeof(name), "surface_%06lld.%s", static_cast<long long>(step), options.surfaceFormat.c_str());
+    const std::string path = (std::filesystem::path(options.outDir) / name).string();
+    Status s = options.surfaceFormat == "obj" ? WriteSurfaceObj(path, surfaceMesh) : WriteSurfacePly(path, surfaceMesh);
+    if (s) {
+      ++summary->surfaceExports;
+      summary->surfaceTriangles = surfaceMesh.TriangleCount();
+    }
+    return s;
+  };
+  if (options.exportSurfaceEvery > 0) {
+    if (Status s = exportSurface(0); !s) return s;
+  }
+
+  double nextFrameTime = 0.0;
+  sim::HostFluid frameHost;
+  auto frameNow = [&]() -> Status {
+    if (options.framesDir.empty()) return Status::Ok();
+    solver->Download(&frameHost);
+    char name[64];
+    std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(summary->frames));
+    const std::string path = (std::filesystem::path(options.framesDir) / name).string();
+    if (Status s = pictures->Write(MakeFrameScene(scene.setup, frameHost, pictureMode), path); !s) return s;
+    ++summary->frames;
+    nextFrameTime += 1.0 / options.fps;
+    return Status::Ok();
+  };
+  if (Status s = frameNow(); !s) return s;
 
   double activeSum = 0.0;
+  double forceSum = 0.0;
+  double nextFrame = 0.0;  // paddles: display frames at paddleFrameRate get new targets
   const auto begin = std::chrono::steady_clock::now();
   while (targetSteps > 0 ? solver->GetTotals().steps < targetSteps : solver->Time() < targetTime - 1e-9) {
+    if (paddles && solver->Time() >= nextFrame - 1e-9) {
+      nextFrame += 1.0 / scene.paddleFrameRate;
+      if (Status s = paddles->BeginFrame(nextFrame); !s) return s;
+    }
     if (Status s = solver->Step(); !s) return s;
+    if (paddles) {
+      paddles->AfterStep();
+      for (int k = 0; k < paddles->Count(); ++k) {
+        forceSum += sim::Length(paddles->State(k).force);
+        summary->paddlePeakHaptic = std::max(summary->paddlePeakHaptic, paddles->State(k).haptic);
+      }
+    }
     const sim::StepInfo& info = solver->LastStep();
     const int64_t step = solver->GetTotals().steps;
     summary->peakMeanDensityError = std::max(summary->peakMeanDensityError, info.meanDensityError);
@@ -272,10 +443,23 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
         const DamBreakMeasure m = MeasureDamBreak(*scene.damBreak, host, spacing);
         stats << ',' << m.front << ',' << m.height;
       }
+      if (paddles) {
+        stats << ',' << info.pushedOut;
+        for (int k = 0; k < paddles->Count(); ++k) {
+          const interaction::PaddleState& p = paddles->State(k);
+          stats << ',' << p.force.x << ',' << p.force.y << ',' << p.force.z << ',' << p.haptic;
+        }
+      }
       stats << '\n';
     }
     if (options.exportEvery > 0 && step % options.exportEvery == 0) {
       if (Status s = exportNow(step); !s) return s;
+    }
+    if (options.exportSurfaceEvery > 0 && step % options.exportSurfaceEvery == 0) {
+      if (Status s = exportSurface(step); !s) return s;
+    }
+    while (!options.framesDir.empty() && solver->Time() >= nextFrameTime - 1e-9) {
+      if (Status s = frameNow(); !s) return s;
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     const double fraction = targetSteps > 0 ? static_cast<double>(step) / targetSteps : solver->Time() / targetTime;
@@ -293,6 +477,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   summary->meanDensityError = solver->LastStep().meanDensityError;
   summary->maxDensityError = solver->LastStep().maxDensityError;
   summary->clampedEvents = totals.clampedEvents;
+  summary->pushedOut = totals.pushedOutEvents;
+  if (paddles && totals.steps > 0) summary->paddleMeanForce = forceSum / static_cast<double>(totals.steps * paddles->Count());
   summary->meanActiveFraction = totals.steps > 0 ? activeSum / static_cast<double>(totals.steps) : 1.0;
   solver->Download(&host);
   summary->lost = summary->fluid - static_cast<int64_t>(host.size());
@@ -300,6 +486,26 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     const DamBreakMeasure m = MeasureDamBreak(*scene.damBreak, host, spacing);
     summary->surgeFront = m.front;
     summary->columnHeight = m.height;
+  }
+
+  std::string movie;
+  if (summary->frames > 0) {
+    const std::string ffmpeg = FindOnPath("ffmpeg");
+    if (ffmpeg.empty()) {
+      SPHXR_LOG_INFO("ffmpeg is not on the PATH: the frames stay a PNG sequence");
+    } else {
+      movie = (std::filesystem::path(options.framesDir) / "movie.mp4").string();
+      const std::string command = Format("'%s' -y -loglevel error -framerate %g -i '%s/frame_%%05d.png' -pix_fmt yuv420p "
+                                         "-vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' '%s'",
+                                         ffmpeg.c_str(), options.fps, options.framesDir.c_str(), movie.c_str());
+      if (std::system(command.c_str()) != 0) {
+        SPHXR_LOG_WARN("ffmpeg could not make %s; the PNG frames are there", movie.c_str());
+        movie.clear();
+      }
+    }
+  }
+  if (pictures && !options.screenshotPath.empty()) {
+    if (Status s = pictures->Write(MakeFrameScene(scene.setup, host, pictureMode), options.screenshotPath); !s) return s;
   }
 
   std::printf("sphxr summary: %s\n", scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str());
@@ -329,6 +535,32 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (scene.damBreak) {
     std::printf("  dam break       surge front Z = %.3f, column height H = %.3f (Martin & Moyce units)\n",
                 summary->surgeFront, summary->columnHeight);
+  }
+  if (paddles) {
+    for (int k = 0; k < paddles->Count(); ++k) {
+      const interaction::PaddleDesc& d = paddles->Desc(k);
+      const interaction::PaddleState& p = paddles->State(k);
+      std::printf("  paddle          %s (%s): %d boundary particles, %s, filtered force [%.3g %.3g %.3g] N at the end, "
+                  "%lld teleport(s)\n",
+                  d.name.c_str(), interaction::HolderName(d.holder), paddles->ParticleCount(k),
+                  interaction::PaddleModeName(p.mode), p.force.x, p.force.y, p.force.z, static_cast<long long>(p.teleports));
+    }
+    std::printf("  paddles         mean filtered |force| %.3f N, peak haptic amplitude %.2f, fluid pushed out of a paddle "
+                "%lld times\n",
+                summary->paddleMeanForce, summary->paddlePeakHaptic, static_cast<long long>(summary->pushedOut));
+  }
+  if (summary->surfaceExports > 0) {
+    summary->surfaceMs = 1e3 * surfaceSeconds / static_cast<double>(summary->surfaceExports);
+    std::printf("  surface         %lld meshes to %s, %.2f ms per extraction; the last %lld triangles\n",
+                static_cast<long long>(summary->surfaceExports), options.outDir.c_str(), summary->surfaceMs,
+                static_cast<long long>(summary->surfaceTriangles));
+  }
+  if (summary->frames > 0) {
+    std::printf("  frames          %lld PNG files in %s%s%s\n", static_cast<long long>(summary->frames),
+                options.framesDir.c_str(), movie.empty() ? "" : ", movie ", movie.c_str());
+  }
+  if (pictures && !options.screenshotPath.empty()) {
+    std::printf("  picture         %s (%dx%d)\n", options.screenshotPath.c_str(), options.imageWidth, options.imageHeight);
   }
   if (summary->exports > 0) {
     std::printf("  exported        %lld files to %s\n", static_cast<long long>(summary->exports), options.outDir.c_str());

@@ -1,11 +1,13 @@
-// sphxr: the command line. Desktop and XR modes arrive with the renderer and the XR layer; until then
-// every run is headless.
+// sphxr: the command line. Picks the mode: --desktop (the default when a display is present), else
+// --headless; a window that cannot open falls back to headless with one line saying why.
 #include <cstdio>
 
+#include "sphxr/app/desktop.h"
 #include "sphxr/app/headless.h"
 #include "sphxr/common/log.h"
 
 int main(int argc, char** argv) {
+  using sphxr::app::Mode;
   sphxr::app::Options options;
   if (sphxr::Status s = sphxr::app::ParseCommandLine(argc, argv, &options); !s) {
     std::fprintf(stderr, "sphxr: %s\n", s.message().c_str());
@@ -15,16 +17,36 @@ int main(int argc, char** argv) {
     std::fputs(sphxr::app::UsageText().c_str(), stdout);
     return 0;
   }
-  if (options.mode == sphxr::app::Mode::kDesktop || options.mode == sphxr::app::Mode::kXr) {
-    std::fprintf(stderr, "sphxr: %s mode is not part of this build yet (the renderer and XR layer are open issues); "
-                         "use --headless\n", options.mode == sphxr::app::Mode::kXr ? "--xr" : "--desktop");
-    return 2;
+  if (options.mode == Mode::kXr) {
+    SPHXR_LOG_WARN("--xr: the XR layer is not part of this build yet: using the desktop window");
+    options.mode = Mode::kDesktop;
   }
-  if (options.mode == sphxr::app::Mode::kAuto) {
-    SPHXR_LOG_INFO("no window or headset modes in this build yet: running headless");
+  bool autoPicture = false;  // a picture nobody asked for must not cost the run when EGL is missing
+  if (options.mode == Mode::kAuto) {
+    options.mode = sphxr::app::DisplayAvailable() ? Mode::kDesktop : Mode::kHeadless;
+    if (options.mode == Mode::kHeadless) {
+      SPHXR_LOG_INFO("no display (DISPLAY is not set): running headless; a picture goes to %s",
+                     options.screenshotPath.empty() ? "sphxr_screenshot.png" : options.screenshotPath.c_str());
+      if (options.screenshotPath.empty()) {
+        options.screenshotPath = "sphxr_screenshot.png";
+        autoPicture = true;
+      }
+    }
+  }
+  if (options.mode == Mode::kDesktop) {
+    const sphxr::Status s = sphxr::app::RunDesktop(options);
+    if (s) return 0;
+    SPHXR_LOG_WARN("desktop window unavailable (%s): running headless", s.message().c_str());
+    options.mode = Mode::kHeadless;
   }
   sphxr::app::RunSummary summary;
-  if (sphxr::Status s = sphxr::app::RunHeadless(options, &summary); !s) {
+  sphxr::Status run = sphxr::app::RunHeadless(options, &summary);
+  if (!run && autoPicture && run.message().rfind("--screenshot/--frames:", 0) == 0) {
+    SPHXR_LOG_WARN("no picture (%s): running without one", run.message().c_str());
+    options.screenshotPath.clear();
+    run = sphxr::app::RunHeadless(options, &summary);
+  }
+  if (sphxr::Status s = run; !s) {
     std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
     return 1;
   }

@@ -1,11 +1,13 @@
 #include "sphxr/app/scene_file.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
+#include "sphxr/app/param_registry.h"
 #include "sphxr/common/log.h"
 #include "sphxr/sim/solver.h"
 
@@ -59,7 +61,8 @@ class Reader {
 
   Status Parse(const json& root) {
     if (!root.is_object()) return Error("(root)", "a scene must be a JSON object");
-    CheckKeys(root, "", {"name", "description", "solver", "gravity", "tank", "fluid", "obstacles", "run", "probe", "reuse"});
+    CheckKeys(root, "", {"name", "description", "solver", "gravity", "tank", "fluid", "obstacles", "run", "probe", "reuse",
+                         "paddles", "surface"});
     sim::SceneSetup& s = m_out->setup;
     if (root.contains("name")) {
       if (!root["name"].is_string()) return Error("name", "must be a string");
@@ -119,11 +122,15 @@ class Reader {
       for (size_t i = 0; i < fluid.size(); ++i) {
         const std::string key = "fluid[" + std::to_string(i) + "]";
         if (!fluid[i].is_object()) return Error(key, "must be an object with min and max");
-        CheckKeys(fluid[i], key, {"min", "max", "velocity"});
+        CheckKeys(fluid[i], key, {"min", "max", "velocity", "hydrostatic"});
         sim::FluidBlock block;
         if (Status st = Box(fluid[i], key, &block.box); !st) return st;
         if (fluid[i].contains("velocity")) {
           if (Status st = Vec(fluid[i]["velocity"], key + ".velocity", &block.velocity); !st) return st;
+        }
+        if (fluid[i].contains("hydrostatic")) {
+          if (!fluid[i]["hydrostatic"].is_boolean()) return Error(key + ".hydrostatic", "must be true or false");
+          block.hydrostatic = fluid[i]["hydrostatic"].get<bool>();
         }
         s.fluid.push_back(block);
       }
@@ -144,29 +151,57 @@ class Reader {
       // A reuse section turns reuse on unless it says "enabled": false.
       const json& reuse = root["reuse"];
       if (!reuse.is_object()) return Error("reuse", "must be an object");
-      CheckKeys(reuse, "reuse", {"enabled", "delta1", "delta2", "threshold", "idle", "pressure_scale", "cell_count"});
+      CheckKeys(reuse, "reuse",
+                {"enabled", "preset", "delta1", "delta2", "threshold", "idle", "pressure_scale", "cell_count",
+                 "accel_tolerance"});
       sim::ReuseParams& r = s.reuse;
       r.enabled = true;
+      // A preset first, then any parameter the section names overrides it.
+      if (reuse.contains("preset")) {
+        const json& preset = reuse["preset"];
+        if (!preset.is_string() || !sim::ApplyReusePreset(preset.get<std::string>(), &r)) {
+          return Error("reuse.preset", std::string("must be one of ") + sim::ReusePresetNames());
+        }
+      }
       if (reuse.contains("enabled")) {
         if (!reuse["enabled"].is_boolean()) return Error("reuse.enabled", "must be true or false");
         r.enabled = reuse["enabled"].get<bool>();
       }
-      const std::pair<const char*, float*> numbers[] = {{"delta1", &r.delta1},       {"delta2", &r.delta2},
-                                                        {"threshold", &r.threshold}, {"pressure_scale", &r.pressureScale},
-                                                        {"cell_count", &r.cellCount}};
-      for (const auto& [key, member] : numbers) {
-        if (!reuse.contains(key)) continue;
+      for (const ParamDesc& p : ParamRegistry()) {  // the one description of each parameter
+        if (p.group != "reuse" || !reuse.contains(p.name)) continue;
         double v;
-        if (Status st = Number(reuse[key], std::string("reuse.") + key, &v); !st) return st;
-        if (v < 0 || v > 1e9) return Error(std::string("reuse.") + key, "must be from 0 to 1e9");
-        *member = static_cast<float>(v);
+        if (Status st = Number(reuse[p.name], p.key, &v); !st) return st;
+        if (Status st = SetParam(p, v, m_out->path + ": " + p.key, &s); !st) return st;
       }
-      if (reuse.contains("idle")) {
-        if (!reuse["idle"].is_number_integer()) return Error("reuse.idle", "must be an integer (steps)");
-        const int64_t idle = reuse["idle"].get<int64_t>();
-        if (idle < 0 || idle > 1000) return Error("reuse.idle", "must be 0 to 1000 steps");
-        r.idle = static_cast<int>(idle);
+    }
+    if (root.contains("paddles")) {
+      if (Status st = Paddles(root["paddles"]); !st) return st;
+    }
+    if (root.contains("surface")) {
+      // The water surface (docs/surface.md): sim::SurfaceParams; absent keys keep their defaults.
+      const json& surface = root["surface"];
+      if (!surface.is_object()) return Error("surface", "must be an object");
+      CheckKeys(surface, "surface", {"cell_size", "iso_level", "margin"});
+      sim::SurfaceParams p;
+      const struct {
+        const char* key;
+        float* member;
+        double lo, hi;
+        bool loOpen;
+        const char* why;
+      } numbers[] = {{"cell_size", &p.cellSize, 0, 100, false, "must be from 0 (the particle spacing) to 100 m"},
+                     {"iso_level", &p.isoLevel, 0, 10, true, "must be above 0 and below 10 (volume fraction; 0.5 is the surface)"},
+                     {"margin", &p.margin, 0, 100, false, "must be from 0 to 100 m"}};
+      for (const auto& n : numbers) {
+        if (!surface.contains(n.key)) continue;
+        double v;
+        if (Status st = Number(surface[n.key], std::string("surface.") + n.key, &v); !st) return st;
+        if (v > n.hi || v < n.lo || (n.loOpen && v <= n.lo) || (std::string(n.key) == "iso_level" && v >= n.hi)) {
+          return Error(std::string("surface.") + n.key, Format("%g: %s", v, n.why));
+        }
+        *n.member = static_cast<float>(v);
       }
+      m_out->surface = p;
     }
     if (root.contains("run")) {
       const json& run = root["run"];
@@ -202,6 +237,143 @@ class Reader {
     return Status::Ok();
   }
 
+  Status Positive(const json& obj, const std::string& prefix, const char* name, float* out) const {
+    if (!obj.contains(name)) return Status::Ok();
+    double v;
+    if (Status st = Number(obj[name], prefix + "." + name, &v); !st) return st;
+    if (v <= 0.0 || v > 1e6) return Error(prefix + "." + name, Format("%g: must be positive (and at most 1e6)", v));
+    *out = static_cast<float>(v);
+    return Status::Ok();
+  }
+
+  Status Shape(const json& j, const std::string& key, sim::ShapePrimitive* out) const {
+    if (!j.is_object() || j.size() != 1 || !(j.contains("box") || j.contains("capsule"))) {
+      return Error(key, "must be {\"box\": {center, half_extents}} or {\"capsule\": {a, b, radius}}");
+    }
+    if (j.contains("box")) {
+      const json& b = j["box"];
+      if (!b.is_object() || !b.contains("center") || !b.contains("half_extents")) {
+        return Error(key + ".box", "needs \"center\" and \"half_extents\"");
+      }
+      out->kind = sim::ShapePrimitive::Kind::kBox;
+      if (Status st = Vec(b["center"], key + ".box.center", &out->a); !st) return st;
+      if (Status st = Vec(b["half_extents"], key + ".box.half_extents", &out->b); !st) return st;
+      if (!(out->b.x > 0 && out->b.y > 0 && out->b.z > 0)) return Error(key + ".box.half_extents", "must be positive");
+      return Status::Ok();
+    }
+    const json& c = j["capsule"];
+    if (!c.is_object() || !c.contains("a") || !c.contains("b") || !c.contains("radius")) {
+      return Error(key + ".capsule", "needs \"a\", \"b\" and \"radius\"");
+    }
+    out->kind = sim::ShapePrimitive::Kind::kCapsule;
+    if (Status st = Vec(c["a"], key + ".capsule.a", &out->a); !st) return st;
+    if (Status st = Vec(c["b"], key + ".capsule.b", &out->b); !st) return st;
+    double r;
+    if (Status st = Number(c["radius"], key + ".capsule.radius", &r); !st) return st;
+    if (r <= 0) return Error(key + ".capsule.radius", "must be positive");
+    out->radius = static_cast<float>(r);
+    return Status::Ok();
+  }
+
+  // "paddles": {"frame_rate": 90, "list": [{name, hand, shapes, trajectory, loop, viscosity, limits, haptics}]}
+  Status Paddles(const json& j) {
+    if (!j.is_object()) return Error("paddles", "must be an object with \"list\" (and optionally \"frame_rate\")");
+    CheckKeys(j, "paddles", {"frame_rate", "list"});
+    if (j.contains("frame_rate")) {
+      double f;
+      if (Status st = Number(j["frame_rate"], "paddles.frame_rate", &f); !st) return st;
+      if (f < 1 || f > 10000) return Error("paddles.frame_rate", "must be from 1 to 10000 Hz");
+      m_out->paddleFrameRate = f;
+    }
+    if (!j.contains("list") || !j["list"].is_array()) return Error("paddles.list", "must be an array of paddles");
+    const json& list = j["list"];
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string key = "paddles.list[" + std::to_string(i) + "]";
+      const json& p = list[i];
+      if (!p.is_object()) return Error(key, "must be an object");
+      CheckKeys(p, key, {"name", "hand", "shapes", "trajectory", "loop", "viscosity", "limits", "haptics"});
+      interaction::PaddleDesc d;
+      d.name = "paddle" + std::to_string(i);
+      if (p.contains("name")) {
+        if (!p["name"].is_string()) return Error(key + ".name", "must be a string");
+        d.name = p["name"].get<std::string>();
+      }
+      const std::string hand = p.contains("hand") && p["hand"].is_string() ? p["hand"].get<std::string>() : "";
+      if (hand == "left") d.holder = interaction::Holder::kLeftHand;
+      else if (hand == "right") d.holder = interaction::Holder::kRightHand;
+      else if (hand == "script") d.holder = interaction::Holder::kScript;
+      else return Error(key + ".hand", "must be \"left\", \"right\" or \"script\"");
+      if (!p.contains("shapes")) return Error(key + ".shapes", "missing: \"blade_on_handle\" or a list of box/capsule");
+      const json& shapes = p["shapes"];
+      if (shapes.is_string() && shapes.get<std::string>() == "blade_on_handle") {
+        d.shapes = interaction::BladeOnHandle();
+      } else if (shapes.is_array() && !shapes.empty()) {
+        for (size_t k = 0; k < shapes.size(); ++k) {
+          sim::ShapePrimitive prim;
+          if (Status st = Shape(shapes[k], key + ".shapes[" + std::to_string(k) + "]", &prim); !st) return st;
+          d.shapes.push_back(prim);
+        }
+      } else {
+        return Error(key + ".shapes", "must be \"blade_on_handle\" or a non-empty list of box/capsule");
+      }
+      if (p.contains("viscosity")) {
+        double v;
+        if (Status st = Number(p["viscosity"], key + ".viscosity", &v); !st) return st;
+        if (v < 0 || v > 10) return Error(key + ".viscosity", "must be from 0 to 10 (artificial viscosity alpha)");
+        d.viscosity = static_cast<float>(v);
+      }
+      if (p.contains("limits")) {
+        const json& l = p["limits"];
+        const std::string lk = key + ".limits";
+        if (!l.is_object()) return Error(lk, "must be an object");
+        CheckKeys(l, lk, {"max_speed", "max_angular_speed", "teleport_distance", "reentry_speed", "hold_time",
+                          "withdraw_speed", "withdraw_clearance"});
+        interaction::PaddleLimits& m = d.limits;
+        const std::pair<const char*, float*> positive[] = {{"max_speed", &m.maxSpeed},
+                                                           {"max_angular_speed", &m.maxAngularSpeed},
+                                                           {"teleport_distance", &m.teleportDistance},
+                                                           {"reentry_speed", &m.reentrySpeed},
+                                                           {"withdraw_speed", &m.withdrawSpeed}};
+        for (const auto& [name, member] : positive) {
+          if (Status st = Positive(l, lk, name, member); !st) return st;
+        }
+        for (const auto& [name, member] : {std::pair<const char*, float*>{"hold_time", &m.holdTime},
+                                           std::pair<const char*, float*>{"withdraw_clearance", &m.withdrawClearance}}) {
+          if (!l.contains(name)) continue;
+          double v;
+          if (Status st = Number(l[name], lk + "." + name, &v); !st) return st;
+          if (v < 0 || v > 1e6) return Error(lk + "." + name, "must be 0 or more");
+          *member = static_cast<float>(v);
+        }
+      }
+      if (p.contains("haptics")) {
+        const json& h = p["haptics"];
+        const std::string hk = key + ".haptics";
+        if (!h.is_object()) return Error(hk, "must be an object");
+        CheckKeys(h, hk, {"full_scale_force", "time_constant"});
+        if (Status st = Positive(h, hk, "full_scale_force", &d.haptics.fullScaleForce); !st) return st;
+        if (Status st = Positive(h, hk, "time_constant", &d.haptics.timeConstant); !st) return st;
+      }
+      if (d.holder == interaction::Holder::kScript) {
+        if (!p.contains("trajectory") || !p["trajectory"].is_string()) {
+          return Error(key + ".trajectory", "a scripted paddle needs a trajectory file (CSV of timed poses)");
+        }
+        // Relative to the scene file's folder.
+        std::filesystem::path file = p["trajectory"].get<std::string>();
+        if (file.is_relative()) file = std::filesystem::path(m_out->path).parent_path() / file;
+        if (Status st = interaction::Trajectory::Load(file.string(), &d.trajectory); !st) {
+          return Error(key + ".trajectory", st.message());
+        }
+        if (p.contains("loop")) {
+          if (!p["loop"].is_boolean()) return Error(key + ".loop", "must be true or false");
+          d.trajectory.SetLoop(p["loop"].get<bool>());
+        }
+      }
+      m_out->paddles.push_back(std::move(d));
+    }
+    return Status::Ok();
+  }
+
  private:
   SceneFile* m_out;
 };
@@ -229,15 +401,23 @@ Status LoadScene(const std::string& path, SceneFile* out) {
   return ParseScene(buffer.str(), path, out);
 }
 
+
 Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
   const size_t eq = assignment.find('=');
   if (eq == std::string::npos) return Status::Error("--set " + assignment + ": expected key=value");
   const std::string key = assignment.substr(0, eq);
   const std::string value = assignment.substr(eq + 1);
+  const ParamDesc* desc = FindParam(key);
+  if (desc && desc->group == "reuse") {  // reuse.* keys of the registry
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0') return Status::Error("--set " + key + "=" + value + ": not a finite number");
+    return SetParam(*desc, v, "--set " + key, setup);
+  }
   const sim::ParamInfo* info = sim::FindSolverParam(key);
   if (!info) {
     std::string names;
-    for (const sim::ParamInfo& p : sim::SolverParamInfos()) names += std::string(names.empty() ? "" : ", ") + p.key;
+    for (const ParamDesc& p : ParamRegistry()) names += (names.empty() ? "" : ", ") + (p.group == "solver" ? p.name : p.key);
     return Status::Error("--set " + key + ": unknown parameter (known: " + names + ")");
   }
   char* end = nullptr;

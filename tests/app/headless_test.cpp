@@ -94,7 +94,10 @@ TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
   const std::map<std::string, std::string> values = {
       {"--scene", "a.json"}, {"--time", "1"},         {"--steps", "5"},          {"--device", "cpu"},
       {"--threads", "1"},    {"--spacing", "0.01"},   {"--set", "cfl=0.3"},      {"--export-every", "2"},
-      {"--out", "d"},        {"--export-format", "ply"}, {"--stats", "f.csv"}, {"--reuse", "on"}};
+      {"--out", "d"},        {"--export-format", "ply"}, {"--stats", "f.csv"}, {"--reuse", "on"},
+      {"--export-surface-every", "3"}, {"--surface-format", "obj"},
+      {"--screenshot", "a.png"}, {"--frames", "d"}, {"--fps", "30"}, {"--image-size", "64x48"},
+      {"--window-size", "640x480"}, {"--frame-limit", "3"}, {"--render", "particles"}, {"--quality", "auto"}};
   const std::string usage = UsageText();
   std::set<std::string> flags;
   const std::regex flag("--[a-z][a-z-]*");
@@ -303,6 +306,73 @@ TEST(HeadlessTest, RunsASmallSceneWithStatsAndExports) {
       ++seen[id];
     }
     for (size_t id = 0; id < seen.size(); ++id) ASSERT_EQ(seen[id], 1) << path << ": id " << id;
+  }
+}
+
+TEST(HeadlessTest, ExportsTheSurfaceAsPlyAndObj) {
+  // The small scene with a surface section: a finer lattice than the spacing.
+  std::string text = kSmallScene;
+  text.insert(text.rfind('}'), R"(, "surface": { "cell_size": 0.005, "iso_level": 0.5 })");
+  test::TempDir dir("surface");
+  const std::string scene = dir.Write("scene.json", text);
+  for (const std::string format : {"ply", "obj"}) {
+    const std::string out = dir.File("surface_" + format);
+    const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 6 --export-surface-every 3 --surface-format " +
+                                   format + " --out " + Quote(out) + " --threads 1 --no-progress",
+                               dir);
+    ASSERT_TRUE(r.Exited()) << r.err;
+    ASSERT_EQ(r.Code(), 0) << "stdout:\n" << r.out << "\nstderr:\n" << r.err;
+    EXPECT_NE(r.out.find("surface         3 meshes"), std::string::npos) << r.out;
+    for (int step : {0, 3, 6}) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "surface_%06d.%s", step, format.c_str());
+      const std::string path = (std::filesystem::path(out) / name).string();
+      ASSERT_TRUE(std::filesystem::exists(path)) << path;
+      std::vector<float> positions, normals;
+      size_t faces = 0;
+      if (format == "ply") {
+        const Ply ply = ReadPly(path);
+        ASSERT_EQ(ply.properties, (std::vector<std::string>{"x", "y", "z", "nx", "ny", "nz"}));  // (the face list has 5 words)
+        for (const std::string& line : ply.header) {
+          const std::vector<std::string> w = Split(line, ' ');
+          if (w.size() == 3 && w[0] == "element" && w[1] == "face") faces = std::stoul(w[2]);
+        }
+        ASSERT_EQ(ply.body.size(), ply.vertices * 24 + faces * 13) << path;
+        ASSERT_EQ(ply.vertices, 3 * faces);
+        for (size_t v = 0; v < ply.vertices; ++v) {
+          float f[6];
+          std::memcpy(f, ply.body.data() + 24 * v, sizeof(f));
+          positions.insert(positions.end(), f, f + 3);
+          normals.insert(normals.end(), f + 3, f + 6);
+        }
+        for (size_t t = 0; t < faces; ++t) {  // the soup: face t is vertices 3t, 3t+1, 3t+2
+          const char* rec = ply.body.data() + 24 * ply.vertices + 13 * t;
+          uint32_t idx[3];
+          std::memcpy(idx, rec + 1, sizeof(idx));
+          ASSERT_EQ(rec[0], 3);
+          ASSERT_EQ(idx[0], 3 * t);
+          ASSERT_EQ(idx[2], 3 * t + 2);
+        }
+      } else {
+        for (const std::string& line : Lines(test::ReadFile(path))) {
+          const std::vector<std::string> w = Split(line, ' ');
+          if (w.size() == 4 && w[0] == "v") for (int c = 1; c < 4; ++c) positions.push_back(std::stof(w[c]));
+          if (w.size() == 4 && w[0] == "vn") for (int c = 1; c < 4; ++c) normals.push_back(std::stof(w[c]));
+          if (w.size() == 4 && w[0] == "f") ++faces;
+        }
+        ASSERT_EQ(positions.size(), 9 * faces);
+        ASSERT_EQ(normals.size(), positions.size());
+      }
+      // A closed blob of water around the 0.1 m cube: hundreds of triangles, inside the tank's reach,
+      // unit normals.
+      EXPECT_GT(faces, 500u) << path;
+      for (size_t v = 0; v < positions.size() / 3; ++v) {
+        const float* p = &positions[3 * v];
+        ASSERT_TRUE(p[0] > -0.05f && p[0] < 0.25f && p[1] > -0.05f && p[1] < 0.25f && p[2] > -0.05f && p[2] < 0.15f) << path;
+        const float* n = &normals[3 * v];
+        ASSERT_NEAR(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1.0f, 1e-3f) << path;
+      }
+    }
   }
 }
 

@@ -142,6 +142,33 @@ TEST(SceneFileTest, UnknownKeysAreWarnedByName) {
   EXPECT_EQ(scene.setup.params.stiffness, sim::SolverParams{}.stiffness);
 }
 
+TEST(SceneFileTest, SurfaceSectionParsesOnlyWhenPresent) {
+  EXPECT_FALSE(ParseOk(kMinimal).surface.has_value());
+  std::string text = kMinimal;
+  text.insert(text.rfind('}'), R"(, "surface": { "cell_size": 0.005, "iso_level": 0.4, "margin": 0.02 })");
+  const SceneFile scene = ParseOk(text);
+  ASSERT_TRUE(scene.surface.has_value());
+  EXPECT_FLOAT_EQ(scene.surface->cellSize, 0.005f);
+  EXPECT_FLOAT_EQ(scene.surface->isoLevel, 0.4f);
+  EXPECT_FLOAT_EQ(scene.surface->margin, 0.02f);
+  // Absent keys keep the defaults (cell = spacing, iso 0.5, margin = support radius).
+  text = kMinimal;
+  text.insert(text.rfind('}'), R"(, "surface": { "cell_size": 0.01, "smoothing": 2 })");
+  const SceneFile partial = ParseOk(text);
+  ASSERT_TRUE(partial.surface.has_value());
+  EXPECT_FLOAT_EQ(partial.surface->isoLevel, 0.5f);
+  EXPECT_LT(partial.surface->margin, 0.0f);
+  ASSERT_EQ(partial.warnings.size(), 1u);
+  EXPECT_NE(partial.warnings[0].find("surface.smoothing"), std::string::npos);
+  for (const char* bad : {R"("surface": { "cell_size": -1 })", R"("surface": { "iso_level": 0 })",
+                          R"("surface": { "iso_level": 12 })", R"("surface": { "margin": "big" })",
+                          R"("surface": [1, 2])"}) {
+    text = kMinimal;
+    text.insert(text.rfind('}'), std::string(", ") + bad);
+    ExpectRefused(text, {"surface"});
+  }
+}
+
 TEST(SceneFileTest, InvalidJsonRefused) {
   ExpectRefused("{ \"tank\": { \"min\": [0, 0, 0], ", {"not valid JSON"});
   ExpectRefused("", {"not valid JSON"});

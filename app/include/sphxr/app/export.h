@@ -6,10 +6,14 @@
 
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
+#include "sphxr/sim/surface.h"
 
 namespace sphxr::app {
 
 Status WritePly(const std::string& path, const sim::HostFluid& fluid);
 Status WriteVtk(const std::string& path, const sim::HostFluid& fluid);
+/// The surface mesh (a triangle soup, sim/surface.h): binary PLY with per-vertex normals, or OBJ.
+Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh);
+Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh);
 
 }  // namespace sphxr::app

@@ -23,11 +23,26 @@ struct Options {
   int64_t exportEvery = 0;  // steps between particle exports (0 = none)
   std::string outDir = "out";
   std::string exportFormat = "ply";  // ply | vtk
+  int64_t exportSurfaceEvery = 0;    // steps between surface exports (0 = none), into outDir
+  std::string surfaceFormat = "ply"; // ply | obj
   std::string statsPath;    // per-step CSV
   bool validate = false;
   int reuse = -1;           // -1 = as the scene says, 0 = off, 1 = on (the scene's or default parameters)
+  std::string reusePreset;  // --reuse accurate|balanced|fast: that preset (turns reuse on)
   std::vector<std::string> sets;  // solver parameter overrides "key=value"
   int progress = -1;        // -1 = when stderr is a terminal
+  // Pictures without a display (EGL): a PNG of the last state, and/or a PNG every 1/fps simulated s.
+  std::string screenshotPath;
+  std::string framesDir;
+  double fps = 30.0;
+  int imageWidth = 1280, imageHeight = 720;
+  bool particleImages = false;  // --render particles: coloured particles instead of water
+  // Desktop window.
+  int windowWidth = 1280, windowHeight = 720;
+  int frameLimit = 0;           // close the window after this many frames (0 = when the user closes it)
+  bool vsync = true;
+  bool glDebug = false;         // --gl-debug: GL debug callback on in a release build (any GL error aborts)
+  int quality = -1;             // --quality: -1 = auto in the desktop window, scene headless; 0 = scene; 1 = auto
   bool help = false;
 };
 
@@ -52,8 +67,17 @@ struct RunSummary {
   int64_t clampedEvents = 0;
   int64_t lost = 0;                  // particles missing at the end (always 0: clamped, never removed)
   int64_t exports = 0;
+  int64_t surfaceExports = 0;
+  int64_t surfaceTriangles = 0;      // of the last exported surface
+  double surfaceMs = 0.0;            // mean extraction time (field + pyramid + traversal + download)
   float surgeFront = -1.0f;          // dam-break probe: Z = front / a at the end (-1 when not probed)
   float columnHeight = -1.0f;        // dam-break probe: H = h / 2a at the end
+  int paddles = 0;                   // scene "paddles" section
+  int paddleParticles = 0;           // their boundary particles
+  int64_t pushedOut = 0;             // fluid particles pushed out of a paddle (particle-steps)
+  double paddleMeanForce = 0.0;      // N, mean over steps and paddles of the filtered |force|
+  float paddlePeakHaptic = 0.0f;     // largest haptic amplitude over the run
+  int64_t frames = 0;                // PNG frames written to --frames DIR
 };
 
 /// Runs a scene headless: load, apply overrides, simulate, export, summarise. The summary is printed

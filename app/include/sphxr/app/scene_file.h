@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "sphxr/common/status.h"
+#include "sphxr/interaction/paddle.h"
 #include "sphxr/sim/params.h"
+#include "sphxr/sim/surface.h"
 
 namespace sphxr::app {
 
@@ -34,6 +36,10 @@ struct SceneFile {
   double runTime = 0.0;       // s, default run length ("run.time")
   int64_t runSteps = 0;       // default step count ("run.steps"), used when runTime == 0
   std::optional<DamBreakProbe> damBreak;
+  /// "paddles" section (absent: none). Scripted paddles carry their loaded trajectory.
+  std::vector<interaction::PaddleDesc> paddles;
+  double paddleFrameRate = 90.0;  // Hz: display frames at which the paddles get new targets
+  std::optional<sim::SurfaceParams> surface;  // "surface" section (cell_size, iso_level, margin); absent: defaults
   std::vector<std::string> warnings;  // unknown keys, already logged
 };
 

@@ -1,0 +1,30 @@
+#pragma once
+// --quality auto: pick the particle spacing (and the surface cell size) so that a scene runs in real time
+// on the machine it finds. Measured, not guessed: a few steps of the scene are timed, and the spacing is
+// scaled by the cost model of WCSPH (particles ~ h^-3, stable dt ~ h, so simulated seconds per wall second
+// ~ h^4), then checked once more at the chosen spacing.
+#include <string>
+
+#include "sphxr/common/status.h"
+#include "sphxr/sim/solver.h"
+
+namespace sphxr::app {
+
+struct QualityChoice {
+  float spacing = 0.0f;          // m
+  float surfaceCellSize = 0.0f;  // m, for the surface mesh (HPMC) when it lands: one spacing
+  double realtime = 0.0;         // simulated s per wall s measured at the chosen spacing
+  int fluid = 0;                 // particles at the chosen spacing
+  std::string summary;           // the logged line
+};
+
+/// The spacing that reaches `target` simulated seconds per wall second, from a measured `realtime` at
+/// `spacing` (cost ~ h^-4), clamped to [minSpacing, maxSpacing].
+float SpacingForRealtime(float spacing, double realtime, double target, float minSpacing, float maxSpacing);
+
+/// Times the scene for about `budgetSeconds` of wall time (twice at most) and picks the spacing. The
+/// finest spacing tried is half the scene's, the coarsest four times it.
+Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& config, double target,
+                     double budgetSeconds, QualityChoice* out);
+
+}  // namespace sphxr::app

@@ -1,0 +1,520 @@
+#include "sphxr/app/desktop.h"
+
+// GL entry points from libepoxy; GLFW must not include its own GL header.
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <deque>
+#include <filesystem>
+#include <thread>
+#include <glm/gtc/matrix_transform.hpp>
+#include <vector>
+
+#include "sphxr/app/param_registry.h"
+#include "sim_worker.h"
+#include "sphxr/app/pictures.h"
+#include "sphxr/app/quality.h"
+#include "sphxr/app/scene_file.h"
+#include "sphxr/common/log.h"
+#include "sphxr/render/renderer.h"
+
+#ifndef SPHXR_SCENES_DIR
+#define SPHXR_SCENES_DIR "scenes"
+#endif
+
+namespace sphxr::app {
+namespace {
+
+std::string g_glfwError;  // the last GLFW error, for one-line messages
+void GlfwError(int code, const char* text) { g_glfwError = Format("%s (GLFW 0x%x)", text, code); }
+
+/// Orbit camera: yaw/pitch around a target, at a distance; pans move the target.
+struct OrbitCamera {
+  glm::vec3 target{0.0f};
+  float yaw = 0.35f, pitch = 0.35f, distance = 1.0f;
+  float fovY = 0.8f;
+  glm::vec3 Eye() const {
+    return target + distance * glm::vec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+  }
+  glm::mat4 View() const { return glm::lookAt(Eye(), target, glm::vec3(0, 1, 0)); }
+  glm::mat4 Projection(float aspect) const {
+    return glm::perspective(fovY, aspect, std::max(1e-3f, 0.01f * distance), 100.0f * distance);
+  }
+};
+
+constexpr int kHistory = 180;  // frames of timing history in the graphs
+
+}  // namespace
+
+struct DesktopApp::Impl {
+  Options options;
+  SceneFile scene;
+  sim::SceneSetup setup;  // what the panel edits (applied with a rebuild)
+  GLFWwindow* window = nullptr;
+  bool imguiReady = false;
+  std::unique_ptr<render::Renderer> renderer;
+  std::unique_ptr<SimWorker> worker;
+  OrbitCamera camera;
+  render::RenderMode mode = render::RenderMode::kWater;
+  render::ParticleColor color = render::ParticleColor::kSpeed;
+  DesktopHand hand;
+  glm::vec3 handPrevious{0.0f};
+  bool dragHand = false, dragOrbit = false, dragPan = false;
+  double cursorX = 0, cursorY = 0;
+  int frames = 0;
+  int panelVertices = 0;
+  int64_t simSteps = 0;
+  std::vector<std::string> sceneFiles;
+  int sceneIndex = -1;
+  std::deque<float> stageHistory[static_cast<int>(sim::Stage::kCount) + 1];  // + render
+  std::deque<float> fpsHistory;
+  double renderMs = 0.0;
+  std::chrono::steady_clock::time_point lastFrame = std::chrono::steady_clock::now();
+  float frameSeconds = 1.0f / 60.0f;
+
+  ~Impl() {
+    if (worker) worker->Stop();
+    worker.reset();
+    if (window) glfwMakeContextCurrent(window);
+    renderer.reset();
+    if (imguiReady) {
+      ImGui_ImplOpenGL3_Shutdown();
+      ImGui_ImplGlfw_Shutdown();
+      ImGui::DestroyContext();
+    }
+    if (window) glfwDestroyWindow(window);
+    glfwTerminate();
+  }
+
+  void FrameTank() {
+    const sim::Aabb& t = setup.tank;
+    const glm::vec3 lo(t.min.x, t.min.y, t.min.z), hi(t.max.x, t.max.y, t.max.z);
+    camera.target = 0.5f * (lo + hi);
+    camera.distance = 1.3f * 0.5f * glm::length(hi - lo) / std::sin(0.5f * camera.fovY);
+    camera.yaw = 0.35f;
+    camera.pitch = 0.35f;
+  }
+
+  /// World ray through a window pixel (GLFW coordinates: origin top-left, in screen units).
+  void Ray(double x, double y, glm::vec3* origin, glm::vec3* dir) const {
+    int w = 1, h = 1;
+    glfwGetWindowSize(window, &w, &h);
+    const float aspect = static_cast<float>(std::max(w, 1)) / static_cast<float>(std::max(h, 1));
+    const glm::mat4 inv = glm::inverse(camera.Projection(aspect) * camera.View());
+    const glm::vec2 ndc(2.0f * static_cast<float>(x) / std::max(w, 1) - 1.0f, 1.0f - 2.0f * static_cast<float>(y) / std::max(h, 1));
+    const glm::vec4 far = inv * glm::vec4(ndc, 1.0f, 1.0f);
+    *origin = camera.Eye();
+    *dir = glm::normalize(glm::vec3(far) / far.w - *origin);
+  }
+
+  /// The hand's target: the mouse ray meets the plane through the tank's centre that faces the camera,
+  /// clamped to the tank (a hand stays within reach of the water).
+  void UpdateHand(bool moved) {
+    if (!dragHand) {
+      hand.active = false;
+      hand.velocity = {0, 0, 0};
+      return;
+    }
+    glm::vec3 o, d;
+    Ray(cursorX, cursorY, &o, &d);
+    const glm::vec3 n = glm::normalize(camera.target - camera.Eye());
+    const float denom = glm::dot(d, n);
+    if (std::abs(denom) < 1e-6f) return;
+    const float t = glm::dot(camera.target - o, n) / denom;
+    glm::vec3 p = o + d * std::max(t, 0.0f);
+    const sim::Aabb& tank = setup.tank;
+    p = glm::clamp(p, glm::vec3(tank.min.x, tank.min.y, tank.min.z), glm::vec3(tank.max.x, tank.max.y, tank.max.z));
+    const glm::vec3 v = hand.active ? (p - handPrevious) / std::max(frameSeconds, 1e-4f) : glm::vec3(0.0f);
+    (void)moved;
+    hand.active = true;
+    hand.position = {p.x, p.y, p.z};
+    hand.velocity = {v.x, v.y, v.z};
+    handPrevious = p;
+  }
+
+  void Rebuild() {
+    worker->Reset(setup);
+  }
+
+  void LoadSceneFile(const std::string& path) {
+    SceneFile next;
+    if (Status s = LoadScene(path, &next); !s) {
+      SPHXR_LOG_WARN("%s", s.message().c_str());
+      return;
+    }
+    scene = next;
+    setup = scene.setup;
+    Rebuild();
+    FrameTank();
+  }
+
+  void Panel(const SimSnapshot& snap);
+};
+
+DesktopApp::DesktopApp() : m_impl(std::make_unique<Impl>()) {}
+DesktopApp::~DesktopApp() = default;
+
+bool DisplayAvailable() {
+  const char* x = std::getenv("DISPLAY");
+  const char* w = std::getenv("WAYLAND_DISPLAY");
+  return (x && *x) || (w && *w);
+}
+
+Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* out) {
+  out->reset();
+  if (!DisplayAvailable()) return Status::Error("no display (DISPLAY and WAYLAND_DISPLAY are not set)");
+  std::unique_ptr<DesktopApp> app(new DesktopApp());
+  Impl& m = *app->m_impl;
+  m.options = options;
+  if (Status s = LoadScene(options.scenePath, &m.scene); !s) return s;
+  for (const std::string& set : options.sets) {
+    if (Status s = SetSolverParam(&m.scene.setup, set); !s) return s;
+  }
+  if (options.spacing > 0.0f) m.scene.setup.params.spacing = options.spacing;
+  if (options.reuse >= 0) m.scene.setup.reuse.enabled = options.reuse == 1;
+  m.setup = m.scene.setup;
+
+  glfwSetErrorCallback(GlfwError);
+  g_glfwError.clear();
+  if (!glfwInit()) return Status::Error("cannot open a window: " + g_glfwError);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  render::RendererConfig config;
+  config.debug = config.debug || options.glDebug;
+  glfwWindowHint(GLFW_OPENGL_DEBUG_CONTEXT, config.debug ? GLFW_TRUE : GLFW_FALSE);
+  m.window = glfwCreateWindow(options.windowWidth, options.windowHeight, "sphxr", nullptr, nullptr);
+  if (!m.window) {
+    return Status::Error("cannot open an OpenGL 4.5 core window: " + g_glfwError + " (the renderer needs GL 4.5)");
+  }
+  glfwMakeContextCurrent(m.window);
+  glfwSwapInterval(options.vsync ? 1 : 0);
+  if (Status s = render::Renderer::Create(config, &m.renderer); !s) return s;
+  SPHXR_LOG_INFO("desktop window %dx%d, %s", options.windowWidth, options.windowHeight, render::GlDescription());
+
+  // Our callbacks first: ImGui's backend chains to them after taking what it needs.
+  glfwSetWindowUserPointer(m.window, app.get());
+  glfwSetMouseButtonCallback(m.window, [](GLFWwindow* w, int button, int action, int) {
+    auto* self = static_cast<DesktopApp*>(glfwGetWindowUserPointer(w));
+    if (action == GLFW_PRESS && ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
+    self->OnMouseButton(button, action == GLFW_PRESS);
+  });
+  glfwSetCursorPosCallback(m.window, [](GLFWwindow* w, double x, double y) {
+    static_cast<DesktopApp*>(glfwGetWindowUserPointer(w))->OnCursor(x, y);
+  });
+  glfwSetScrollCallback(m.window, [](GLFWwindow* w, double, double dy) {
+    if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
+    static_cast<DesktopApp*>(glfwGetWindowUserPointer(w))->OnScroll(dy);
+  });
+  glfwSetKeyCallback(m.window, [](GLFWwindow* w, int key, int, int action, int) {
+    if (action != GLFW_PRESS || (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard)) return;
+    static_cast<DesktopApp*>(glfwGetWindowUserPointer(w))->OnKey(key);
+  });
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(m.window, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+  m.imguiReady = true;
+
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(SPHXR_SCENES_DIR, ec)) {
+    if (entry.path().extension() == ".json") m.sceneFiles.push_back(entry.path().string());
+  }
+  std::sort(m.sceneFiles.begin(), m.sceneFiles.end());
+  for (size_t i = 0; i < m.sceneFiles.size(); ++i) {
+    if (std::filesystem::equivalent(m.sceneFiles[i], options.scenePath, ec)) m.sceneIndex = static_cast<int>(i);
+  }
+
+  sim::SolverConfig solverConfig;
+  solverConfig.device = options.device;
+  solverConfig.threads = options.threads;
+  if (options.threads == 0) {
+    // One core is left to the frame loop (and llvmpipe's rasteriser, on machines without a GPU).
+    solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
+    SPHXR_LOG_INFO("simulation on %d CPU threads, one core left for drawing (--threads to change)", solverConfig.threads);
+  }
+  if (options.quality != 0 && options.spacing <= 0.0f) {
+    QualityChoice choice;
+    if (Status s = ChooseQuality(m.setup, solverConfig, 1.0, 1.0, &choice); !s) {
+      return Status::Error(options.scenePath + ": " + s.message());
+    }
+    m.setup.params.spacing = choice.spacing;
+  }
+  m.worker = std::make_unique<SimWorker>(solverConfig);
+  if (Status s = m.worker->Start(m.setup); !s) return Status::Error(options.scenePath + ": " + s.message());
+  m.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
+  m.FrameTank();
+  *out = std::move(app);
+  return Status::Ok();
+}
+
+void DesktopApp::OnMouseButton(int button, bool down) {
+  Impl& m = *m_impl;
+  if (button == GLFW_MOUSE_BUTTON_LEFT) {
+    m.dragHand = down;
+    m.hand.active = false;
+    m.UpdateHand(false);
+  } else if (button == GLFW_MOUSE_BUTTON_RIGHT) {
+    m.dragOrbit = down;
+  } else if (button == GLFW_MOUSE_BUTTON_MIDDLE) {
+    m.dragPan = down;
+  }
+}
+
+void DesktopApp::OnCursor(double x, double y) {
+  Impl& m = *m_impl;
+  const double dx = x - m.cursorX, dy = y - m.cursorY;
+  m.cursorX = x;
+  m.cursorY = y;
+  if (m.dragOrbit) {
+    m.camera.yaw -= 0.006f * static_cast<float>(dx);
+    m.camera.pitch = std::clamp(m.camera.pitch + 0.006f * static_cast<float>(dy), -1.5f, 1.5f);
+  }
+  if (m.dragPan) {
+    const glm::mat4 view = m.camera.View();
+    const glm::vec3 right(view[0][0], view[1][0], view[2][0]), up(view[0][1], view[1][1], view[2][1]);
+    const float scale = 0.0015f * m.camera.distance;
+    m.camera.target += (-static_cast<float>(dx) * right + static_cast<float>(dy) * up) * scale;
+  }
+  if (m.dragHand) m.UpdateHand(true);
+}
+
+void DesktopApp::OnScroll(double dy) {
+  m_impl->camera.distance *= std::pow(0.9f, static_cast<float>(dy));
+  m_impl->camera.distance = std::clamp(m_impl->camera.distance, 1e-3f, 1e3f);
+}
+
+void DesktopApp::OnKey(int key) {
+  Impl& m = *m_impl;
+  switch (key) {
+    case GLFW_KEY_SPACE: m.worker->SetPaused(!m.worker->Paused()); break;
+    case GLFW_KEY_N:
+    case GLFW_KEY_PERIOD:
+      m.worker->SetPaused(true);
+      m.worker->StepOnce();
+      break;
+    case GLFW_KEY_R: m.Rebuild(); break;
+    case GLFW_KEY_M:
+      m.mode = m.mode == render::RenderMode::kWater ? render::RenderMode::kParticles : render::RenderMode::kWater;
+      break;
+    case GLFW_KEY_C: m.color = static_cast<render::ParticleColor>((static_cast<int>(m.color) + 1) % 3); break;
+    case GLFW_KEY_F: m.FrameTank(); break;
+    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(m.window, GLFW_TRUE); break;
+    default: break;
+  }
+}
+
+const DesktopHand& DesktopApp::Hand() const { return m_impl->hand; }
+bool DesktopApp::Paused() const { return m_impl->worker->Paused(); }
+int DesktopApp::FramesDrawn() const { return m_impl->frames; }
+int DesktopApp::PanelVertexCount() const { return m_impl->panelVertices; }
+int64_t DesktopApp::SimSteps() const { return m_impl->simSteps; }
+bool DesktopApp::ParticleMode() const { return m_impl->mode == render::RenderMode::kParticles; }
+
+void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(260, 80), ImVec2(700, std::max(100.0f, ImGui::GetIO().DisplaySize.y - 20)));
+  ImGui::Begin("sphxr");
+  // Scene
+  if (!sceneFiles.empty()) {
+    const std::string current = sceneIndex >= 0 ? std::filesystem::path(sceneFiles[sceneIndex]).stem().string() : "(other)";
+    if (ImGui::BeginCombo("scene", current.c_str())) {
+      for (size_t i = 0; i < sceneFiles.size(); ++i) {
+        if (ImGui::Selectable(std::filesystem::path(sceneFiles[i]).stem().string().c_str(), static_cast<int>(i) == sceneIndex)) {
+          sceneIndex = static_cast<int>(i);
+          LoadSceneFile(sceneFiles[i]);
+        }
+      }
+      ImGui::EndCombo();
+    }
+  }
+  if (ImGui::Button(worker->Paused() ? "run (space)" : "pause (space)")) worker->SetPaused(!worker->Paused());
+  ImGui::SameLine();
+  if (ImGui::Button("step (n)")) {
+    worker->SetPaused(true);
+    worker->StepOnce();
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("reset (r)")) Rebuild();
+  const std::string error = worker->LastError();
+  if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
+
+  ImGui::Text("%d fluid + %d boundary particles", snap.fluidCount, snap.boundaryCount);
+  ImGui::Text("t = %.3f s, step %lld, dt %.2e s", snap.last.time, static_cast<long long>(snap.steps), snap.last.dt);
+  ImGui::Text("simulation %.1f steps/s, %.3g simulated s per wall s", snap.stepsPerSecond, snap.simSecondsPerWallSecond);
+  ImGui::Text("display %.1f fps, render %.2f ms", ImGui::GetIO().Framerate, renderMs);
+
+  // Timing graph per stage
+  if (ImGui::CollapsingHeader("timing (ms per step / frame)", ImGuiTreeNodeFlags_DefaultOpen)) {
+    for (int s = 0; s <= static_cast<int>(sim::Stage::kCount); ++s) {
+      const std::deque<float>& h = stageHistory[s];
+      std::vector<float> values(h.begin(), h.end());
+      const char* name = s < static_cast<int>(sim::Stage::kCount) ? sim::StageName(static_cast<sim::Stage>(s)) : "render";
+      const float last = values.empty() ? 0.0f : values.back();
+      const float top = values.empty() ? 1.0f : std::max(1e-3f, *std::max_element(values.begin(), values.end()));
+      const std::string label = Format("%-9s %6.2f", name, last);
+      ImGui::PlotLines(label.c_str(), values.data(), static_cast<int>(values.size()), 0, nullptr, 0.0f, top, ImVec2(180, 22));
+    }
+    ImGui::TextDisabled("surface: no surface stage yet (HPMC); water is drawn from the particles");
+  }
+
+  // Parameters: the one registry (app/src/param_registry.h) that scene files and --set read too.
+  auto editor = [&](const ParamDesc& p) {
+    bool edited = false;
+    if (p.integer) {
+      int v = static_cast<int>(p.Get(setup));
+      ImGui::DragInt(p.name.c_str(), &v, 0.2f, static_cast<int>(p.min), static_cast<int>(p.max), "%d",
+                     ImGuiSliderFlags_AlwaysClamp);
+      if (ImGui::IsItemDeactivatedAfterEdit() || (ImGui::IsItemEdited() && !ImGui::IsItemActive())) edited = true;
+      if (ImGui::IsItemEdited()) p.Set(&setup, v);
+    } else {
+      float v = static_cast<float>(p.Get(setup));
+      const float lo = static_cast<float>(p.min), hi = static_cast<float>(p.max);
+      if (p.name == "spacing") {
+        // A spacing that would make millions of particles is refused by the solver with a message.
+        ImGui::SliderFloat("spacing (m)", &v, std::max(lo, 5e-4f), std::min(hi, 0.05f), "%.4f",
+                           ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+      } else {
+        ImGui::DragFloat(p.name.c_str(), &v, 0.005f * std::max(std::abs(v), 0.1f), lo, hi, "%.4g",
+                         ImGuiSliderFlags_AlwaysClamp);
+      }
+      if (ImGui::IsItemEdited()) p.Set(&setup, v);
+      edited = ImGui::IsItemDeactivatedAfterEdit();
+    }
+    if (ImGui::IsItemHovered()) {
+      ImGui::SetTooltip("%s\nrange %g to %g %s, default %g", p.help.c_str(), p.min, p.max, p.unit.c_str(), p.defaultValue);
+    }
+    return edited;
+  };
+  if (ImGui::CollapsingHeader("solver (edits rebuild the scene)")) {
+    for (const ParamDesc& p : ParamRegistry()) {
+      if (p.group == "solver" && editor(p)) Rebuild();
+    }
+  }
+  if (ImGui::CollapsingHeader("activity-based reuse", ImGuiTreeNodeFlags_DefaultOpen)) {
+    sim::ReuseParams& r = setup.reuse;
+    if (ImGui::Checkbox("reuse on", &r.enabled)) Rebuild();
+    ImGui::SameLine();
+    ImGui::Text("active fraction %.1f %%", 100.0 * snap.last.activeFraction);
+    for (const ParamDesc& p : ParamRegistry()) {
+      if (p.group == "reuse" && editor(p) && r.enabled) Rebuild();
+    }
+  }
+  // Rendering
+  if (ImGui::CollapsingHeader("render", ImGuiTreeNodeFlags_DefaultOpen)) {
+    int m = static_cast<int>(mode);
+    ImGui::RadioButton("water", &m, 0);
+    ImGui::SameLine();
+    ImGui::RadioButton("particles (m)", &m, 1);
+    mode = static_cast<render::RenderMode>(m);
+    int c = static_cast<int>(color);
+    ImGui::Combo("colour (c)", &c, "speed\0density error\0reuse activity\0");
+    color = static_cast<render::ParticleColor>(c);
+    static float cellSize = 1.0f;
+    ImGui::BeginDisabled();
+    ImGui::SliderFloat("surface cell (spacings)", &cellSize, 0.5f, 2.0f);
+    ImGui::EndDisabled();
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("arrives with the HPMC surface");
+  }
+  ImGui::TextDisabled("left drag: hand  right drag: orbit  middle drag: pan  wheel: zoom  f: frame");
+  if (hand.active) {
+    ImGui::Text("hand target [%.3f %.3f %.3f] m, speed %.2f m/s", hand.position[0], hand.position[1], hand.position[2],
+                std::sqrt(hand.velocity[0] * hand.velocity[0] + hand.velocity[1] * hand.velocity[1] +
+                          hand.velocity[2] * hand.velocity[2]));
+  }
+  ImGui::End();
+}
+
+bool DesktopApp::Frame(render::Image* capture) {
+  Impl& m = *m_impl;
+  if (glfwWindowShouldClose(m.window)) return false;
+  glfwPollEvents();
+  const auto now = std::chrono::steady_clock::now();
+  m.frameSeconds = std::chrono::duration<float>(now - m.lastFrame).count();
+  m.lastFrame = now;
+
+  // The newest snapshot: drawn again with the newest camera when the simulation has not published.
+  const std::shared_ptr<const SimSnapshot> snap = m.worker->Latest();
+  m.simSteps = snap->steps;
+  auto push = [](std::deque<float>& h, float v) {
+    h.push_back(v);
+    while (h.size() > kHistory) h.pop_front();
+  };
+  for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) push(m.stageHistory[s], static_cast<float>(snap->stageMs[s]));
+  push(m.stageHistory[static_cast<int>(sim::Stage::kCount)], static_cast<float>(m.renderMs));
+
+  int fbw = 0, fbh = 0;
+  glfwGetFramebufferSize(m.window, &fbw, &fbh);
+  render::FrameScene frame = MakeFrameScene(snap->setup, snap->fluid, m.mode, m.color);
+  if (m.hand.active) {
+    const float size = 0.08f * std::max({snap->setup.tank.max.x - snap->setup.tank.min.x,
+                                         snap->setup.tank.max.y - snap->setup.tank.min.y,
+                                         snap->setup.tank.max.z - snap->setup.tank.min.z});
+    render::SolidMesh handMesh;
+    handMesh.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(m.hand.position[0], m.hand.position[1],
+                                                                          m.hand.position[2])),
+                                glm::vec3(size));
+    handMesh.color = glm::vec3(0.95f, 0.55f, 0.15f);
+    frame.solids.push_back(handMesh);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  if (fbw > 0 && fbh > 0) {
+    render::View view;
+    view.view = m.camera.View();
+    view.projection = m.camera.Projection(static_cast<float>(fbw) / static_cast<float>(fbh));
+    view.framebuffer = 0;
+    view.width = fbw;
+    view.height = fbh;
+    m.renderer->Draw(frame, std::span(&view, 1));
+  }
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  m.Panel(*snap);
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  m.panelVertices = ImGui::GetDrawData() ? ImGui::GetDrawData()->TotalVtxCount : 0;
+  if (capture && fbw > 0 && fbh > 0) *capture = render::ReadPixels(0, 0, 0, fbw, fbh);
+  m.renderMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  glfwSwapBuffers(m.window);
+  ++m.frames;
+  return true;
+}
+
+void DesktopApp::Run() {
+  const int limit = m_impl->options.frameLimit;
+  const std::string& shot = m_impl->options.screenshotPath;
+  render::Image last;
+  // With --screenshot, every frame is read back so the one before closing can be written (slower).
+  while (Frame(shot.empty() ? nullptr : &last)) {
+    if (limit > 0 && m_impl->frames >= limit) break;
+  }
+  if (!shot.empty() && last.width > 0) {
+    if (Status s = WritePng(shot, last); !s) {
+      SPHXR_LOG_WARN("%s", s.message().c_str());
+    } else {
+      SPHXR_LOG_INFO("window picture: %s (%dx%d)", shot.c_str(), last.width, last.height);
+    }
+  }
+}
+
+Status RunDesktop(const Options& options) {
+  std::unique_ptr<DesktopApp> app;
+  if (Status s = DesktopApp::Create(options, &app); !s) return s;
+  app->Run();
+  return Status::Ok();
+}
+
+}  // namespace sphxr::app

@@ -1,0 +1,104 @@
+#include "sphxr/app/param_registry.h"
+
+#include <cmath>
+#include <vector>
+
+#include "sphxr/common/log.h"
+
+namespace sphxr::app {
+namespace {
+
+std::vector<ParamDesc> Build() {
+  std::vector<ParamDesc> out;
+  const sim::SolverParams solverDefaults;
+  for (const sim::ParamInfo& info : sim::SolverParamInfos()) {
+    ParamDesc p;
+    p.name = info.key;
+    p.key = "solver." + p.name;
+    p.group = "solver";
+    p.unit = info.unit;
+    p.help = info.help;
+    p.min = info.min;
+    p.max = info.max;
+    p.defaultValue = solverDefaults.*(info.member);
+    p.solverMember = info.member;
+    out.push_back(p);
+  }
+  const sim::ReuseParams reuseDefaults;
+  auto reuseFloat = [&](const char* name, const char* unit, const char* help, float sim::ReuseParams::*m) {
+    ParamDesc p;
+    p.name = name;
+    p.key = std::string("reuse.") + name;
+    p.group = "reuse";
+    p.unit = unit;
+    p.help = help;
+    p.min = 0.0;
+    p.max = 1e9;
+    p.defaultValue = reuseDefaults.*m;
+    p.reuseFloat = m;
+    out.push_back(p);
+  };
+  reuseFloat("delta1", "", "weight of the pressure term delta1 P_i / P_pc in ACT_i (Huang et al. 2013, 3.3)",
+             &sim::ReuseParams::delta1);
+  reuseFloat("delta2", "", "weight of the crowding term delta2 N_CPN / N_i in ACT_i", &sim::ReuseParams::delta2);
+  reuseFloat("threshold", "", "ACT_i below this makes a particle inactive (it reuses its values)",
+             &sim::ReuseParams::threshold);
+  reuseFloat("pressure_scale", "Pa", "P_pc; 0 = the Tait pressure at 1 % compression", &sim::ReuseParams::pressureScale);
+  reuseFloat("cell_count", "", "N_CPN; 0 = the rest lattice's particles per cell", &sim::ReuseParams::cellCount);
+  reuseFloat("accel_tolerance", "g",
+             "a particle whose acceleration changed by more than this many |g| since its last computation stays "
+             "active for IDLE + 1 steps (0 = off; docs/reuse.md)",
+             &sim::ReuseParams::accelTolerance);
+  ParamDesc idle;
+  idle.name = "idle";
+  idle.key = "reuse.idle";
+  idle.group = "reuse";
+  idle.unit = "steps";
+  idle.help = "IDLE: consecutive steps an inactive particle reuses its density, pressure and acceleration";
+  idle.min = 0;
+  idle.max = 1000;
+  idle.defaultValue = reuseDefaults.idle;
+  idle.integer = true;
+  idle.reuseInt = &sim::ReuseParams::idle;
+  out.push_back(idle);
+  return out;
+}
+
+}  // namespace
+
+double ParamDesc::Get(const sim::SceneSetup& s) const {
+  if (solverMember) return s.params.*solverMember;
+  if (reuseFloat) return s.reuse.*reuseFloat;
+  return s.reuse.*reuseInt;
+}
+
+void ParamDesc::Set(sim::SceneSetup* s, double v) const {
+  if (solverMember) s->params.*solverMember = static_cast<float>(v);
+  if (reuseFloat) s->reuse.*reuseFloat = static_cast<float>(v);
+  if (reuseInt) s->reuse.*reuseInt = static_cast<int>(std::lround(v));
+}
+
+std::span<const ParamDesc> ParamRegistry() {
+  static const std::vector<ParamDesc> registry = Build();
+  return registry;
+}
+
+const ParamDesc* FindParam(const std::string& key) {
+  for (const ParamDesc& p : ParamRegistry()) {
+    if (p.key == key || (p.group == "solver" && p.name == key)) return &p;
+  }
+  return nullptr;
+}
+
+Status SetParam(const ParamDesc& p, double value, const std::string& where, sim::SceneSetup* s) {
+  if (!std::isfinite(value)) return Status::Error(where + ": must be finite");
+  if (p.integer && value != std::floor(value)) return Status::Error(where + ": must be an integer (" + p.unit + ")");
+  if (value < p.min || value > p.max) {
+    return Status::Error(Format("%s: %g is out of range: must be from %g to %g%s%s (%s)", where.c_str(), value, p.min,
+                                p.max, p.unit.empty() ? "" : " ", p.unit.c_str(), p.help.c_str()));
+  }
+  p.Set(s, value);
+  return Status::Ok();
+}
+
+}  // namespace sphxr::app

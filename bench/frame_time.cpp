@@ -1,0 +1,109 @@
+// Frame time by stage for the window's workload: one simulation step, the (future) surface, and the
+// render of one 1280x720 view, on dam_break and a 20k-particle tank. The render goes through the same
+// renderer as the window, into an EGL offscreen target (Mesa llvmpipe here), timed to glFinish.
+// Reports; never asserts. Usage: sphxr_bench_frame [--steps N] [--frames M] [--threads T]
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_util.h"
+#include "sphxr/app/pictures.h"
+#include "sphxr/app/scene_file.h"
+#include "sphxr/render/gl_context.h"
+#include "sphxr/render/renderer.h"
+#include "sphxr/sim/solver.h"
+
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double Ms(std::chrono::steady_clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace sphxr;
+  int steps = 30, frames = 10, threads = 0;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--frames")) frames = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--threads")) threads = std::atoi(argv[i + 1]);
+  }
+  const int width = 1280, height = 720;
+  std::unique_ptr<render::HeadlessContext> context;
+  std::unique_ptr<render::OffscreenTarget> target;
+  std::unique_ptr<render::Renderer> renderer;
+  render::RendererConfig config;
+  config.debug = false;
+  if (Status s = render::HeadlessContext::Create(false, &context); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+  if (Status s = render::OffscreenTarget::Create(width, height, &target); !s) return 1;
+  if (Status s = render::Renderer::Create(config, &renderer); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+  std::printf("machine: %s, %d cores, load %.2f; GL %s; %d steps, %d frames per row, %dx%d\n\n",
+              bench::CpuModel().c_str(), bench::CpuCount(), bench::LoadAverage(), render::GlDescription(), steps,
+              frames, width, height);
+  std::printf("| scene | fluid particles | sim ms/step (median) | surface ms | render ms, water (median) | render ms, particles (median) |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|\n");
+
+  struct Case {
+    std::string name, file;
+    float spacing;  // 0 = the scene's
+  };
+  const Case cases[] = {{"dam_break", SPHXR_SCENES_DIR "/dam_break.json", 0.0f},
+                        {"tank_rest at 5.8 mm (20k)", SPHXR_SCENES_DIR "/tank_rest.json", 0.0058f}};
+  for (const Case& c : cases) {
+    app::SceneFile scene;
+    if (Status s = app::LoadScene(c.file, &scene); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+    if (c.spacing > 0.0f) scene.setup.params.spacing = c.spacing;
+    sim::SolverConfig sc;
+    sc.device = sim::Device::kCpu;
+    sc.threads = threads;
+    std::unique_ptr<sim::Solver> solver;
+    if (Status s = sim::Solver::Create(scene.setup, sc, &solver); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+    (void)solver->Step();  // first touch
+    std::vector<double> stepMs;
+    for (int i = 0; i < steps; ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      (void)solver->Step();
+      stepMs.push_back(Ms(std::chrono::steady_clock::now() - t0));
+    }
+    sim::HostFluid fluid;
+    solver->Download(&fluid);
+    const float aspect = static_cast<float>(width) / height;
+    double renderMs[2];
+    for (int mode = 0; mode < 2; ++mode) {
+      const render::FrameScene frame = app::MakeFrameScene(
+          scene.setup, fluid, mode == 0 ? render::RenderMode::kWater : render::RenderMode::kParticles);
+      const render::Camera camera = render::FrameBox(frame.tank, aspect);
+      render::View view;
+      view.view = camera.View();
+      view.projection = camera.Projection(aspect);
+      view.framebuffer = target->Framebuffer();
+      view.width = width;
+      view.height = height;
+      renderer->Draw(frame, std::span(&view, 1));  // warm-up (shader variants, buffer growth)
+      glFinish();
+      std::vector<double> ms;
+      for (int f = 0; f < frames; ++f) {
+        const auto t0 = std::chrono::steady_clock::now();
+        renderer->Draw(frame, std::span(&view, 1));
+        glFinish();
+        ms.push_back(Ms(std::chrono::steady_clock::now() - t0));
+      }
+      renderMs[mode] = Median(ms);
+    }
+    std::printf("| %s | %d | %.2f | - (no surface yet) | %.1f | %.1f |\n", c.name.c_str(), solver->FluidCount(),
+                Median(stepMs), renderMs[0], renderMs[1]);
+  }
+  return 0;
+}

@@ -1,0 +1,158 @@
+#pragma once
+// The renderer: draws one FrameScene for any list of views (OpenGL 4.5 core). A view is a pair of
+// matrices, a target framebuffer and a viewport; the renderer does not know whether views come from a
+// headset (one per eye) or a desktop camera (DESIGN.md, "Shape" and "One frame").
+//
+// Per frame:  Draw(scene, views)
+//   1 upload     surface mesh, particles (once per frame, shared by all views)
+//   per view:
+//   2 sky        full-screen triangle, gradient + sun (the same function the water reflects)
+//   3 floor      checkered plane under the tank; obstacles, paddles (lit boxes/meshes); tank edges
+//   4 thickness  water thickness along each pixel's ray into an R16F texture (additive pass)
+//   5 water      surface mesh (or particles as spheres when there is no mesh): Fresnel-weighted sky
+//                reflection, Beer-Lambert transmission over the thickness, specular highlight
+//      or particles   point sprites coloured by speed, density error or reuse activity
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "sphxr/common/status.h"
+#include "sphxr/sim/params.h"
+#include "sphxr/sim/vec.h"
+
+namespace sphxr::render {
+
+/// One view: what the renderer draws into. `framebuffer` 0 is the default framebuffer.
+struct View {
+  glm::mat4 view{1.0f};        // world -> eye
+  glm::mat4 projection{1.0f};  // eye -> clip (OpenGL conventions, depth -1..1)
+  uint32_t framebuffer = 0;
+  int x = 0, y = 0, width = 0, height = 0;  // viewport in pixels, origin bottom-left
+};
+
+/// A triangle mesh as plain arrays on the host (the CPU backend's HPMC output); xyz floats.
+/// `indices` may be null: then every three vertices make a triangle.
+struct MeshView {
+  const float* positions = nullptr;  // 3 floats per vertex
+  const float* normals = nullptr;    // 3 floats per vertex, pointing out of the water
+  int vertexCount = 0;
+  const uint32_t* indices = nullptr;
+  int indexCount = 0;
+  bool Empty() const { return positions == nullptr || vertexCount <= 0; }
+};
+
+/// What colours the particles in particle mode.
+enum class ParticleColor { kSpeed, kDensityError, kActivity };
+const char* ParticleColorName(ParticleColor c);
+
+/// Fluid particles as plain host arrays (e.g. a sim::HostFluid). `velocity`, `density` and `idle` may be
+/// null when the colour mode does not need them.
+struct ParticleView {
+  const sim::Vec4* position = nullptr;
+  const sim::Vec4* velocity = nullptr;
+  const float* density = nullptr;
+  const int32_t* idle = nullptr;  // reuse idle count: -1 active, >= 0 reusing
+  int count = 0;
+  float radius = 0.01f;           // m, drawn sphere radius (about half the spacing)
+  float restDensity = 1000.0f;
+  float speedScale = 2.0f;        // m/s mapped to the top of the colour map
+  float densityErrorScale = 0.05f;// |rho/rho0 - 1| mapped to the top of the colour map
+};
+
+enum class RenderMode { kWater, kParticles };
+const char* RenderModeName(RenderMode m);
+
+/// A paddle or hand: a mesh drawn with a model matrix (or a unit cube when the mesh is empty).
+struct SolidMesh {
+  MeshView mesh;            // empty: a unit cube centred at the origin
+  glm::mat4 model{1.0f};
+  glm::vec3 color{0.8f, 0.5f, 0.2f};
+};
+
+/// Everything one frame shows. Plain data: the caller owns the arrays until Draw() returns.
+class InteropMesh;
+
+struct FrameScene {
+  MeshView surface;             // water surface; empty: water mode draws the particles as water
+  const InteropMesh* deviceSurface = nullptr;  // water surface already in GL buffers (CUDA-GL interop);
+                                               // when set and not empty it is drawn instead of `surface` spheres
+  ParticleView particles;
+  RenderMode mode = RenderMode::kWater;
+  ParticleColor particleColor = ParticleColor::kSpeed;
+  sim::Aabb tank{{0, 0, 0}, {1, 1, 1}};
+  bool drawTank = true;
+  std::vector<sim::Aabb> obstacles;
+  std::vector<SolidMesh> solids;  // paddles, hands
+  bool drawFloor = true;
+  /// Multiplies RendererConfig::waterAbsorption. Water a few centimetres deep is nearly clear; small
+  /// tabletop scenes raise this so that their water still reads as a body of water (MakeFrameScene).
+  float absorptionScale = 1.0f;
+};
+
+/// Called for every GL debug message of type error (and for GL errors found by glGetError).
+using GlErrorHandler = std::function<void(const std::string& message)>;
+
+struct RendererConfig {
+  /// Install the GL debug callback. On by default in debug builds; the tests turn it on always.
+  bool debug =
+#ifdef NDEBUG
+      false;
+#else
+      true;
+#endif
+  /// What happens on a GL error: null = log it and abort() (debug builds fail loudly).
+  GlErrorHandler onError;
+  glm::vec3 sunDirection = glm::normalize(glm::vec3(0.35f, 0.8f, 0.45f));  // towards the sun
+  glm::vec3 waterAbsorption{4.0f, 1.2f, 0.8f};  // 1/m, Beer-Lambert coefficients (red goes first)
+  glm::vec3 waterColor{0.05f, 0.32f, 0.45f};    // colour the absorbed light scatters back (inscatter)
+};
+
+/// Draw timings of the last frame (CPU side, with a glFinish at the end only when asked).
+struct DrawStats {
+  double uploadMs = 0.0;
+  double drawMs = 0.0;
+};
+
+class Renderer {
+ public:
+  /// Needs a current OpenGL 4.5 core context. Fails with one clear line when the context is older.
+  static Status Create(const RendererConfig& config, std::unique_ptr<Renderer>* out);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  /// Uploads the scene once, then draws it into every view.
+  void Draw(const FrameScene& scene, std::span<const View> views);
+  const DrawStats& LastStats() const { return m_stats; }
+  /// GL errors seen by the debug callback since creation.
+  int ErrorCount() const;
+  const RendererConfig& Config() const { return m_config; }
+
+ private:
+  struct Impl;
+  explicit Renderer(const RendererConfig& config);
+  RendererConfig m_config;
+  std::unique_ptr<Impl> m_impl;
+  DrawStats m_stats;
+};
+
+/// The sky seen along a world direction: the same formula as the sky shader and the water's
+/// reflection (C++ twin, used by the tests and by the clear colour). Linear RGB in [0, 1].
+glm::vec3 SkyColor(glm::vec3 direction, glm::vec3 sunDirection);
+
+/// A camera that frames an axis-aligned box from the front-right, above (headless pictures, tests).
+struct Camera {
+  glm::vec3 eye, target, up{0, 1, 0};
+  float fovYRadians = 0.8f;
+  float nearPlane = 0.01f, farPlane = 100.0f;
+  glm::mat4 View() const;
+  glm::mat4 Projection(float aspect) const;
+};
+Camera FrameBox(const sim::Aabb& box, float aspect);
+
+}  // namespace sphxr::render
