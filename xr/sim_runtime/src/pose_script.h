@@ -1,0 +1,51 @@
+#pragma once
+// Scripted devices of the simulated headset: the head and two controllers, as timed key frames read
+// from a text file, or the default motion (head looking at the tank, right controller stirring).
+//
+// File format, one key frame per line ('#' starts a comment):
+//   <time_s> <head|left|right> <px> <py> <pz> <qx> <qy> <qz> <qw> [trigger=F] [squeeze=F] [menu=0|1]
+//                                                                  [a=0|1] [b=0|1] [tracked=0|1]
+// Poses are in the STAGE space (metres, +y up, -z forward). Between key frames of one device the
+// position is interpolated linearly, the orientation by slerp; buttons and values hold the earlier
+// key frame's value. Before the first / after the last key frame the device holds that frame. A
+// device with no key frame keeps its default motion. `loop <seconds>` on its own line repeats the
+// script with that period.
+#include <string>
+#include <vector>
+
+#include "sphxr/xr/math.h"
+
+namespace sphxr::xr::simrt {
+
+enum class Device { kHead = 0, kLeft = 1, kRight = 2 };
+constexpr int kDeviceCount = 3;
+
+struct DeviceSample {
+  Pose pose;
+  float trigger = 0, squeeze = 0;
+  bool menu = false, a = false, b = false;
+  bool tracked = true;
+};
+
+class PoseScript {
+ public:
+  /// The default motion: head at (0, 1.6, 0.5) looking 30 degrees down at a tank centred near
+  /// (0, 1.0, -0.4); left controller held still; right controller circling (radius 0.1 m, 0.5 Hz)
+  /// at (0.1, 1.0, -0.4) with its grip pointing down, trigger at 0.8.
+  static PoseScript Default();
+  /// Parses a script file; on error returns false with a one-line message naming the line.
+  static bool Load(const std::string& path, PoseScript* out, std::string* error);
+  static bool Parse(const std::string& text, PoseScript* out, std::string* error);
+
+  DeviceSample Sample(Device device, double seconds) const;
+
+ private:
+  struct Key {
+    double time;
+    DeviceSample sample;
+  };
+  std::vector<Key> m_keys[kDeviceCount];
+  double m_loopSeconds = 0;
+};
+
+}  // namespace sphxr::xr::simrt

@@ -1,0 +1,202 @@
+#pragma once
+// The simulated headset: an OpenXR 1.0 runtime of our own, loaded by the Khronos loader through
+// its manifest (XR_RUNTIME_JSON). Private to the runtime library; see docs/xr.md for its settings.
+//
+// One mutex guards everything: the runtime serves one application with one session, and nothing in
+// it is hot. Handles are pointers to the objects below, each starting with a tag checked on entry.
+#define XR_USE_PLATFORM_XLIB
+#define XR_USE_GRAPHICS_API_OPENGL
+#include <GL/gl.h>
+#include <GL/glx.h>
+#include <X11/Xlib.h>
+#include <openxr/openxr.h>
+#include <openxr/openxr_platform.h>
+
+#include <cstdio>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "pose_script.h"
+
+namespace sphxr::xr::simrt {
+
+/// Settings, read from the environment at xrCreateInstance (docs/xr.md lists them).
+struct Config {
+  double rateHz = 90.0;
+  int eyeWidth = 1024, eyeHeight = 1024;
+  float ipdMetres = 0.064f;
+  std::string profile = "/interaction_profiles/khr/simple_controller";
+  std::string poseScriptPath;
+  std::string captureDir;
+  int captureEvery = 1;
+  std::string hapticsLogPath;
+  long exitAfterFrames = -1;          // runtime-initiated exit (STOPPING) after this many frames
+  long loseSessionAfterFrames = -1;   // LOSS_PENDING after this many frames
+  long loseInstanceAfterFrames = -1;  // instance loss after this many frames
+  bool failSessionCreate = false;     // xrCreateSession answers XR_ERROR_RUNTIME_FAILURE
+};
+
+enum class Tag : uint32_t { kInstance = 0x51a1, kSession, kSpace, kActionSet, kAction, kSwapchain, kDead };
+
+struct Session;
+struct ActionSet;
+
+struct Action {
+  Tag tag = Tag::kAction;
+  ActionSet* set = nullptr;
+  std::string name;
+  XrActionType type{};
+  std::vector<XrPath> subactions;
+};
+
+struct ActionSet {
+  Tag tag = Tag::kActionSet;
+  struct Instance* instance = nullptr;
+  std::string name;
+  bool attached = false;
+  std::vector<std::unique_ptr<Action>> actions;
+};
+
+struct Instance {
+  Tag tag = Tag::kInstance;
+  Config config;
+  PoseScript script;
+  std::vector<std::string> paths;  // XrPath n is paths[n - 1]
+  std::unordered_map<std::string, XrPath> pathIds;
+  std::deque<XrEventDataBuffer> events;
+  std::vector<std::unique_ptr<ActionSet>> actionSets;
+  // Suggested bindings: profile path -> (action, binding path).
+  std::map<XrPath, std::vector<std::pair<Action*, XrPath>>> suggested;
+  bool graphicsRequirementsQueried = false;
+  bool systemQueried = false;
+  bool lost = false;
+  Session* session = nullptr;
+  FILE* hapticsLog = nullptr;
+};
+
+struct Space {
+  Tag tag = Tag::kSpace;
+  Session* session = nullptr;
+  bool isAction = false;
+  XrReferenceSpaceType referenceType{};
+  Action* action = nullptr;
+  XrPath subaction = XR_NULL_PATH;
+  Pose offset;
+};
+
+struct Swapchain {
+  Tag tag = Tag::kSwapchain;
+  Session* session = nullptr;
+  int64_t format = 0;
+  uint32_t width = 0, height = 0;
+  std::vector<GLuint> textures;
+  uint32_t nextIndex = 0;
+  std::deque<uint32_t> acquired;  // acquired, not yet released, in order
+  bool waited = false;
+  int lastReleased = -1;
+};
+
+/// Per (action, subaction) state as of the last xrSyncActions.
+struct ActionStateCache {
+  float value = 0, previous = 0;
+  bool active = false;
+  XrTime changeTime = 0;
+};
+
+struct Session {
+  Tag tag = Tag::kSession;
+  Instance* instance = nullptr;
+  XrGraphicsBindingOpenGLXlibKHR binding{};
+  XrSessionState state = XR_SESSION_STATE_UNKNOWN;
+  bool running = false;
+  bool exitRequested = false;
+  bool lost = false;
+  XrTime periodNs = 0;
+  XrTime lastDisplayTime = 0;   // predicted display time handed out by the last xrWaitFrame
+  XrTime beginTime = 0;         // xrBeginSession: time zero of the pose script
+  bool frameWaited = false, frameBegun = false;
+  long framesEnded = 0;
+  XrPath currentProfile = XR_NULL_PATH;
+  std::vector<ActionSet*> activeSets;  // of the last xrSyncActions
+  std::map<std::pair<Action*, XrPath>, ActionStateCache> actionStates;
+  std::vector<std::unique_ptr<Space>> spaces;
+  std::vector<std::unique_ptr<Swapchain>> swapchains;
+};
+
+// Shared between the runtime's source files.
+std::mutex& Lock();
+XrTime Now();
+void PushSessionState(Session* s, XrSessionState state);
+XrPath InternPath(Instance* inst, const std::string& path);
+const std::string* PathString(const Instance* inst, XrPath path);
+/// Seconds of the pose script at `time`.
+double ScriptSeconds(const Session* s, XrTime time);
+/// The world (STAGE) pose of an action's device at `time`; false if the action has no pose binding
+/// for `subaction` in the current profile or is not active.
+bool ActionPose(Session* s, Action* action, XrPath subaction, XrTime time, Pose* out);
+void RecordHaptic(Session* s, Action* action, XrPath subaction, float amplitude, XrDuration duration,
+                  float frequency, bool stop);
+/// Saves the submitted projection views as PNGs when capture is on (called by xrEndFrame).
+void CaptureFrame(Session* s, const XrCompositionLayerProjection& layer);
+
+inline XrPosef ToXr(const Pose& p) {
+  return {{p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w},
+          {p.position.x, p.position.y, p.position.z}};
+}
+inline Pose FromXr(const XrPosef& p) {
+  return {{p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w},
+          {p.position.x, p.position.y, p.position.z}};
+}
+
+template <class T>
+T* Check(void* handle, Tag tag) {
+  auto* t = static_cast<T*>(handle);
+  return (t && t->tag == tag) ? t : nullptr;
+}
+
+// Entry points implemented outside runtime.cpp.
+XrResult StringToPath(XrInstance, const char*, XrPath*);
+XrResult PathToString(XrInstance, XrPath, uint32_t, uint32_t*, char*);
+XrResult CreateActionSet(XrInstance, const XrActionSetCreateInfo*, XrActionSet*);
+XrResult DestroyActionSet(XrActionSet);
+XrResult CreateAction(XrActionSet, const XrActionCreateInfo*, XrAction*);
+XrResult DestroyAction(XrAction);
+XrResult SuggestInteractionProfileBindings(XrInstance, const XrInteractionProfileSuggestedBinding*);
+XrResult AttachSessionActionSets(XrSession, const XrSessionActionSetsAttachInfo*);
+XrResult GetCurrentInteractionProfile(XrSession, XrPath, XrInteractionProfileState*);
+XrResult GetActionStateBoolean(XrSession, const XrActionStateGetInfo*, XrActionStateBoolean*);
+XrResult GetActionStateFloat(XrSession, const XrActionStateGetInfo*, XrActionStateFloat*);
+XrResult GetActionStateVector2f(XrSession, const XrActionStateGetInfo*, XrActionStateVector2f*);
+XrResult GetActionStatePose(XrSession, const XrActionStateGetInfo*, XrActionStatePose*);
+XrResult SyncActions(XrSession, const XrActionsSyncInfo*);
+XrResult EnumerateBoundSourcesForAction(XrSession, const XrBoundSourcesForActionEnumerateInfo*, uint32_t,
+                                        uint32_t*, XrPath*);
+XrResult GetInputSourceLocalizedName(XrSession, const XrInputSourceLocalizedNameGetInfo*, uint32_t, uint32_t*,
+                                     char*);
+XrResult ApplyHapticFeedback(XrSession, const XrHapticActionInfo*, const XrHapticBaseHeader*);
+XrResult StopHapticFeedback(XrSession, const XrHapticActionInfo*);
+XrResult EnumerateSwapchainFormats(XrSession, uint32_t, uint32_t*, int64_t*);
+XrResult CreateSwapchain(XrSession, const XrSwapchainCreateInfo*, XrSwapchain*);
+XrResult DestroySwapchain(XrSwapchain);
+XrResult EnumerateSwapchainImages(XrSwapchain, uint32_t, uint32_t*, XrSwapchainImageBaseHeader*);
+XrResult AcquireSwapchainImage(XrSwapchain, const XrSwapchainImageAcquireInfo*, uint32_t*);
+XrResult WaitSwapchainImage(XrSwapchain, const XrSwapchainImageWaitInfo*);
+XrResult ReleaseSwapchainImage(XrSwapchain, const XrSwapchainImageReleaseInfo*);
+
+/// Two-call idiom helper: writes `count` items via `write(i)` when capacity allows.
+template <class F>
+XrResult TwoCall(uint32_t capacity, uint32_t* countOut, uint32_t count, F write) {
+  if (!countOut) return XR_ERROR_VALIDATION_FAILURE;
+  *countOut = count;
+  if (capacity == 0) return XR_SUCCESS;
+  if (capacity < count) return XR_ERROR_SIZE_INSUFFICIENT;
+  for (uint32_t i = 0; i < count; ++i) write(i);
+  return XR_SUCCESS;
+}
+
+}  // namespace sphxr::xr::simrt
