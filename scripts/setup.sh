@@ -5,7 +5,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake ninja-build pkg-config libthrust-dev nlohmann-json3-dev libgtest-dev libgmock-dev
-          python3 python3-matplotlib)
+          python3 python3-matplotlib libepoxy-dev libglm-dev libglfw3-dev libimgui-dev libstb-dev libegl-dev
+          libegl-mesa0 libgl1-mesa-dri xvfb xauth
+          libopenxr-dev libopenxr-loader1 openxr-layer-corevalidation libgl-dev libx11-dev libpng-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
