@@ -60,7 +60,9 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
 
 namespace sphxr::sim {
 
-// The presets, chosen from the sweep in docs/reuse.md (bench/reuse_sweep.cpp).
+// The presets, chosen from the sweep in docs/reuse.md (bench/reuse.cpp). `balanced` is the loosest
+// guard that still keeps scenes/dam_break.json within the Martin & Moyce bounds of the core (tolerance
+// 1 g failed them: front 12.7 %, column height 16.6 %).
 bool ApplyReusePreset(const std::string& name, ReuseParams* reuse) {
   struct Preset {
     const char* name;
@@ -70,7 +72,7 @@ bool ApplyReusePreset(const std::string& name, ReuseParams* reuse) {
   };
   static const Preset kPresets[] = {
       {"accurate", 0.25f, 1.0f, 1.2f, 1, 0.3f},
-      {"balanced", 0.25f, 1.0f, 1.3f, 3, 1.0f},
+      {"balanced", 0.25f, 1.0f, 1.3f, 3, 0.5f},
       {"fast", 0.25f, 1.0f, 1.5f, 5, 2.0f},
   };
   for (const Preset& p : kPresets) {
