@@ -86,13 +86,17 @@ DamBreakMeasure MeasureDamBreak(const DamBreakProbe& probe, const sim::HostFluid
 }  // namespace
 
 std::string UsageText() {
-  return "usage: sphxr [--desktop | --headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
+  return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
          "             [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
          "             [--progress | --no-progress] [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
          "             [--image-size WxH] [--render water|particles] [--quality auto|scene] [--gl-debug]\n"
          "\n"
+         "  --xr              the headset (OpenXR), with a mirror window; the default when a runtime answers.\n"
+         "                    No runtime: one line, then the desktop window. --frame-limit N ends after N\n"
+         "                    frames; XR_RUNTIME_JSON=build/xr/sim_runtime/sphxr_sim_runtime.json: the\n"
+         "                    simulated headset (docs/xr.md)\n"
          "  --desktop         a window with the water, a panel and a mouse-driven hand (the default when a\n"
          "                    display is present); --window-size WxH, --frame-limit N, --no-vsync\n"
          "  --headless        run without a window (the default without a display)\n"
