@@ -180,6 +180,17 @@ TEST(XrApp, WaterInBothEyesWithParallaxAndACleanExit) {
   EXPECT_NEAR(wl.cy, wr.cy, 2.0);
 }
 
+TEST(XrApp, ResetButtonRestartsTheScene) {
+  SimHeadset headset("app_reset");
+  // The right controller's menu button (the simple controller's reset) pressed from 0.1 s on: one press.
+  SetUpHeadset(headset, "0 right 0.3 0.8 0.1 0 0 0 1\n0.1 right 0.3 0.8 0.1 0 0 0 1 menu=1\n");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 20" + kCommon,
+                            headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "reset button: the scene starts again"), 1) << r.out;
+  ExpectNoValidationErrors(headset);
+}
+
 TEST(XrApp, DefaultModeIsTheHeadsetWhenARuntimeAnswers) {
   SimHeadset headset("app_default");
   SetUpHeadset(headset);
