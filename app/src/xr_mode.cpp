@@ -375,11 +375,16 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   outcome->busyMsP50 = Percentile(busy, 0.5);
   outcome->busyMsP90 = Percentile(busy, 0.9);
   const std::shared_ptr<const SimSnapshot> last = app.worker->Latest();
+  double speedSum = 0.0;  // how much the water moves at the end (the tests compare a stirred tank with a still one)
+  for (const sim::Vec4& v : last->fluid.velocity) speedSum += std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  outcome->meanFluidSpeed = last->fluid.velocity.empty() ? 0.0 : speedSum / static_cast<double>(last->fluid.velocity.size());
   std::printf("sphxr --xr: %s after %lld frames (%lld drawn) in %.1f s; frame interval p50 %.2f / p90 %.2f ms, "
-              "busy (all but xrWaitFrame) p50 %.2f / p90 %.2f ms, %lld late; simulation at t = %.3f s, %lld steps\n",
+              "busy (all but xrWaitFrame) p50 %.2f / p90 %.2f ms, %lld late; simulation at t = %.3f s, %lld steps, "
+              "mean fluid speed %.4f m/s\n",
               outcome->message.c_str(), static_cast<long long>(outcome->frames), static_cast<long long>(outcome->rendered),
               seconds, outcome->frameMsP50, outcome->frameMsP90, outcome->busyMsP50, outcome->busyMsP90,
-              static_cast<long long>(outcome->lateFrames), last->last.time, static_cast<long long>(last->steps));
+              static_cast<long long>(outcome->lateFrames), last->last.time, static_cast<long long>(last->steps),
+              outcome->meanFluidSpeed);
   std::fflush(stdout);
   return Status::Ok();
 }

@@ -35,6 +35,7 @@ struct XrOutcome {
   double frameMsP50 = 0, frameMsP90 = 0;  // wall time between frames
   double busyMsP50 = 0, busyMsP90 = 0;    // a frame's time outside xrWaitFrame (sync, update, eyes, end)
   int64_t lateFrames = 0;                 // frames more than 1.5 display periods after the previous one
+  double meanFluidSpeed = 0;              // m/s, over the particles of the last snapshot
 };
 
 /// Runs the headset until the session ends (the runtime, the window closing, `--frame-limit` frames).
