@@ -398,14 +398,23 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
 
   double nextFrameTime = 0.0;
-  sim::HostFluid frameHost;
+  // A picture is drawn from a snapshot, as in the window: in water mode from the extracted surface mesh
+  // (the scene's "surface" section), with the paddles at their poses.
+  SimSnapshot pictureSnap;
+  auto picture = [&](const std::string& path) -> Status {
+    SurfaceRequest surface;
+    surface.enabled = pictureMode == render::RenderMode::kWater;
+    surface.params = scene.surface.value_or(sim::SurfaceParams{});
+    if (Status s = CaptureSnapshot(*solver, paddles.get(), surface, &pictureSnap); !s) return Status::Error("picture: " + s.message());
+    pictureSnap.setup = scene.setup;
+    return pictures->Write(MakeFrameScene(pictureSnap, pictureMode), path);
+  };
   auto frameNow = [&]() -> Status {
     if (options.framesDir.empty()) return Status::Ok();
-    solver->Download(&frameHost);
     char name[64];
     std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(summary->frames));
     const std::string path = (std::filesystem::path(options.framesDir) / name).string();
-    if (Status s = pictures->Write(MakeFrameScene(scene.setup, frameHost, pictureMode), path); !s) return s;
+    if (Status s = picture(path); !s) return s;
     ++summary->frames;
     nextFrameTime += 1.0 / options.fps;
     return Status::Ok();
@@ -509,7 +518,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
   }
   if (pictures && !options.screenshotPath.empty()) {
-    if (Status s = pictures->Write(MakeFrameScene(scene.setup, host, pictureMode), options.screenshotPath); !s) return s;
+    if (Status s = picture(options.screenshotPath); !s) return s;
   }
 
   std::printf("sphxr summary: %s\n", scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str());
