@@ -41,13 +41,11 @@ using Clock = std::chrono::steady_clock;
 std::string g_glfwError;
 void GlfwError(int code, const char* text) { g_glfwError = Format("%s (GLFW 0x%x)", text, code); }
 
-// ---- The hand-off to the simulation: the one place that changes when SimWorker takes hands. ----
-// The worker of this branch has no hands yet (SimWorker::SetHands and SimSnapshot::haptic arrive with
-// the wire-desk branch): hands go nowhere, haptics stay 0, the frame shows the tank and particles.
-void SendHands(SimWorker& /*worker*/, const std::vector<interaction::HandInput>& /*hands*/) {}
-float HapticAmplitude(const SimSnapshot& /*snap*/, int /*hand*/) { return 0.0f; }
+// ---- The hand-off to the simulation: hands in, haptics and the frame out. ----
+void SendHands(SimWorker& worker, const std::vector<interaction::HandInput>& hands) { worker.SetHands(hands); }
+float HapticAmplitude(const SimSnapshot& snap, int hand) { return snap.haptic[hand]; }
 render::FrameScene BuildFrameScene(const SimSnapshot& snap, render::RenderMode mode, render::ParticleColor color) {
-  return MakeFrameScene(snap.setup, snap.fluid, mode, color);
+  return MakeFrameScene(snap, mode, color);  // surface mesh (or particles), paddles, tank
 }
 // ---- end of the hand-off ----
 
@@ -57,10 +55,21 @@ glm::mat4 ToGlm(const xr::Mat4& m) { return glm::make_mat4(m.m.data()); }
 /// grip points along its -z. Body -> grip: +90 degrees about x (body -y becomes grip -z).
 constexpr xr::Quat kGripFromPaddle{0.70710678f, 0.0f, 0.0f, 0.70710678f};
 
-interaction::HandInput ToHandInput(const xr::HandState& h, const sim::Vec3& offset, double timeSeconds) {
+/// Where a hand's paddle may go: over the tank (5 cm beyond its sides) from its floor to 0.5 m above its
+/// top. A hand elsewhere (resting at the user's side, reaching past the tank) does not drag its paddle
+/// through the walls and floor: it counts as untracked, so the paddle holds, then withdraws above the
+/// water (paddle.h), and re-enters when the hand comes back.
+bool InReach(const sim::Vec3& p, const sim::Aabb& tank) {
+  constexpr float kSide = 0.05f, kAbove = 0.5f;
+  return p.x >= tank.min.x - kSide && p.x <= tank.max.x + kSide && p.z >= tank.min.z - kSide &&
+         p.z <= tank.max.z + kSide && p.y >= tank.min.y && p.y <= tank.max.y + kAbove;
+}
+
+interaction::HandInput ToHandInput(const xr::HandState& h, const sim::Vec3& offset, const sim::Aabb& tank,
+                                   double timeSeconds) {
   interaction::HandInput in;
-  in.tracked = h.poseValid && h.tracked;
   in.pose.position = {h.grip.position.x - offset.x, h.grip.position.y - offset.y, h.grip.position.z - offset.z};
+  in.tracked = h.poseValid && h.tracked && InReach(in.pose.position, tank);
   const xr::Quat q = h.grip.orientation * kGripFromPaddle;
   in.pose.orientation = {q.w, q.x, q.y, q.z};
   in.hasVelocity = h.velocityValid;
@@ -83,7 +92,8 @@ double Percentile(std::vector<double> v, double q) {
 struct XrApp {
   Options options;
   SceneFile scene;
-  sim::SceneSetup setup;  // what reset restores
+  sim::SceneSetup setup;  // the scene at the spacing in use
+  SimScene simScene;      // with a paddle for each hand; what reset restores
   sim::Vec3 offset;       // play = sim + offset
   GLFWwindow* window = nullptr;
   bool imguiReady = false;
@@ -117,7 +127,7 @@ struct XrApp {
     ImGui::Text("%s", xr::SessionStateName(session->state()));
     if (ImGui::Button(worker->Paused() ? "run" : "pause")) worker->SetPaused(!worker->Paused());
     ImGui::SameLine();
-    if (ImGui::Button("reset")) worker->Reset(setup);
+    if (ImGui::Button("reset")) worker->Reset(simScene);
     ImGui::SameLine();
     if (ImGui::Button("end session")) RequestExit();
     ImGui::Text("%d fluid + %d boundary particles", snap.fluidCount, snap.boundaryCount);
@@ -129,7 +139,12 @@ struct XrApp {
     ImGui::RadioButton("water", &m, 0);
     ImGui::SameLine();
     ImGui::RadioButton("particles", &m, 1);
-    mode = static_cast<render::RenderMode>(m);
+    if (m != static_cast<int>(mode)) {
+      mode = static_cast<render::RenderMode>(m);
+      SurfaceRequest surface = simScene.surface;
+      surface.enabled = mode == render::RenderMode::kWater;  // no surface extraction for particles
+      worker->SetSurface(surface);
+    }
     const std::string error = worker->LastError();
     if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
     ImGui::End();
@@ -216,8 +231,14 @@ Status StartSimulation(XrApp& app) {
     }
     app.setup.params.spacing = choice.spacing;
   }
+  // Each controller holds a paddle: the scene's hand-held ones, else the default blade on a handle
+  // (sized at the spacing in use).
+  SceneFile atSpacing = app.scene;
+  atSpacing.setup = app.setup;
+  app.simScene = SimSceneFromFile(atSpacing, {0, 1});
+  app.simScene.surface.enabled = app.mode == render::RenderMode::kWater;
   app.worker = std::make_unique<SimWorker>(solverConfig);
-  if (Status s = app.worker->Start(app.setup); !s) return Status::Error(options.scenePath + ": " + s.message());
+  if (Status s = app.worker->Start(app.simScene); !s) return Status::Error(options.scenePath + ": " + s.message());
   return Status::Ok();
 }
 
@@ -300,7 +321,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
 
           const double displayTime = 1e-9 * static_cast<double>(info.predictedDisplayTimeNs);
           std::vector<interaction::HandInput> hands;
-          for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, displayTime));
+          for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, app.setup.tank, displayTime));
           SendHands(*app.worker, hands);
           for (int h = 0; h < xr::kHandCount; ++h) {
             float amplitude = HapticAmplitude(*snap, h);
@@ -313,19 +334,9 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
           }
           if (info.resetRequested) {
             SPHXR_LOG_INFO("reset button: the scene starts again");
-            app.worker->Reset(app.setup);
+            app.worker->Reset(app.simScene);
           }
           frame = BuildFrameScene(*snap, app.mode, app.color);
-          // The controllers themselves: a small dark box at each tracked grip.
-          for (const interaction::HandInput& hand : hands) {
-            if (!hand.tracked) continue;
-            render::SolidMesh controller;
-            controller.model = glm::scale(
-                glm::translate(glm::mat4(1.0f), glm::vec3(hand.pose.position.x, hand.pose.position.y, hand.pose.position.z)),
-                glm::vec3(0.03f));
-            controller.color = glm::vec3(0.15f, 0.15f, 0.18f);
-            frame.solids.push_back(controller);
-          }
         },
         [&](const xr::FrameInfo&, const xr::EyeView& eye) {
           // The renderer writes display-ready colour (the desktop window shows its bytes as they are):
@@ -380,11 +391,11 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   outcome->meanFluidSpeed = last->fluid.velocity.empty() ? 0.0 : speedSum / static_cast<double>(last->fluid.velocity.size());
   std::printf("sphxr --xr: %s after %lld frames (%lld drawn) in %.1f s; frame interval p50 %.2f / p90 %.2f ms, "
               "busy (all but xrWaitFrame) p50 %.2f / p90 %.2f ms, %lld late; simulation at t = %.3f s, %lld steps, "
-              "mean fluid speed %.4f m/s\n",
+              "mean fluid speed %.4f m/s; last snapshot: %.2f ms per step, surface %.2f ms\n",
               outcome->message.c_str(), static_cast<long long>(outcome->frames), static_cast<long long>(outcome->rendered),
               seconds, outcome->frameMsP50, outcome->frameMsP90, outcome->busyMsP50, outcome->busyMsP90,
               static_cast<long long>(outcome->lateFrames), last->last.time, static_cast<long long>(last->steps),
-              outcome->meanFluidSpeed);
+              outcome->meanFluidSpeed, last->stepMs, last->surfaceMs);
   std::fflush(stdout);
   return Status::Ok();
 }

@@ -180,6 +180,80 @@ TEST(XrApp, WaterInBothEyesWithParallaxAndACleanExit) {
   EXPECT_NEAR(wl.cy, wr.cy, 2.0);
 }
 
+/// The haptic requests of the simulated headset's log for one hand: (amplitude, stop) per line.
+std::vector<float> HapticAmplitudes(const std::filesystem::path& log, const std::string& hand) {
+  std::vector<float> out;
+  std::ifstream in(log);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    long frame = 0;
+    double time = 0;
+    std::string who;
+    float amplitude = 0;
+    if ((ss >> frame >> time >> who >> amplitude) && who == hand) out.push_back(amplitude);
+  }
+  return out;
+}
+
+double MeanFluidSpeed(const std::string& out) {
+  const size_t p = out.find("mean fluid speed ");
+  return p == std::string::npos ? -1.0 : std::atof(out.c_str() + p + 17);
+}
+
+// A paddle held by the right hand: the default blade on a handle (paddle.h), blade below the grip.
+const std::string kRightPaddle = R"(,
+  "paddles": { "list": [ { "name": "right paddle", "hand": "right",
+    "shapes": [ { "box": { "center": [0.0, -0.05, 0.0], "half_extents": [0.006, 0.05, 0.04] } },
+                { "capsule": { "a": [0.0, 0.0, 0.0], "b": [0.0, 0.12, 0.0], "radius": 0.01 } } ],
+    "haptics": { "full_scale_force": 2.0, "time_constant": 0.05 } } ] })";
+
+TEST(XrApp, ScriptedControllersPaddleMovesTheWaterAndAsksForHaptics) {
+  // The right controller pointing down (grip -z to -y: the paddle upright), its blade 7 cm into the
+  // water (surface at y = 1.0 in the play space), sweeping across the tank and back every second.
+  const std::string stir =
+      "0 right -0.05 1.03 -0.4 -0.7071068 0 0 0.7071068 trigger=1\n"
+      "0.5 right 0.05 1.03 -0.4 -0.7071068 0 0 0.7071068 trigger=1\n"
+      "1 right -0.05 1.03 -0.4 -0.7071068 0 0 0.7071068 trigger=1\nloop 1\n";
+  // The same controller held 0.3 m above the tank: the paddle never touches the water.
+  const std::string still = "0 right 0 1.5 -0.4 -0.7071068 0 0 0.7071068 trigger=1\n";
+  struct Result {
+    AppRun run;
+    std::vector<float> right, left;
+  };
+  auto runWith = [&](const std::string& name, const std::string& poses) {
+    SimHeadset headset(name);
+    SetUpHeadset(headset, poses);
+    const auto haptics = headset.dir / "haptics.txt";
+    headset.env.Set("SPHXR_SIM_XR_HAPTICS_LOG", haptics.string());
+    Result r;
+    r.run = RunSphxr("--xr --scene " + WriteScene(headset.dir, kRightPaddle).string() +
+                         " --frame-limit 180 --spacing 0.02 --set stiffness=10000" + kCommon,
+                     headset.dir);
+    EXPECT_EQ(r.run.code, 0) << r.run.out;
+    ExpectNoValidationErrors(headset);
+    r.right = HapticAmplitudes(haptics, "right");
+    r.left = HapticAmplitudes(haptics, "left");
+    return r;
+  };
+  const Result stirred = runWith("app_paddle_stir", stir);
+  const Result held = runWith("app_paddle_still", still);
+  const double vStirred = MeanFluidSpeed(stirred.run.out), vHeld = MeanFluidSpeed(held.run.out);
+  std::printf("mean fluid speed: stirred %.4f m/s, paddle above the water %.4f m/s; right-hand haptic requests: %zu "
+              "(peak %.2f), %zu\n",
+              vStirred, vHeld, stirred.right.size(),
+              stirred.right.empty() ? 0.0f : *std::max_element(stirred.right.begin(), stirred.right.end()),
+              held.right.size());
+  EXPECT_GT(vStirred, 0.01) << stirred.run.out;
+  EXPECT_GT(vStirred, 3.0 * vHeld) << held.run.out;
+  // Haptics: the paddle in the water asked for them, the one above the water never did; the left hand
+  // holds nothing.
+  ASSERT_FALSE(stirred.right.empty()) << stirred.run.out;
+  EXPECT_GT(*std::max_element(stirred.right.begin(), stirred.right.end()), 0.05f);
+  EXPECT_TRUE(held.right.empty());
+  EXPECT_TRUE(stirred.left.empty());
+}
+
 TEST(XrApp, ResetButtonRestartsTheScene) {
   SimHeadset headset("app_reset");
   // The right controller's menu button (the simple controller's reset) pressed from 0.1 s on: one press.
