@@ -66,10 +66,10 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
 
 Status SimWorker::Start(const SimScene& scene) {
   if (Status s = Build(scene, &m_solver, &m_paddles); !s) return s;
-  m_scene = scene;
   m_nextPaddleFrame = 0.0;
   {
     std::lock_guard lock(m_mutex);
+    m_scene = scene;
     m_surface = scene.surface;
   }
   double zero[static_cast<int>(sim::Stage::kCount)] = {};
@@ -222,10 +222,11 @@ void SimWorker::Run() {
       } else {
         m_paddles = std::move(freshPaddles);  // bound to the old solver: replaced first
         m_solver = std::move(fresh);
-        m_scene = *reset;
         m_nextPaddleFrame = 0.0;
         {
-          std::lock_guard lock(m_mutex);
+          std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
+          m_scene = *reset;
+          m_surface = m_scene.surface;
           m_error.clear();
         }
         anchorWall = Clock::now();
