@@ -1,5 +1,7 @@
 #include "sim_worker.h"
 
+#include <omp.h>
+
 #include <chrono>
 #include <cmath>
 
@@ -37,8 +39,9 @@ interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand
   const float spacing = setup.params.spacing;
   d.shapes = interaction::BladeOnHandle(1.5f * width, std::max(0.6f * spacing, 0.12f * width), width, 1.2f * width,
                                         std::max(1.2f * spacing, 0.12f * width));
-  // Full scale at the drag of a brisk 1 m/s stroke, 1/2 rho Cd A v^2 with Cd = 2 for a flat plate: rho A.
-  d.haptics.fullScaleForce = std::max(0.05f, setup.params.restDensity * width * 1.2f * width);
+  // Full scale at the drag of a brisk 1.4 m/s stroke, 1/2 rho Cd A v^2 with Cd = 2 for a flat plate:
+  // 2 rho A (the blade held still in the water then shows about a tenth, its buoyancy).
+  d.haptics.fullScaleForce = std::max(0.05f, 2.0f * setup.params.restDensity * width * 1.2f * width);
   return d;
 }
 
@@ -63,10 +66,10 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
 
 Status SimWorker::Start(const SimScene& scene) {
   if (Status s = Build(scene, &m_solver, &m_paddles); !s) return s;
-  m_scene = scene;
   m_nextPaddleFrame = 0.0;
   {
     std::lock_guard lock(m_mutex);
+    m_scene = scene;
     m_surface = scene.surface;
   }
   double zero[static_cast<int>(sim::Stage::kCount)] = {};
@@ -178,6 +181,10 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
 }
 
 void SimWorker::Run() {
+  // The CPU backend's team size is an OpenMP setting of the thread that made the solver (Start ran on
+  // the caller's thread): without this the worker's steps ran with the default team, whose spinning
+  // threads fought the renderer's for the cores (a 3.5 ms step took 650 ms under Xvfb + llvmpipe).
+  omp_set_num_threads(m_config.threads > 0 ? m_config.threads : omp_get_num_procs());
   // Real-time pacing: simulated time may not run ahead of wall time (anchored again after a pause).
   Clock::time_point anchorWall = Clock::now();
   double anchorSim = m_solver->Time();
@@ -215,10 +222,11 @@ void SimWorker::Run() {
       } else {
         m_paddles = std::move(freshPaddles);  // bound to the old solver: replaced first
         m_solver = std::move(fresh);
-        m_scene = *reset;
         m_nextPaddleFrame = 0.0;
         {
-          std::lock_guard lock(m_mutex);
+          std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
+          m_scene = *reset;
+          m_surface = m_scene.surface;
           m_error.clear();
         }
         anchorWall = Clock::now();

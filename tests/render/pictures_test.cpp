@@ -213,6 +213,16 @@ class Xvfb {
 };
 
 
+glm::vec3 V(sim::Vec3 v) { return {v.x, v.y, v.z}; }
+glm::vec3 V(const std::array<float, 3>& v) { return {v[0], v[1], v[2]}; }
+
+/// The blade centre (the point the mouse places) of the snapshot's mouse paddle, world.
+glm::vec3 BladeCentre(const app::PaddlePose& p) {
+  const sim::Vec3 w = app::PaddleWorkingPoint(p.shapes);
+  const interaction::Quat& q = p.pose.orientation;
+  return V(p.pose.position) + glm::quat(q.w, q.x, q.y, q.z) * V(w);
+}
+
 TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
   Xvfb xvfb;
   ASSERT_FALSE(xvfb.Display().empty()) << "could not start Xvfb (install the xvfb package)";
@@ -234,6 +244,11 @@ TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
     for (int i = 0; i < 3; ++i) ASSERT_TRUE(desktop->Frame());
     EXPECT_GT(desktop->PanelVertexCount(), 100) << "the ImGui panel did not draw";
     EXPECT_FALSE(desktop->Hand().active);
+    // A scene without paddles gets a hand-held one for the mouse (the right hand), out of the water.
+    ASSERT_EQ(desktop->Snapshot()->paddles.size(), 1u);
+    EXPECT_EQ(desktop->Snapshot()->paddles[0].hand, 1);
+    EXPECT_EQ(desktop->Hand().index, 1);
+    EXPECT_GT(BladeCentre(desktop->Snapshot()->paddles[0]).y, 0.15f) << "a hand-held paddle starts above the tank";
 
     // A drag with the left button: press right of the panel, move, and the hand's target follows the
     // cursor (the paddle it holds follows in simulated time: DesktopPaddleTest below).
@@ -309,13 +324,22 @@ TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
 namespace sphxr::test {
 namespace {
 
-// Water over the whole floor of a small tank, 7 cm deep: 20 x 7 x 12 = 1,680 particles at 1 cm. The
-// mouse's default paddle (a blade 4 cm wide on a handle) fits a third of the tank's depth.
+// Water over the whole floor of a small tank, 6 cm deep: 20 x 6 x 12 = 1,440 particles at 1 cm, and a
+// right-hand paddle (the mouse plays it): a blade 4 x 4.8 x 1.2 cm on a 6 cm handle, re-entering at
+// 4 m/s so that the test spends its time on the stroke (the simulation runs at a few hundredths of real
+// time on the shared machine).
 constexpr const char* kPoolScene = R"({
   "name": "pool",
   "solver": { "spacing": 0.01, "max_dt": 0.001 },
-  "tank": { "min": [0, 0, 0], "max": [0.2, 0.14, 0.12] },
-  "fluid": [ { "min": [0, 0, 0], "max": [0.2, 0.07, 0.12] } ],
+  "tank": { "min": [0, 0, 0], "max": [0.2, 0.1, 0.12] },
+  "fluid": [ { "min": [0, 0, 0], "max": [0.2, 0.06, 0.12] } ],
+  "paddles": { "list": [ {
+    "name": "mouse", "hand": "right",
+    "shapes": [ { "box": { "center": [0, -0.084, 0], "half_extents": [0.02, 0.024, 0.006] } },
+                { "capsule": { "a": [0, 0, 0], "b": [0, -0.06, 0], "radius": 0.006 } } ],
+    "limits": { "reentry_speed": 4 },
+    "haptics": { "full_scale_force": 4, "time_constant": 0.05 }
+  } ] },
   "run": { "steps": 2 }
 })";
 
@@ -336,16 +360,6 @@ class DisplayScope {
   std::string m_saved;
 };
 
-glm::vec3 V(sim::Vec3 v) { return {v.x, v.y, v.z}; }
-glm::vec3 V(const std::array<float, 3>& v) { return {v[0], v[1], v[2]}; }
-
-/// The blade centre (the point the mouse places) of the snapshot's mouse paddle, world.
-glm::vec3 BladeCentre(const app::PaddlePose& p) {
-  const sim::Vec3 w = app::PaddleWorkingPoint(p.shapes);
-  const interaction::Quat& q = p.pose.orientation;
-  return V(p.pose.position) + glm::quat(q.w, q.x, q.y, q.z) * V(w);
-}
-
 TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanelShowsItsHaptics) {
   Xvfb xvfb;
   ASSERT_FALSE(xvfb.Display().empty()) << "could not start Xvfb (install the xvfb package)";
@@ -364,9 +378,10 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   ASSERT_TRUE(s.ok()) << s.message();
   auto snapshot = [&] { return desktop->Snapshot(); };
   ASSERT_TRUE(desktop->Frame());
-  ASSERT_EQ(snapshot()->paddles.size(), 1u) << "a scene without paddles gets one for the mouse";
-  EXPECT_EQ(snapshot()->paddles[0].hand, desktop->Hand().index);
-  const float top = 0.14f;
+  ASSERT_EQ(snapshot()->paddles.size(), 1u) << "the mouse plays the scene's hand-held paddle (no default added)";
+  EXPECT_EQ(snapshot()->paddles[0].hand, 1);
+  EXPECT_EQ(desktop->Hand().index, 1);
+  const float top = 0.1f;
   EXPECT_GT(BladeCentre(snapshot()->paddles[0]).y, top) << "a hand-held paddle starts out of the water";
 
   // Press right of the panel and find, with the button held, the cursor rows that put the blade's centre
@@ -387,7 +402,13 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   // The paddle enters the water at the press point (re-entry at 1 m/s of simulated time).
   const auto start = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  while (wall() < 12.0 && glm::length(BladeCentre(snapshot()->paddles[0]) - target0) > 0.005f) ASSERT_TRUE(desktop->Frame());
+  // Frames at about 30 Hz (as with vsync, the window leaves the simulation thread its core).
+  auto frame = [&] {
+    const bool open = desktop->Frame();
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    return open;
+  };
+  while (wall() < 12.0 && glm::length(BladeCentre(snapshot()->paddles[0]) - target0) > 0.005f) ASSERT_TRUE(frame());
   ASSERT_LT(glm::length(BladeCentre(snapshot()->paddles[0]) - target0), 0.005f)
       << "the paddle did not reach the mouse: t = " << snapshot()->last.time << " s after " << snapshot()->steps
       << " steps (" << snapshot()->stepsPerSecond << " steps/s, " << snapshot()->stepMs << " ms per step, surface "
@@ -396,10 +417,10 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   // Held still under water, it feels the water (buoyancy): the panel's haptic bar is not zero.
   float hapticInWater = 0.0f;
   for (int i = 0; i < 5; ++i) {
-    ASSERT_TRUE(desktop->Frame());
+    ASSERT_TRUE(frame());
     hapticInWater = std::max(hapticInWater, desktop->PanelHaptic());
   }
-  EXPECT_GT(hapticInWater, 0.05f) << "the panel shows no haptic amplitude with the blade in the water";
+  EXPECT_GT(hapticInWater, 0.02f) << "the panel shows no haptic amplitude with the blade in the water";
 
   // The drag: the fluid's mean horizontal velocity along the drag, against the sideways one.
   const std::shared_ptr<const app::SimSnapshot> before = snapshot();
@@ -420,16 +441,15 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   };
   for (int i = 1; i <= 20; ++i) {  // the cursor moves over 20 frames
     desktop->OnCursor(x0 + (x1 - x0) * i / 20.0, y);
-    ASSERT_TRUE(desktop->Frame());
+    ASSERT_TRUE(frame());
     measure();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  while (wall() < enterWall + 12.0 && glm::length(BladeCentre(snapshot()->paddles[0]) - target1) > 0.005f) {
-    ASSERT_TRUE(desktop->Frame());
+  while (wall() < enterWall + 8.0 && glm::length(BladeCentre(snapshot()->paddles[0]) - target1) > 0.005f) {
+    ASSERT_TRUE(frame());
     measure();
   }
   for (int i = 0; i < 5; ++i) {  // the water goes on for a few frames after the blade stops
-    ASSERT_TRUE(desktop->Frame());
+    ASSERT_TRUE(frame());
     measure();
   }
   const std::shared_ptr<const app::SimSnapshot> after = snapshot();
@@ -459,11 +479,13 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   farShift /= far;
   std::printf("paddle drag: %.3f m; mean fluid velocity along the drag %.4f m/s (before %.4f), sideways %.4f (before %.4f);"
               " water ahead of the blade moved %.4f m along (%d particles), beside the path %.4f m (%d);"
-              " haptic at rest %.2f, peak %.2f; force at the end %.3f N\n",
+              " haptic at rest %.2f, peak %.2f; force at the end %.3f N; %.2f ms per step, surface %.2f ms, %.3f simulated s"
+              " in %.1f s\n",
               glm::length(target1 - target0), alongPeak, alongBefore, sidePeak, sideBefore, nearShift, near, farShift, far,
-              hapticInWater, hapticPeak, sim::Length(after->paddles[0].force));
-  EXPECT_GT(alongPeak, 0.01) << "the water did not move along the drag";
-  EXPECT_GT(alongPeak, 2.0 * std::abs(alongBefore)) << "the water moved along the drag as much before it";
+              hapticInWater, hapticPeak, sim::Length(after->paddles[0].force), after->stepMs, after->surfaceMs,
+              after->last.time, wall());
+  // The plunge into the water left it sloshing: the stroke must add momentum along the drag to that.
+  EXPECT_GT(alongPeak - alongBefore, 0.015) << "the water did not move along the drag";
   EXPECT_GT(nearShift, 0.005) << "the water ahead of the blade was not pushed";
   // Beside the path the water flows back round the blade (a return flow), so the water ahead of the blade
   // moved forward relative to it.
