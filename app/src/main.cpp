@@ -2,10 +2,7 @@
 // is present), else --desktop (the default when a display is present), else --headless. Each fallback is
 // one line saying why: no runtime -> the desktop window; no window -> headless; a session lost mid-run ->
 // the desktop window (or exit when there is no display or the --frame-limit is reached).
-#include <unistd.h>
-
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 
 #include "sphxr/app/desktop.h"
@@ -24,16 +21,6 @@ int main(int argc, char** argv) {
     std::fputs(sphxr::app::UsageText().c_str(), stdout);
     return 0;
   }
-#ifdef __linux__
-  // A frame loop shares the cores with the simulation's OpenMP threads, whose spinning waits (libgomp's
-  // default) starve it and llvmpipe's rasteriser: in --xr on 2 cores a 2.4 ms step took 580 ms and a
-  // 2 ms surface 560 ms. libgomp reads OMP_WAIT_POLICY when it is loaded, before main, so the windowed
-  // modes start again once with passive waiting (unless the user chose a policy).
-  if (options.mode != Mode::kHeadless && !std::getenv("OMP_WAIT_POLICY") && sphxr::app::DisplayAvailable()) {
-    setenv("OMP_WAIT_POLICY", "passive", 1);
-    execv("/proc/self/exe", argv);  // returns only on failure: go on with the default policy
-  }
-#endif
   // The default: the headset when a runtime answers (asked without creating a session).
   if (options.mode == Mode::kAuto && sphxr::app::DisplayAvailable() && sphxr::app::XrRuntimeAvailable(nullptr)) {
     options.mode = Mode::kXr;

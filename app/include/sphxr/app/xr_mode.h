@@ -36,6 +36,7 @@ struct XrOutcome {
   double busyMsP50 = 0, busyMsP90 = 0;    // a frame's time outside xrWaitFrame (sync, update, eyes, end)
   int64_t lateFrames = 0;                 // frames more than 1.5 display periods after the previous one
   double meanFluidSpeed = 0;              // m/s, over the particles of the last snapshot
+  double peakMeanFluidSpeed = 0;          // m/s, the largest mean over the snapshots drawn
 };
 
 /// Runs the headset until the session ends (the runtime, the window closing, `--frame-limit` frames).
