@@ -301,6 +301,9 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
       app.RequestExit();
     }
     const xr::EventResult ev = app.session->PollEvents();
+    for (xr::SessionState state : ev.transitions) {
+      outcome->states += (outcome->states.empty() ? "" : " ") + std::string(xr::SessionStateName(state));
+    }
     if (ev.exit) {
       outcome->lost = ev.lost;
       outcome->message = ev.message;
@@ -405,6 +408,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
               seconds, outcome->frameMsP50, outcome->frameMsP90, outcome->busyMsP50, outcome->busyMsP90,
               static_cast<long long>(outcome->lateFrames), last->last.time, static_cast<long long>(last->steps),
               outcome->meanFluidSpeed, outcome->peakMeanFluidSpeed, last->stepMs, last->surfaceMs);
+  std::printf("sphxr --xr: session states %s\n", outcome->states.c_str());
   std::fflush(stdout);
   return Status::Ok();
 }

@@ -151,6 +151,11 @@ TEST(XrApp, WaterInBothEyesWithParallaxAndACleanExit) {
                          headset.dir);
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("sphxr --xr: OpenXR session ended after 30 frames"), std::string::npos) << r.out;
+  // The specification's life cycle, as the simulated headset drives it, to the end.
+  EXPECT_NE(r.out.find("sphxr --xr: session states IDLE READY SYNCHRONIZED VISIBLE FOCUSED VISIBLE SYNCHRONIZED "
+                       "STOPPING IDLE EXITING\n"),
+            std::string::npos)
+      << r.out;
   EXPECT_EQ(CountOf(r.out, "error"), 0) << r.out;
   ExpectNoValidationErrors(headset);
 
@@ -324,6 +329,9 @@ TEST(XrApp, SessionLostMidRunEndsCleanlyInTheDesktopWindow) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(CountOf(r.out, "the XR session was lost"), 1) << r.out;
   EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
+  EXPECT_NE(r.out.find("sphxr --xr: session states IDLE READY SYNCHRONIZED VISIBLE FOCUSED LOSS_PENDING\n"),
+            std::string::npos)
+      << r.out;
   ExpectNoValidationErrors(headset);
   // Lost after the frame limit's worth of frames: nothing left to show, the program exits.
   SimHeadset again("app_lost_end");

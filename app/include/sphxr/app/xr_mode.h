@@ -32,6 +32,7 @@ struct XrOutcome {
   int64_t frames = 0;      // frames whose update ran
   int64_t rendered = 0;    // frames with eyes drawn
   std::string message;     // how the session ended, one line
+  std::string states;      // the session states seen, in order ("IDLE READY ...")
   double frameMsP50 = 0, frameMsP90 = 0;  // wall time between frames
   double busyMsP50 = 0, busyMsP90 = 0;    // a frame's time outside xrWaitFrame (sync, update, eyes, end)
   int64_t lateFrames = 0;                 // frames more than 1.5 display periods after the previous one
