@@ -559,3 +559,61 @@ TEST(HeadlessPicturesTest, WaterScreenshotIsDrawnFromTheSurfaceMesh) {
 
 }  // namespace
 }  // namespace sphxr::test
+
+namespace sphxr::test {
+namespace {
+
+// The paddle's solids land where its primitives are: the unit cube's corners on the box's corners, the
+// cylinder's axis on the capsule's segment, the spheres at its ends, for a rotated and moved body.
+TEST(PaddleSolidsTest, BoxAndCapsuleAreDrawnAtTheBodyPose) {
+  app::PaddlePose paddle;
+  sim::ShapePrimitive box;
+  box.kind = sim::ShapePrimitive::Kind::kBox;
+  box.a = {0.0f, -0.1f, 0.0f};
+  box.b = {0.03f, 0.04f, 0.005f};
+  sim::ShapePrimitive capsule;
+  capsule.kind = sim::ShapePrimitive::Kind::kCapsule;
+  capsule.a = {0.0f, 0.0f, 0.0f};
+  capsule.b = {0.0f, -0.06f, 0.02f};
+  capsule.radius = 0.01f;
+  paddle.shapes = {box, capsule};
+  const glm::quat q = glm::angleAxis(0.7f, glm::normalize(glm::vec3(0.3f, 1.0f, -0.2f)));
+  paddle.pose.position = {0.1f, 0.2f, 0.05f};
+  paddle.pose.orientation = {q.w, q.x, q.y, q.z};
+  paddle.hand = 1;
+  std::vector<render::SolidMesh> solids;
+  app::AppendPaddleSolids(paddle, &solids);
+  ASSERT_EQ(solids.size(), 4u);  // box, cylinder, two spheres
+  auto world = [&](glm::vec3 body) { return glm::vec3(0.1f, 0.2f, 0.05f) + q * body; };
+  auto near = [](glm::vec3 a, glm::vec3 b) { return glm::length(a - b) < 1e-5f; };
+  // Box: the unit cube centred at the origin (empty mesh).
+  EXPECT_TRUE(solids[0].mesh.Empty());
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 s((c & 1) ? 0.5f : -0.5f, (c & 2) ? 0.5f : -0.5f, (c & 4) ? 0.5f : -0.5f);
+    const glm::vec3 expect = world(V(box.a) + 2.0f * s * V(box.b));
+    EXPECT_TRUE(near(glm::vec3(solids[0].model * glm::vec4(s, 1.0f)), expect)) << "corner " << c;
+  }
+  // Cylinder: radius 1 along y from 0 to 1 -> from a to b with the capsule's radius.
+  EXPECT_FALSE(solids[1].mesh.Empty());
+  EXPECT_TRUE(near(glm::vec3(solids[1].model * glm::vec4(0, 0, 0, 1)), world(V(capsule.a))));
+  EXPECT_TRUE(near(glm::vec3(solids[1].model * glm::vec4(0, 1, 0, 1)), world(V(capsule.b))));
+  const glm::vec3 rim = glm::vec3(solids[1].model * glm::vec4(1, 0, 0, 1)) - world(V(capsule.a));
+  EXPECT_NEAR(glm::length(rim), capsule.radius, 1e-6f);
+  EXPECT_NEAR(glm::dot(rim, q * glm::normalize(V(capsule.b) - V(capsule.a))), 0.0f, 1e-6f);
+  // The cylinder's vertices lie on the capsule's surface (distance to the segment = radius); the spheres'
+  // within it (their inner halves are hidden in the cylinder).
+  for (size_t k = 1; k < solids.size(); ++k) {
+    const render::MeshView& m = solids[k].mesh;
+    for (int v = 0; v < m.vertexCount; ++v) {
+      const glm::vec3 p(solids[k].model * glm::vec4(m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2], 1));
+      const glm::vec3 a = world(V(capsule.a)), b = world(V(capsule.b));
+      const float t = std::clamp(glm::dot(p - a, b - a) / glm::dot(b - a, b - a), 0.0f, 1.0f);
+      const float d = glm::length(p - (a + t * (b - a)));
+      if (k == 1) ASSERT_NEAR(d, capsule.radius, 1e-5f) << "cylinder vertex " << v;
+      else ASSERT_LT(d, capsule.radius + 1e-5f) << "sphere " << k << " vertex " << v;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sphxr::test
