@@ -444,6 +444,19 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     }
   }
 
+  // Paddles: where they are, what the water does to them, what a hand would feel.
+  if (ImGui::CollapsingHeader("paddles", ImGuiTreeNodeFlags_DefaultOpen)) {
+    for (size_t k = 0; k < snap.paddles.size(); ++k) {
+      const PaddlePose& p = snap.paddles[k];
+      const char* who = p.hand == 0 ? "left hand" : p.hand == 1 ? "right hand" : "script";
+      ImGui::Text("%s%s: %s, fluid force %.3f N", who, p.hand == hand.index ? " (mouse)" : "",
+                  interaction::PaddleModeName(p.mode), sim::Length(p.force));
+    }
+    panelHaptic = snap.haptic[hand.index];
+    ImGui::ProgressBar(panelHaptic, ImVec2(180, 0), Format("%.2f", panelHaptic).c_str());
+    ImGui::SameLine();
+    ImGui::Text("haptic (%s)", hand.index == 0 ? "left" : "right");
+  }
   // Parameters: the one registry (app/src/param_registry.h) that scene files and --set read too.
   auto editor = [&](const ParamDesc& p) {
     bool edited = false;
@@ -502,19 +515,6 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
                         "finer is smoother and slower (the scene's surface.cell_size sets the start)",
                         surfaceCell * setup.params.spacing);
     }
-  }
-  // Paddles: where they are, what the water does to them, what a hand would feel.
-  if (ImGui::CollapsingHeader("paddles", ImGuiTreeNodeFlags_DefaultOpen)) {
-    for (size_t k = 0; k < snap.paddles.size(); ++k) {
-      const PaddlePose& p = snap.paddles[k];
-      const char* who = p.hand == 0 ? "left hand" : p.hand == 1 ? "right hand" : "script";
-      ImGui::Text("%s%s: %s, fluid force %.3f N", who, p.hand == hand.index ? " (mouse)" : "",
-                  interaction::PaddleModeName(p.mode), sim::Length(p.force));
-    }
-    panelHaptic = snap.haptic[hand.index];
-    ImGui::ProgressBar(panelHaptic, ImVec2(180, 0), Format("%.2f", panelHaptic).c_str());
-    ImGui::SameLine();
-    ImGui::Text("haptic (%s)", hand.index == 0 ? "left" : "right");
   }
   ImGui::TextDisabled("left drag: paddle  right drag: orbit  middle drag: pan  wheel: zoom  f: frame");
   if (hand.active) {

@@ -53,7 +53,9 @@ class SimWorker {
   /// The same paddles and surface with new parameters.
   void Reset(const sim::SceneSetup& setup);
   /// The hands that drive the hand-held paddles (index 0 left, 1 right; missing or untracked hands: the
-  /// paddle holds, then withdraws). The worker uses the newest hands for each paddle frame.
+  /// paddle holds, then withdraws). The worker uses the newest hands for each paddle frame (every
+  /// 1/paddleFrameRate simulated s) and sets their `time` to that frame's simulated time. Poses are in
+  /// the simulation's world frame; a measured velocity (hasVelocity) is taken as per simulated second.
   void SetHands(const std::vector<interaction::HandInput>& hands);
   /// Surface extraction for the snapshots (off in particle mode; the cell size from the panel).
   void SetSurface(const SurfaceRequest& surface);

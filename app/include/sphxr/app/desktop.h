@@ -47,7 +47,7 @@ class DesktopApp {
   void OnKey(int key);
 
   const DesktopHand& Hand() const;
-  /// The snapshot drawn by the last frame (paddle poses, haptics, surface).
+  /// The snapshot drawn by the last frame (paddle poses, haptics, surface); null before the first frame.
   std::shared_ptr<const SimSnapshot> Snapshot() const;
   /// The haptic amplitude of the mouse's hand as the panel showed it in the last frame (0..1).
   float PanelHaptic() const;
