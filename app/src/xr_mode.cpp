@@ -292,6 +292,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   const glm::mat4 sceneToPlay = glm::translate(glm::mat4(1.0f), glm::vec3(app.offset.x, app.offset.y, app.offset.z));
   std::vector<double> intervals, busy;
   std::shared_ptr<const SimSnapshot> previousSnap;
+  render::Image lastMirror;  // --screenshot: the window's last mirror image
   Clock::time_point previousFrame{};
   int64_t previousPeriodNs = 0;
   const auto started = Clock::now();
@@ -367,6 +368,12 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
           app.renderer->Draw(frame, std::span(&view, 1));
           if (eye.eye == 0) {
             app.Mirror(eye);
+            if (!options.screenshotPath.empty()) {  // the mirror as blitted, before the panel
+              int w = 0, h = 0;
+              glfwGetFramebufferSize(app.window, &w, &h);
+              if (w > 0 && h > 0) lastMirror = render::ReadPixels(0, 0, 0, w, h);
+              glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer);
+            }
             mirrored = true;
             ++outcome->rendered;
           }
@@ -395,12 +402,23 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     }
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  if (!options.screenshotPath.empty()) {
+    if (lastMirror.width == 0) {
+      SPHXR_LOG_WARN("--screenshot %s: no frame was drawn, no picture", options.screenshotPath.c_str());
+    } else if (Status s = WritePng(options.screenshotPath, lastMirror); !s) {
+      SPHXR_LOG_WARN("%s", s.message().c_str());
+    } else {
+      SPHXR_LOG_INFO("mirror picture (the left eye, without the panel): %s (%dx%d)", options.screenshotPath.c_str(),
+                     lastMirror.width, lastMirror.height);
+    }
+  }
   outcome->frameMsP50 = Percentile(intervals, 0.5);
   outcome->frameMsP90 = Percentile(intervals, 0.9);
   outcome->busyMsP50 = Percentile(busy, 0.5);
   outcome->busyMsP90 = Percentile(busy, 0.9);
   const std::shared_ptr<const SimSnapshot> last = app.worker->Latest();
   outcome->meanFluidSpeed = MeanSpeed(last->fluid);
+  outcome->peakMeanFluidSpeed = std::max(outcome->peakMeanFluidSpeed, outcome->meanFluidSpeed);
   std::printf("sphxr --xr: %s after %lld frames (%lld drawn) in %.1f s; frame interval p50 %.2f / p90 %.2f ms, "
               "busy (all but xrWaitFrame) p50 %.2f / p90 %.2f ms, %lld late; simulation at t = %.3f s, %lld steps, "
               "mean fluid speed %.4f m/s (peak %.4f); last snapshot: %.2f ms per step, surface %.2f ms\n",
