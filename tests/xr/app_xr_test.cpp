@@ -321,6 +321,14 @@ TEST(XrApp, NoRuntimeIsOneLineThenTheDesktopWindow) {
   EXPECT_EQ(CountOf(r.out, "no OpenXR runtime available"), 1) << r.out;
   EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
   EXPECT_EQ(CountOf(r.out, "sphxr --xr:"), 0) << r.out;  // no session summary: none ran
+  // A manifest whose runtime library is missing: the same one line.
+  std::ofstream(dir / "broken_runtime.json")
+      << R"({"file_format_version": "1.0.0", "runtime": {"name": "broken", "library_path": "./libmissing.so"}})";
+  env.Set("XR_RUNTIME_JSON", (dir / "broken_runtime.json").string());
+  const AppRun b = RunSphxr("--xr --scene " + WriteScene(dir).string() + " --frame-limit 3" + kCommon, dir);
+  ASSERT_EQ(b.code, 0) << b.out;
+  EXPECT_EQ(CountOf(b.out, "OpenXR"), 1) << b.out;
+  EXPECT_EQ(CountOf(b.out, "using the desktop window"), 1) << b.out;
   // Without a mode flag, no runtime is not even worth a line: the desktop window is the default.
   const AppRun d = RunSphxr("--scene " + WriteScene(dir).string() + " --frame-limit 3" + kCommon, dir);
   ASSERT_EQ(d.code, 0) << d.out;
