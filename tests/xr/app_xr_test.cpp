@@ -378,6 +378,15 @@ TEST(XrApp, SessionLostMidRunEndsCleanlyInTheDesktopWindow) {
   ASSERT_EQ(e.code, 0) << e.out;
   EXPECT_EQ(CountOf(e.out, "the XR session was lost"), 1) << e.out;
   EXPECT_EQ(CountOf(e.out, "exiting"), 1) << e.out;
+  // The instance lost instead of the session: the same clean end.
+  SimHeadset instance("app_lost_instance");
+  SetUpHeadset(instance);
+  instance.env.Set("SPHXR_SIM_XR_LOSE_INSTANCE_AFTER_FRAMES", "5");
+  const AppRun i = RunSphxr("--xr --scene " + WriteScene(instance.dir).string() + " --frame-limit 10" + kCommon,
+                            instance.dir);
+  ASSERT_EQ(i.code, 0) << i.out;
+  EXPECT_EQ(CountOf(i.out, "the XR session was lost"), 1) << i.out;
+  EXPECT_EQ(CountOf(i.out, "using the desktop window"), 1) << i.out;
 }
 
 }  // namespace
