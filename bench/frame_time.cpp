@@ -1,5 +1,6 @@
-// Frame time by stage for the window's workload: one simulation step, the (future) surface, and the
-// render of one 1280x720 view, on dam_break and a 20k-particle tank. The render goes through the same
+// Frame time by stage for the window's workload: one simulation step, the surface extraction (HPMC, as
+// the window's simulation thread does it for a snapshot), and the render of one 1280x720 view (water
+// from the surface mesh, water from the particles, particles), on dam_break and a 20k-particle tank. The render goes through the same
 // renderer as the window, into an EGL offscreen target (Mesa llvmpipe here), timed to glFinish.
 // Reports; never asserts. Usage: sphxr_bench_frame [--steps N] [--frames M] [--threads T]
 #include <epoxy/gl.h>
@@ -16,6 +17,7 @@
 #include "bench_util.h"
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
+#include "sphxr/app/snapshot.h"
 #include "sphxr/render/gl_context.h"
 #include "sphxr/render/renderer.h"
 #include "sphxr/sim/solver.h"
@@ -52,8 +54,8 @@ int main(int argc, char** argv) {
   std::printf("machine: %s, %d cores, load %.2f; GL %s; %d steps, %d frames per row, %dx%d\n\n",
               bench::CpuModel().c_str(), bench::CpuCount(), bench::LoadAverage(), render::GlDescription(), steps,
               frames, width, height);
-  std::printf("| scene | fluid particles | sim ms/step (median) | surface ms | render ms, water (median) | render ms, particles (median) |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|\n");
+  std::printf("| scene | fluid particles | sim ms/step (median) | surface ms (median) | triangles | render ms, water from the mesh | render ms, water from particles | render ms, particles |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
 
   struct Case {
     std::string name, file;
@@ -77,13 +79,21 @@ int main(int argc, char** argv) {
       (void)solver->Step();
       stepMs.push_back(Ms(std::chrono::steady_clock::now() - t0));
     }
-    sim::HostFluid fluid;
-    solver->Download(&fluid);
+    app::SimSnapshot snap;
+    app::SurfaceRequest surface;
+    surface.params = scene.surface.value_or(sim::SurfaceParams{});
+    std::vector<double> surfaceMs;
+    for (int f = 0; f <= frames; ++f) {  // the first grows the mesh buffer
+      if (Status s = app::CaptureSnapshot(*solver, nullptr, surface, &snap); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+      if (f > 0) surfaceMs.push_back(snap.surfaceMs);
+    }
+    snap.setup = scene.setup;
     const float aspect = static_cast<float>(width) / height;
-    double renderMs[2];
-    for (int mode = 0; mode < 2; ++mode) {
-      const render::FrameScene frame = app::MakeFrameScene(
-          scene.setup, fluid, mode == 0 ? render::RenderMode::kWater : render::RenderMode::kParticles);
+    double renderMs[3];
+    for (int mode = 0; mode < 3; ++mode) {
+      const render::FrameScene frame =
+          mode == 0 ? app::MakeFrameScene(snap, render::RenderMode::kWater)
+                    : app::MakeFrameScene(scene.setup, snap.fluid, mode == 1 ? render::RenderMode::kWater : render::RenderMode::kParticles);
       const render::Camera camera = render::FrameBox(frame.tank, aspect);
       render::View view;
       view.view = camera.View();
@@ -102,8 +112,9 @@ int main(int argc, char** argv) {
       }
       renderMs[mode] = Median(ms);
     }
-    std::printf("| %s | %d | %.2f | - (no surface yet) | %.1f | %.1f |\n", c.name.c_str(), solver->FluidCount(),
-                Median(stepMs), renderMs[0], renderMs[1]);
+    std::printf("| %s | %d | %.2f | %.2f | %lld | %.1f | %.1f | %.1f |\n", c.name.c_str(), solver->FluidCount(),
+                Median(stepMs), Median(surfaceMs), static_cast<long long>(snap.surface.TriangleCount()), renderMs[0],
+                renderMs[1], renderMs[2]);
   }
   return 0;
 }

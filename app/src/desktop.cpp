@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <thread>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <vector>
 
 #include "sphxr/app/param_registry.h"
@@ -67,6 +68,11 @@ struct DesktopApp::Impl {
   render::ParticleColor color = render::ParticleColor::kSpeed;
   DesktopHand hand;
   glm::vec3 handPrevious{0.0f};
+  SimScene simScene;         // the scene's paddles (with the mouse's) and surface
+  float surfaceCell = 1.0f;  // surface cell size in particle spacings (panel)
+  float panelHaptic = 0.0f;
+  int64_t surfaceTriangles = 0;
+  std::shared_ptr<const SimSnapshot> shown;
   bool dragHand = false, dragOrbit = false, dragPan = false;
   double cursorX = 0, cursorY = 0;
   int frames = 0;
@@ -74,7 +80,7 @@ struct DesktopApp::Impl {
   int64_t simSteps = 0;
   std::vector<std::string> sceneFiles;
   int sceneIndex = -1;
-  std::deque<float> stageHistory[static_cast<int>(sim::Stage::kCount) + 1];  // + render
+  std::deque<float> stageHistory[static_cast<int>(sim::Stage::kCount) + 2];  // + surface, render
   std::deque<float> fpsHistory;
   double renderMs = 0.0;
   std::chrono::steady_clock::time_point lastFrame = std::chrono::steady_clock::now();
@@ -115,6 +121,36 @@ struct DesktopApp::Impl {
     *dir = glm::normalize(glm::vec3(far) / far.w - *origin);
   }
 
+  /// The mouse's hand as the paddles read it: tracked while the left button is held; the grip placed so
+  /// that the blade's centre is at the mouse's point, the blade's face turned across the screen (a drag
+  /// to the side pushes the water with the face, not the edge).
+  std::vector<interaction::HandInput> HandInputs() const {
+    std::vector<interaction::HandInput> hands(2);
+    interaction::HandInput& h = hands[hand.index];
+    if (!hand.active) return hands;
+    const interaction::PaddleDesc* held = nullptr;
+    for (const interaction::PaddleDesc& d : simScene.paddles) {
+      if (d.holder == (hand.index == 0 ? interaction::Holder::kLeftHand : interaction::Holder::kRightHand)) held = &d;
+    }
+    if (!held) return hands;
+    // The blade's thin axis (body x or z) is turned to the camera's horizontal right vector.
+    const glm::mat4 view = camera.View();
+    glm::vec3 right(view[0][0], 0.0f, view[2][0]);
+    right = glm::length(right) > 1e-6f ? glm::normalize(right) : glm::vec3(1, 0, 0);
+    bool thinX = false;
+    for (const sim::ShapePrimitive& sp : held->shapes) {
+      if (sp.kind == sim::ShapePrimitive::Kind::kBox) thinX = sp.b.x < sp.b.z;
+    }
+    const float theta = thinX ? std::atan2(-right.z, right.x) : std::atan2(right.x, right.z);
+    const glm::quat q = glm::angleAxis(theta, glm::vec3(0, 1, 0));
+    const sim::Vec3 w = PaddleWorkingPoint(held->shapes);
+    const glm::vec3 grip = glm::vec3(hand.position[0], hand.position[1], hand.position[2]) - q * glm::vec3(w.x, w.y, w.z);
+    h.tracked = true;
+    h.pose.position = {grip.x, grip.y, grip.z};
+    h.pose.orientation = {q.w, q.x, q.y, q.z};
+    return hands;
+  }
+
   /// The hand's target: the mouse ray meets the plane through the tank's centre that faces the camera,
   /// clamped to the tank (a hand stays within reach of the water).
   void UpdateHand(bool moved) {
@@ -144,6 +180,33 @@ struct DesktopApp::Impl {
     worker->Reset(setup);
   }
 
+  /// The scene's paddles, and a default paddle for the mouse's hand when no paddle of the scene is
+  /// held by a hand (the mouse then plays the first hand-held paddle's hand).
+  void MakeSimScene() {
+    simScene = SimSceneFromFile(scene);
+    simScene.setup = setup;
+    hand.index = 1;
+    bool handHeld = false;
+    for (const interaction::PaddleDesc& d : simScene.paddles) {
+      if (!handHeld && d.holder != interaction::Holder::kScript) {
+        handHeld = true;
+        hand.index = d.holder == interaction::Holder::kLeftHand ? 0 : 1;
+      }
+    }
+    if (!handHeld) simScene.paddles.push_back(DefaultHandPaddle(setup, hand.index));
+    const float spacing = setup.params.spacing;
+    surfaceCell = simScene.surface.params.cellSize > 0.0f && spacing > 0.0f ? simScene.surface.params.cellSize / spacing : 1.0f;
+    simScene.surface.params.cellSize = surfaceCell * spacing;
+    simScene.surface.enabled = mode == render::RenderMode::kWater;
+  }
+
+  SurfaceRequest Surface() const {
+    SurfaceRequest r = simScene.surface;
+    r.enabled = mode == render::RenderMode::kWater;
+    r.params.cellSize = surfaceCell * setup.params.spacing;
+    return r;
+  }
+
   void LoadSceneFile(const std::string& path) {
     SceneFile next;
     if (Status s = LoadScene(path, &next); !s) {
@@ -152,7 +215,8 @@ struct DesktopApp::Impl {
     }
     scene = next;
     setup = scene.setup;
-    Rebuild();
+    MakeSimScene();
+    worker->Reset(simScene);
     FrameTank();
   }
 
@@ -251,9 +315,10 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
     }
     m.setup.params.spacing = choice.spacing;
   }
-  m.worker = std::make_unique<SimWorker>(solverConfig);
-  if (Status s = m.worker->Start(m.setup); !s) return Status::Error(options.scenePath + ": " + s.message());
   m.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
+  m.MakeSimScene();
+  m.worker = std::make_unique<SimWorker>(solverConfig);
+  if (Status s = m.worker->Start(m.simScene); !s) return Status::Error(options.scenePath + ": " + s.message());
   m.FrameTank();
   *out = std::move(app);
   return Status::Ok();
@@ -316,6 +381,9 @@ void DesktopApp::OnKey(int key) {
 }
 
 const DesktopHand& DesktopApp::Hand() const { return m_impl->hand; }
+std::shared_ptr<const SimSnapshot> DesktopApp::Snapshot() const { return m_impl->shown; }
+float DesktopApp::PanelHaptic() const { return m_impl->panelHaptic; }
+int64_t DesktopApp::SurfaceTriangles() const { return m_impl->surfaceTriangles; }
 bool DesktopApp::Paused() const { return m_impl->worker->Paused(); }
 int DesktopApp::FramesDrawn() const { return m_impl->frames; }
 int DesktopApp::PanelVertexCount() const { return m_impl->panelVertices; }
@@ -358,18 +426,37 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
 
   // Timing graph per stage
   if (ImGui::CollapsingHeader("timing (ms per step / frame)", ImGuiTreeNodeFlags_DefaultOpen)) {
-    for (int s = 0; s <= static_cast<int>(sim::Stage::kCount); ++s) {
+    for (int s = 0; s <= static_cast<int>(sim::Stage::kCount) + 1; ++s) {
       const std::deque<float>& h = stageHistory[s];
       std::vector<float> values(h.begin(), h.end());
-      const char* name = s < static_cast<int>(sim::Stage::kCount) ? sim::StageName(static_cast<sim::Stage>(s)) : "render";
+      const int n = static_cast<int>(sim::Stage::kCount);
+      const char* name = s < n ? sim::StageName(static_cast<sim::Stage>(s)) : s == n ? "surface" : "render";
       const float last = values.empty() ? 0.0f : values.back();
       const float top = values.empty() ? 1.0f : std::max(1e-3f, *std::max_element(values.begin(), values.end()));
       const std::string label = Format("%-9s %6.2f", name, last);
       ImGui::PlotLines(label.c_str(), values.data(), static_cast<int>(values.size()), 0, nullptr, 0.0f, top, ImVec2(180, 22));
     }
-    ImGui::TextDisabled("surface: no surface stage yet (HPMC); water is drawn from the particles");
+    if (mode == render::RenderMode::kWater) {
+      ImGui::TextDisabled("surface: HPMC, %lld triangles, cell %.4f m, %.2f ms per extraction",
+                          static_cast<long long>(snap.surface.TriangleCount()), snap.surfaceCellSize, snap.surfaceMs);
+    } else {
+      ImGui::TextDisabled("surface: not extracted in particle mode");
+    }
   }
 
+  // Paddles: where they are, what the water does to them, what a hand would feel.
+  if (ImGui::CollapsingHeader("paddles", ImGuiTreeNodeFlags_DefaultOpen)) {
+    for (size_t k = 0; k < snap.paddles.size(); ++k) {
+      const PaddlePose& p = snap.paddles[k];
+      const char* who = p.hand == 0 ? "left hand" : p.hand == 1 ? "right hand" : "script";
+      ImGui::Text("%s%s: %s, fluid force %.3f N", who, p.hand == hand.index ? " (mouse)" : "",
+                  interaction::PaddleModeName(p.mode), sim::Length(p.force));
+    }
+    panelHaptic = snap.haptic[hand.index];
+    ImGui::ProgressBar(panelHaptic, ImVec2(180, 0), Format("%.2f", panelHaptic).c_str());
+    ImGui::SameLine();
+    ImGui::Text("haptic (%s)", hand.index == 0 ? "left" : "right");
+  }
   // Parameters: the one registry (app/src/param_registry.h) that scene files and --set read too.
   auto editor = [&](const ParamDesc& p) {
     bool edited = false;
@@ -422,13 +509,14 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     int c = static_cast<int>(color);
     ImGui::Combo("colour (c)", &c, "speed\0density error\0reuse activity\0");
     color = static_cast<render::ParticleColor>(c);
-    static float cellSize = 1.0f;
-    ImGui::BeginDisabled();
-    ImGui::SliderFloat("surface cell (spacings)", &cellSize, 0.5f, 2.0f);
-    ImGui::EndDisabled();
-    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("arrives with the HPMC surface");
+    ImGui::SliderFloat("surface cell (spacings)", &surfaceCell, 0.5f, 2.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp);
+    if (ImGui::IsItemHovered()) {
+      ImGui::SetTooltip("edge of a marching-cubes cell of the water surface, in particle spacings (%.4f m);\n"
+                        "finer is smoother and slower (the scene's surface.cell_size sets the start)",
+                        surfaceCell * setup.params.spacing);
+    }
   }
-  ImGui::TextDisabled("left drag: hand  right drag: orbit  middle drag: pan  wheel: zoom  f: frame");
+  ImGui::TextDisabled("left drag: paddle  right drag: orbit  middle drag: pan  wheel: zoom  f: frame");
   if (hand.active) {
     ImGui::Text("hand target [%.3f %.3f %.3f] m, speed %.2f m/s", hand.position[0], hand.position[1], hand.position[2],
                 std::sqrt(hand.velocity[0] * hand.velocity[0] + hand.velocity[1] * hand.velocity[1] +
@@ -446,29 +534,23 @@ bool DesktopApp::Frame(render::Image* capture) {
   m.lastFrame = now;
 
   // The newest snapshot: drawn again with the newest camera when the simulation has not published.
+  m.worker->SetHands(m.HandInputs());
+  m.worker->SetSurface(m.Surface());
   const std::shared_ptr<const SimSnapshot> snap = m.worker->Latest();
+  m.shown = snap;
   m.simSteps = snap->steps;
   auto push = [](std::deque<float>& h, float v) {
     h.push_back(v);
     while (h.size() > kHistory) h.pop_front();
   };
   for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) push(m.stageHistory[s], static_cast<float>(snap->stageMs[s]));
-  push(m.stageHistory[static_cast<int>(sim::Stage::kCount)], static_cast<float>(m.renderMs));
+  push(m.stageHistory[static_cast<int>(sim::Stage::kCount)], static_cast<float>(snap->surfaceMs));
+  push(m.stageHistory[static_cast<int>(sim::Stage::kCount) + 1], static_cast<float>(m.renderMs));
 
   int fbw = 0, fbh = 0;
   glfwGetFramebufferSize(m.window, &fbw, &fbh);
-  render::FrameScene frame = MakeFrameScene(snap->setup, snap->fluid, m.mode, m.color);
-  if (m.hand.active) {
-    const float size = 0.08f * std::max({snap->setup.tank.max.x - snap->setup.tank.min.x,
-                                         snap->setup.tank.max.y - snap->setup.tank.min.y,
-                                         snap->setup.tank.max.z - snap->setup.tank.min.z});
-    render::SolidMesh handMesh;
-    handMesh.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(m.hand.position[0], m.hand.position[1],
-                                                                          m.hand.position[2])),
-                                glm::vec3(size));
-    handMesh.color = glm::vec3(0.95f, 0.55f, 0.15f);
-    frame.solids.push_back(handMesh);
-  }
+  const render::FrameScene frame = MakeFrameScene(*snap, m.mode, m.color);
+  m.surfaceTriangles = frame.surface.vertexCount / 3;
   const auto t0 = std::chrono::steady_clock::now();
   if (fbw > 0 && fbh > 0) {
     render::View view;

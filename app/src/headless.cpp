@@ -86,13 +86,18 @@ DamBreakMeasure MeasureDamBreak(const DamBreakProbe& probe, const sim::HostFluid
 }  // namespace
 
 std::string UsageText() {
-  return "usage: sphxr [--desktop | --headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
+  return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
          "             [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
          "             [--progress | --no-progress] [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
          "             [--image-size WxH] [--render water|particles] [--quality auto|scene] [--gl-debug]\n"
          "\n"
+         "  --xr              the headset (OpenXR), with a mirror window; the default when a runtime answers.\n"
+         "                    No runtime: one line, then the desktop window. --frame-limit N ends after N\n"
+         "                    frames, --screenshot FILE.png the last mirror image (the left eye);\n"
+         "                    XR_RUNTIME_JSON=build/xr/sim_runtime/sphxr_sim_runtime.json: the simulated\n"
+         "                    headset (docs/xr.md)\n"
          "  --desktop         a window with the water, a panel and a mouse-driven hand (the default when a\n"
          "                    display is present); --window-size WxH, --frame-limit N, --no-vsync\n"
          "  --headless        run without a window (the default without a display)\n"
@@ -394,14 +399,23 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
 
   double nextFrameTime = 0.0;
-  sim::HostFluid frameHost;
+  // A picture is drawn from a snapshot, as in the window: in water mode from the extracted surface mesh
+  // (the scene's "surface" section), with the paddles at their poses.
+  SimSnapshot pictureSnap;
+  auto picture = [&](const std::string& path) -> Status {
+    SurfaceRequest surface;
+    surface.enabled = pictureMode == render::RenderMode::kWater;
+    surface.params = scene.surface.value_or(sim::SurfaceParams{});
+    if (Status s = CaptureSnapshot(*solver, paddles.get(), surface, &pictureSnap); !s) return Status::Error("picture: " + s.message());
+    pictureSnap.setup = scene.setup;
+    return pictures->Write(MakeFrameScene(pictureSnap, pictureMode), path);
+  };
   auto frameNow = [&]() -> Status {
     if (options.framesDir.empty()) return Status::Ok();
-    solver->Download(&frameHost);
     char name[64];
     std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(summary->frames));
     const std::string path = (std::filesystem::path(options.framesDir) / name).string();
-    if (Status s = pictures->Write(MakeFrameScene(scene.setup, frameHost, pictureMode), path); !s) return s;
+    if (Status s = picture(path); !s) return s;
     ++summary->frames;
     nextFrameTime += 1.0 / options.fps;
     return Status::Ok();
@@ -505,7 +519,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
   }
   if (pictures && !options.screenshotPath.empty()) {
-    if (Status s = pictures->Write(MakeFrameScene(scene.setup, host, pictureMode), options.screenshotPath); !s) return s;
+    if (Status s = picture(options.screenshotPath); !s) return s;
   }
 
   std::printf("sphxr summary: %s\n", scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str());

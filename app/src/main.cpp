@@ -1,9 +1,13 @@
-// sphxr: the command line. Picks the mode: --desktop (the default when a display is present), else
-// --headless; a window that cannot open falls back to headless with one line saying why.
+// sphxr: the command line. Picks the mode: --xr (the default when an OpenXR runtime answers and a display
+// is present), else --desktop (the default when a display is present), else --headless. Each fallback is
+// one line saying why: no runtime -> the desktop window; no window -> headless; a session lost mid-run ->
+// the desktop window (or exit when there is no display or the --frame-limit is reached).
 #include <cstdio>
+#include <string>
 
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/headless.h"
+#include "sphxr/app/xr_mode.h"
 #include "sphxr/common/log.h"
 
 int main(int argc, char** argv) {
@@ -17,9 +21,27 @@ int main(int argc, char** argv) {
     std::fputs(sphxr::app::UsageText().c_str(), stdout);
     return 0;
   }
+  // The default: the headset when a runtime answers (asked without creating a session).
+  if (options.mode == Mode::kAuto && sphxr::app::DisplayAvailable() && sphxr::app::XrRuntimeAvailable(nullptr)) {
+    options.mode = Mode::kXr;
+  }
   if (options.mode == Mode::kXr) {
-    SPHXR_LOG_WARN("--xr: the XR layer is not part of this build yet: using the desktop window");
-    options.mode = Mode::kDesktop;
+    sphxr::app::XrOutcome outcome;
+    const sphxr::Status s = sphxr::app::RunXr(options, &outcome);
+    const bool display = sphxr::app::DisplayAvailable();
+    if (s && !outcome.lost) return 0;
+    if (!s && !outcome.fallback) {
+      std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
+      return 1;
+    }
+    const std::string why = s ? "the XR session was lost (" + outcome.message + ")" : s.message();
+    if (s && (!display || (options.frameLimit > 0 && outcome.frames >= options.frameLimit))) {
+      SPHXR_LOG_WARN("%s: exiting", why.c_str());
+      return 0;
+    }
+    SPHXR_LOG_WARN("%s: %s", why.c_str(), display ? "using the desktop window" : "running headless");
+    if (options.frameLimit > 0) options.frameLimit -= static_cast<int>(outcome.frames);
+    options.mode = display ? Mode::kDesktop : Mode::kHeadless;
   }
   bool autoPicture = false;  // a picture nobody asked for must not cost the run when EGL is missing
   if (options.mode == Mode::kAuto) {

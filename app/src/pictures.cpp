@@ -10,6 +10,9 @@
 #include <filesystem>
 #include <sstream>
 
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
 #include "sphxr/common/log.h"
 
 namespace sphxr::app {
@@ -64,6 +67,112 @@ render::FrameScene MakeFrameScene(const sim::SceneSetup& scene, const sim::HostF
   const float smallest = std::min({scene.tank.max.x - scene.tank.min.x, height, scene.tank.max.z - scene.tank.min.z});
   f.absorptionScale = std::max(1.0f, 0.6f / std::max(smallest, 1e-3f));
   f.particles.speedScale = std::sqrt(2.0f * 9.81f * height);  // the free-fall speed over the tank's height
+  return f;
+}
+
+namespace {
+
+struct UnitMesh {
+  std::vector<float> positions, normals;
+  render::MeshView View() const {
+    render::MeshView v;
+    v.positions = positions.data();
+    v.normals = normals.data();
+    v.vertexCount = static_cast<int>(positions.size() / 3);
+    return v;
+  }
+  void Add(glm::vec3 p, glm::vec3 n) {
+    positions.insert(positions.end(), {p.x, p.y, p.z});
+    normals.insert(normals.end(), {n.x, n.y, n.z});
+  }
+};
+
+constexpr int kSegments = 16;
+constexpr float kPi = 3.14159265358979f;
+
+/// Open cylinder of radius 1 along y from 0 to 1 (counter-clockwise seen from outside).
+const UnitMesh& UnitCylinder() {
+  static const UnitMesh mesh = [] {
+    UnitMesh m;
+    for (int i = 0; i < kSegments; ++i) {
+      const float a0 = 2 * kPi * i / kSegments, a1 = 2 * kPi * (i + 1) / kSegments;
+      const glm::vec3 n0(std::cos(a0), 0, -std::sin(a0)), n1(std::cos(a1), 0, -std::sin(a1));
+      const glm::vec3 up(0, 1, 0);
+      m.Add(n0, n0), m.Add(n1, n1), m.Add(n1 + up, n1);
+      m.Add(n0, n0), m.Add(n1 + up, n1), m.Add(n0 + up, n0);
+    }
+    return m;
+  }();
+  return mesh;
+}
+
+/// Sphere of radius 1 at the origin.
+const UnitMesh& UnitSphere() {
+  static const UnitMesh mesh = [] {
+    UnitMesh m;
+    const int rings = kSegments / 2;
+    auto at = [&](int i, int j) {
+      const float theta = kPi * j / rings, phi = 2 * kPi * i / kSegments;
+      return glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
+    };
+    for (int j = 0; j < rings; ++j) {
+      for (int i = 0; i < kSegments; ++i) {
+        const glm::vec3 a = at(i, j), b = at(i, j + 1), c = at(i + 1, j + 1), d = at(i + 1, j);
+        m.Add(a, a), m.Add(b, b), m.Add(c, c);
+        m.Add(a, a), m.Add(c, c), m.Add(d, d);
+      }
+    }
+    return m;
+  }();
+  return mesh;
+}
+
+glm::vec3 G(sim::Vec3 v) { return {v.x, v.y, v.z}; }
+
+}  // namespace
+
+void AppendPaddleSolids(const PaddlePose& paddle, std::vector<render::SolidMesh>* out) {
+  const interaction::Quat& q = paddle.pose.orientation;
+  const glm::mat4 body = glm::translate(glm::mat4(1.0f), G(paddle.pose.position)) *
+                         glm::mat4_cast(glm::quat(q.w, q.x, q.y, q.z));
+  const glm::vec3 color = paddle.hand >= 0 ? glm::vec3(0.95f, 0.55f, 0.15f) : glm::vec3(0.85f, 0.62f, 0.35f);
+  for (const sim::ShapePrimitive& s : paddle.shapes) {
+    render::SolidMesh solid;
+    solid.color = color;
+    if (s.kind == sim::ShapePrimitive::Kind::kBox) {
+      solid.model = glm::scale(glm::translate(body, G(s.a)), 2.0f * G(s.b));  // the unit cube
+      out->push_back(solid);
+      continue;
+    }
+    const glm::vec3 a = G(s.a), b = G(s.b), axis = b - a;
+    const float length = glm::length(axis);
+    glm::mat4 along(1.0f);
+    if (length > 1e-6f) {
+      const glm::vec3 dir = axis / length, y(0, 1, 0);
+      const glm::vec3 c = glm::cross(y, dir);
+      const float sinA = glm::length(c), cosA = glm::dot(y, dir);
+      if (sinA > 1e-6f) along = glm::rotate(glm::mat4(1.0f), std::atan2(sinA, cosA), c / sinA);
+      else if (cosA < 0) along = glm::rotate(glm::mat4(1.0f), kPi, glm::vec3(1, 0, 0));
+      solid.mesh = UnitCylinder().View();
+      solid.model = glm::translate(body, a) * along * glm::scale(glm::mat4(1.0f), glm::vec3(s.radius, length, s.radius));
+      out->push_back(solid);
+    }
+    for (const glm::vec3& end : {a, b}) {
+      solid.mesh = UnitSphere().View();
+      solid.model = glm::scale(glm::translate(body, end), glm::vec3(s.radius));
+      out->push_back(solid);
+    }
+  }
+}
+
+render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMode mode, render::ParticleColor color) {
+  render::FrameScene f = MakeFrameScene(snapshot.setup, snapshot.fluid, mode, color);
+  if (mode == render::RenderMode::kWater && snapshot.surface.VertexCount() > 0) {
+    f.surface.positions = snapshot.surface.positions.data();
+    f.surface.normals = snapshot.surface.normals.data();
+    f.surface.vertexCount = static_cast<int>(snapshot.surface.VertexCount());
+  }
+  for (const PaddlePose& p : snapshot.paddles) AppendPaddleSolids(p, &f.solids);
   return f;
 }
 

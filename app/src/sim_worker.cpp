@@ -1,8 +1,11 @@
 #include "sim_worker.h"
 
+#include <omp.h>
+
 #include <chrono>
 #include <cmath>
 
+#include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
 
 namespace sphxr::app {
@@ -11,22 +14,103 @@ using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 }  // namespace
 
+SimScene SimSceneFromFile(const SceneFile& scene, std::initializer_list<int> hands) {
+  SimScene out;
+  out.setup = scene.setup;
+  out.paddles = scene.paddles;
+  out.paddleFrameRate = scene.paddleFrameRate;
+  out.surface.params = scene.surface.value_or(sim::SurfaceParams{});
+  for (int hand : hands) {
+    const interaction::Holder holder = hand == 0 ? interaction::Holder::kLeftHand : interaction::Holder::kRightHand;
+    bool held = false;
+    for (const interaction::PaddleDesc& d : out.paddles) held = held || d.holder == holder;
+    if (!held) out.paddles.push_back(DefaultHandPaddle(out.setup, hand));
+  }
+  return out;
+}
+
+interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand) {
+  interaction::PaddleDesc d;
+  d.name = hand == 0 ? "left hand" : "right hand";
+  d.holder = hand == 0 ? interaction::Holder::kLeftHand : interaction::Holder::kRightHand;
+  const sim::Aabb& t = setup.tank;
+  // At most 10 cm wide, and no wider than a third of the tank's narrower horizontal side.
+  const float width = std::min(0.1f, std::min(t.max.x - t.min.x, t.max.z - t.min.z) / 3.0f);
+  const float spacing = setup.params.spacing;
+  d.shapes = interaction::BladeOnHandle(1.5f * width, std::max(0.6f * spacing, 0.12f * width), width, 1.2f * width,
+                                        std::max(1.2f * spacing, 0.12f * width));
+  // Full scale at the drag of a brisk 1.4 m/s stroke, 1/2 rho Cd A v^2 with Cd = 2 for a flat plate:
+  // 2 rho A (the blade held still in the water then shows about a tenth, its buoyancy).
+  d.haptics.fullScaleForce = std::max(0.05f, 2.0f * setup.params.restDensity * width * 1.2f * width);
+  return d;
+}
+
 SimWorker::SimWorker(const sim::SolverConfig& config) : m_config(config) {}
 
 SimWorker::~SimWorker() { Stop(); }
 
-Status SimWorker::Start(const sim::SceneSetup& setup) {
-  if (Status s = sim::Solver::Create(setup, m_config, &m_solver); !s) return s;
-  m_setup = setup;
+Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
+                        std::unique_ptr<interaction::PaddleSystem>* paddles) const {
+  sim::SceneSetup setup = scene.setup;
+  paddles->reset();
+  if (!scene.paddles.empty()) {
+    if (Status s = interaction::PaddleSystem::Create(scene.paddles, setup, paddles); !s) return s;
+    (*paddles)->AddBodies(&setup);
+  }
+  if (Status s = sim::Solver::Create(setup, m_config, solver); !s) return s;
+  if (*paddles) {
+    if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
+  }
+  return Status::Ok();
+}
+
+Status SimWorker::Start(const SimScene& scene) {
+  if (Status s = Build(scene, &m_solver, &m_paddles); !s) return s;
+  m_nextPaddleFrame = 0.0;
+  {
+    std::lock_guard lock(m_mutex);
+    m_scene = scene;
+    m_surface = scene.surface;
+  }
   double zero[static_cast<int>(sim::Stage::kCount)] = {};
   Publish(zero, 0.0);
   m_thread = std::thread([this] { Run(); });
   return Status::Ok();
 }
 
+Status SimWorker::Start(const sim::SceneSetup& setup) {
+  SimScene scene;
+  scene.setup = setup;
+  return Start(scene);
+}
+
+void SimWorker::Reset(const SimScene& scene) {
+  std::lock_guard lock(m_mutex);
+  m_pendingReset = std::make_unique<SimScene>(scene);
+  m_wake.notify_all();
+}
+
 void SimWorker::Reset(const sim::SceneSetup& setup) {
   std::lock_guard lock(m_mutex);
-  m_pendingReset = std::make_unique<sim::SceneSetup>(setup);
+  SimScene scene = m_pendingReset ? *m_pendingReset : m_scene;
+  scene.setup = setup;
+  scene.surface = m_surface;
+  m_pendingReset = std::make_unique<SimScene>(std::move(scene));
+  m_wake.notify_all();
+}
+
+void SimWorker::SetHands(const std::vector<interaction::HandInput>& hands) {
+  std::lock_guard lock(m_mutex);
+  m_hands = hands;
+}
+
+void SimWorker::SetSurface(const SurfaceRequest& surface) {
+  std::lock_guard lock(m_mutex);
+  const bool changed = surface.enabled != m_surface.enabled || surface.params.cellSize != m_surface.params.cellSize ||
+                       surface.params.isoLevel != m_surface.params.isoLevel ||
+                       surface.params.margin != m_surface.params.margin;
+  m_surface = surface;
+  if (changed) m_surfaceChanged = true;
   m_wake.notify_all();
 }
 
@@ -58,21 +142,49 @@ void SimWorker::Stop() {
 
 void SimWorker::Publish(double stageMs[], double stepMs) {
   auto snap = std::make_shared<SimSnapshot>();
-  m_solver->Download(&snap->fluid);
-  snap->setup = m_setup;
-  snap->last = m_solver->LastStep();
-  snap->steps = m_solver->GetTotals().steps;
+  SurfaceRequest surface;
+  std::shared_ptr<const SimSnapshot> previous;
+  {
+    std::lock_guard lock(m_mutex);
+    surface = m_surface;
+    previous = m_latest;
+    m_surfaceChanged = false;
+  }
+  // The surface costs about a step or two: extracted again only when it keeps under a fifth of the
+  // worker's time (or the state is about to stand still: paused, a single step, a new cell size).
+  const auto now = Clock::now();
+  const bool reuseSurface = surface.enabled && previous && previous->surfaceFresh && !m_paused &&
+                            previous->surfaceCellSize > 0.0f && previous->steps > 0 &&
+                            previous->surfaceMs * 5e-3 > Seconds(now - m_lastSurface) &&
+                            (surface.params.cellSize <= 0.0f || surface.params.cellSize == previous->surfaceCellSize);
+  SurfaceRequest request = surface;
+  if (reuseSurface) request.enabled = false;
+  if (Status s = CaptureSnapshot(*m_solver, m_paddles.get(), request, snap.get()); !s) {
+    std::lock_guard lock(m_mutex);
+    m_error = "surface: " + s.message();
+  }
+  if (reuseSurface) {
+    snap->surface = previous->surface;
+    snap->surfaceMs = previous->surfaceMs;
+    snap->surfaceCellSize = previous->surfaceCellSize;
+    snap->surfaceFresh = false;
+  } else if (request.enabled) {
+    m_lastSurface = now;
+  }
+  snap->setup = m_scene.setup;
   for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) snap->stageMs[s] = stageMs[s];
   snap->stepMs = stepMs;
   snap->stepsPerSecond = m_rateSteps;
   snap->simSecondsPerWallSecond = m_rateSim;
-  snap->fluidCount = m_solver->FluidCount();
-  snap->boundaryCount = m_solver->BoundaryCount();
   std::lock_guard lock(m_mutex);
   m_latest = std::move(snap);
 }
 
 void SimWorker::Run() {
+  // The CPU backend's team size is an OpenMP setting of the thread that made the solver (Start ran on
+  // the caller's thread): without this the worker's steps ran with the default team, whose spinning
+  // threads fought the renderer's for the cores (a 3.5 ms step took 650 ms under Xvfb + llvmpipe).
+  omp_set_num_threads(m_config.threads > 0 ? m_config.threads : omp_get_num_procs());
   // Real-time pacing: simulated time may not run ahead of wall time (anchored again after a pause).
   Clock::time_point anchorWall = Clock::now();
   double anchorSim = m_solver->Time();
@@ -94,23 +206,27 @@ void SimWorker::Run() {
     dirty = false;
   };
   while (!m_stop) {
-    std::unique_ptr<sim::SceneSetup> reset;
+    std::unique_ptr<SimScene> reset;
     {
       std::lock_guard lock(m_mutex);
       reset = std::move(m_pendingReset);
     }
     if (reset) {
       std::unique_ptr<sim::Solver> fresh;
-      const Status s = sim::Solver::Create(*reset, m_config, &fresh);
+      std::unique_ptr<interaction::PaddleSystem> freshPaddles;
+      const Status s = Build(*reset, &fresh, &freshPaddles);
       if (!s) {
         SPHXR_LOG_WARN("scene rebuild refused: %s", s.message().c_str());
         std::lock_guard lock(m_mutex);
         m_error = s.message();
       } else {
+        m_paddles = std::move(freshPaddles);  // bound to the old solver: replaced first
         m_solver = std::move(fresh);
-        m_setup = *reset;
+        m_nextPaddleFrame = 0.0;
         {
-          std::lock_guard lock(m_mutex);
+          std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
+          m_scene = *reset;
+          m_surface = m_scene.surface;
           m_error.clear();
         }
         anchorWall = Clock::now();
@@ -123,8 +239,13 @@ void SimWorker::Run() {
       }
     }
     const bool stepRequested = m_stepRequests.load() > 0;
+    bool surfaceChanged;
+    {
+      std::lock_guard lock(m_mutex);
+      surfaceChanged = m_surfaceChanged;
+    }
     if (m_paused && !stepRequested) {
-      if (dirty) publishNow(Clock::now());  // the last steps before the pause are shown
+      if (dirty || surfaceChanged) publishNow(Clock::now());  // the last steps before the pause are shown
       std::unique_lock lock(m_mutex);
       m_wake.wait_for(lock, std::chrono::milliseconds(20));
       anchorWall = Clock::now();
@@ -135,11 +256,26 @@ void SimWorker::Run() {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));  // ahead of real time
     } else {
       if (stepRequested) --m_stepRequests;
+      if (m_paddles && m_solver->Time() >= m_nextPaddleFrame - 1e-9) {
+        // A paddle frame: the newest hands become the paddles' targets one frame ahead in simulated time.
+        m_nextPaddleFrame = m_solver->Time() + 1.0 / m_scene.paddleFrameRate;
+        std::vector<interaction::HandInput> hands;
+        {
+          std::lock_guard lock(m_mutex);
+          hands = m_hands;
+        }
+        for (interaction::HandInput& h : hands) h.time = m_nextPaddleFrame;
+        if (Status s = m_paddles->BeginFrame(m_nextPaddleFrame, hands); !s) {
+          std::lock_guard lock(m_mutex);
+          m_error = s.message();
+        }
+      }
       if (Status s = m_solver->Step(); !s) {
         std::lock_guard lock(m_mutex);
         m_error = s.message();
         m_paused = true;
       }
+      if (m_paddles) m_paddles->AfterStep();
       if (!std::isfinite(m_solver->LastStep().maxSpeed)) {
         std::lock_guard lock(m_mutex);
         m_error = "the simulation became non-finite: press reset, and lower the time step or raise the stiffness";

@@ -1,42 +1,64 @@
 #pragma once
 // The simulation on its own thread, so the frame loop never waits on it. The worker steps the solver
-// (no faster than real time), and publishes a snapshot of the particles at most ~60 times a second;
-// the frame loop draws the newest snapshot with the newest camera, again and again when a step is
-// slower than a frame.
+// (no faster than real time) with the paddles driven by the newest hands (SetHands), and publishes a
+// snapshot (particles, the water surface, the paddles' poses, the haptic amplitudes) at most ~60 times
+// a second; the frame loop draws the newest snapshot with the newest camera, again and again when a
+// step is slower than a frame.
 #include <atomic>
+#include <chrono>
+#include <initializer_list>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
+#include "sphxr/app/snapshot.h"
 #include "sphxr/common/status.h"
+#include "sphxr/interaction/hand.h"
+#include "sphxr/interaction/paddle.h"
 #include "sphxr/sim/solver.h"
 
 namespace sphxr::app {
 
-struct SimSnapshot {
-  sim::HostFluid fluid;
+struct SceneFile;
+
+/// What the worker runs: the scene without the paddles' bodies (the worker samples the paddles at the
+/// scene's spacing and adds them on every (re)build), the paddles, and the surface to extract.
+struct SimScene {
   sim::SceneSetup setup;
-  sim::StepInfo last;
-  int64_t steps = 0;
-  double stageMs[static_cast<int>(sim::Stage::kCount)] = {};  // of the steps since the last snapshot
-  double stepMs = 0.0;                                         // mean wall ms per step since the last snapshot
-  double stepsPerSecond = 0.0;                                 // measured over the last half second
-  double simSecondsPerWallSecond = 0.0;                        // measured over the last half second
-  int fluidCount = 0, boundaryCount = 0;
+  std::vector<interaction::PaddleDesc> paddles;
+  double paddleFrameRate = 90.0;  // Hz (simulated): the paddles get the newest hands' targets this often
+  SurfaceRequest surface;
 };
+
+/// The scene file's scene, with a default hand-held paddle (interaction::BladeOnHandle sized to the
+/// tank) for each hand in `hands` (0 left, 1 right) that no paddle of the scene is held by.
+SimScene SimSceneFromFile(const SceneFile& scene, std::initializer_list<int> hands = {});
+/// The default paddle for a hand: a blade on a handle, at most 10 cm wide, narrower in a small tank.
+interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand);
 
 class SimWorker {
  public:
   SimWorker(const sim::SolverConfig& config);
   ~SimWorker();
 
-  /// Builds the solver for `setup` on the calling thread (so errors come back here), then starts the thread.
-  Status Start(const sim::SceneSetup& setup);
+  /// Builds the solver for the scene on the calling thread (so errors come back here), then starts the thread.
+  Status Start(const SimScene& scene);
+  Status Start(const sim::SceneSetup& setup);  // no paddles, the default surface
   /// Replaces the scene (spacing, parameters, a new scene file): the worker rebuilds the solver.
   /// Errors are reported by LastError() and the old scene keeps running.
+  void Reset(const SimScene& scene);
+  /// The same paddles and surface with new parameters.
   void Reset(const sim::SceneSetup& setup);
+  /// The hands that drive the hand-held paddles (index 0 left, 1 right; missing or untracked hands: the
+  /// paddle holds, then withdraws). The worker uses the newest hands for each paddle frame (every
+  /// 1/paddleFrameRate simulated s) and sets their `time` to that frame's simulated time. Poses are in
+  /// the simulation's world frame; a measured velocity (hasVelocity) is taken as per simulated second.
+  void SetHands(const std::vector<interaction::HandInput>& hands);
+  /// Surface extraction for the snapshots (off in particle mode; the cell size from the panel).
+  void SetSurface(const SurfaceRequest& surface);
   void SetPaused(bool paused);
   bool Paused() const { return m_paused.load(); }
   void StepOnce();
@@ -48,19 +70,27 @@ class SimWorker {
  private:
   void Run();
   void Publish(double stageMs[], double stepMs);
+  Status Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
+               std::unique_ptr<interaction::PaddleSystem>* paddles) const;
 
   sim::SolverConfig m_config;
   std::unique_ptr<sim::Solver> m_solver;
-  sim::SceneSetup m_setup;
+  std::unique_ptr<interaction::PaddleSystem> m_paddles;
+  SimScene m_scene;
+  double m_nextPaddleFrame = 0.0;
   std::thread m_thread;
   mutable std::mutex m_mutex;
   std::condition_variable m_wake;
   std::shared_ptr<const SimSnapshot> m_latest;
-  std::unique_ptr<sim::SceneSetup> m_pendingReset;
+  std::unique_ptr<SimScene> m_pendingReset;
+  std::vector<interaction::HandInput> m_hands;  // guarded by m_mutex
+  SurfaceRequest m_surface;                     // guarded by m_mutex
+  bool m_surfaceChanged = false;                // guarded by m_mutex
   std::string m_error;
   std::atomic<bool> m_stop{false}, m_paused{false};
   std::atomic<int> m_stepRequests{0};
   double m_rateSteps = 0.0, m_rateSim = 0.0;
+  std::chrono::steady_clock::time_point m_lastSurface{};
 };
 
 }  // namespace sphxr::app

@@ -12,13 +12,17 @@
 
 namespace sphxr::app {
 
-/// Where the mouse-driven hand wants to be, in world coordinates. Until the paddles land, nothing moves
-/// in the water: the app draws the hand, and the lead wires this to sphxr::interaction::HandInput.
+/// The mouse-driven hand: while the left button is held, where the mouse puts the blade of the paddle
+/// it holds (world coordinates). The window sends it to the simulation thread as an
+/// interaction::HandInput (SimWorker::SetHands), which drives a real paddle (interaction::PaddleSystem).
 struct DesktopHand {
-  bool active = false;                // a button is held over the scene
-  std::array<float, 3> position{};    // m, target of the hand
+  bool active = false;                // the left button is held over the scene: the hand is tracked
+  std::array<float, 3> position{};    // m, target of the paddle's blade centre
   std::array<float, 3> velocity{};    // m/s, finite difference over the last frame
+  int index = 1;                      // the hand the mouse plays (0 left, 1 right)
 };
+
+struct SimSnapshot;
 
 class DesktopApp {
  public:
@@ -43,6 +47,12 @@ class DesktopApp {
   void OnKey(int key);
 
   const DesktopHand& Hand() const;
+  /// The snapshot drawn by the last frame (paddle poses, haptics, surface); null before the first frame.
+  std::shared_ptr<const SimSnapshot> Snapshot() const;
+  /// The haptic amplitude of the mouse's hand as the panel showed it in the last frame (0..1).
+  float PanelHaptic() const;
+  /// Surface triangles drawn by the last frame (0: no surface mesh, e.g. particle mode).
+  int64_t SurfaceTriangles() const;
   bool Paused() const;
   int FramesDrawn() const;
   int PanelVertexCount() const;  // ImGui vertices of the last frame (0: the panel did not draw)

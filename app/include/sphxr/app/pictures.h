@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "sphxr/app/snapshot.h"
 #include "sphxr/common/status.h"
 #include "sphxr/render/gl_context.h"
 #include "sphxr/render/renderer.h"
@@ -17,10 +18,19 @@ Status WritePng(const std::string& path, const render::Image& image);
 /// Reads a PNG into RGBA rows bottom-up (tests).
 Status ReadPng(const std::string& path, render::Image* out);
 
-/// The FrameScene of a scene's tank and obstacles with the particles of `fluid` (no surface mesh yet:
-/// water mode draws the particles as water). The arrays of `fluid` must outlive the returned scene.
+/// The FrameScene of a scene's tank and obstacles with the particles of `fluid` (no surface mesh: water
+/// mode draws the particles as water). The arrays of `fluid` must outlive the returned scene.
 render::FrameScene MakeFrameScene(const sim::SceneSetup& scene, const sim::HostFluid& fluid, render::RenderMode mode,
                                   render::ParticleColor color = render::ParticleColor::kSpeed);
+
+/// The full FrameScene of a snapshot, what the desktop window, the headset and headless pictures draw:
+/// tank, obstacles, particles, the water surface (water mode, when the snapshot has one; else the
+/// particles are drawn as water) and the paddles (render::SolidMesh per box and capsule at the body's
+/// pose). The snapshot must outlive the returned scene.
+render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMode mode,
+                                  render::ParticleColor color = render::ParticleColor::kSpeed);
+/// The solids of one paddle at its pose (appended to `out`).
+void AppendPaddleSolids(const PaddlePose& paddle, std::vector<render::SolidMesh>* out);
 
 /// Renders frames of a run into PNG files without a display.
 class OfflinePictures {

@@ -1,0 +1,64 @@
+#pragma once
+// One published state of a running simulation: what every picture of it is drawn from (the desktop
+// window, the headset, headless PNGs). Plain host data, copied out of the solver between steps, so a
+// frame can be drawn from it on another thread while the solver goes on.
+#include <cstdint>
+#include <vector>
+
+#include "sphxr/common/status.h"
+#include "sphxr/interaction/paddle.h"
+#include "sphxr/sim/params.h"
+#include "sphxr/sim/solver.h"
+#include "sphxr/sim/surface.h"
+
+namespace sphxr::app {
+
+/// A paddle as it is drawn: its solid in the body frame at the body's pose in the solver.
+struct PaddlePose {
+  std::vector<sim::ShapePrimitive> shapes;  // body frame
+  interaction::Pose pose;                   // where the solver has the body now (world)
+  int hand = -1;                            // 0 left, 1 right, -1 scripted
+  interaction::PaddleMode mode = interaction::PaddleMode::kFollowing;
+  sim::Vec3 force;                          // fluid on the paddle, filtered, N
+  float haptic = 0.0f;                      // 0..1
+};
+
+struct SimSnapshot {
+  sim::HostFluid fluid;
+  sim::SceneSetup setup;
+  sim::StepInfo last;
+  int64_t steps = 0;
+  double stageMs[static_cast<int>(sim::Stage::kCount)] = {};  // of the steps since the last snapshot
+  double stepMs = 0.0;                                         // mean wall ms per step since the last snapshot
+  double stepsPerSecond = 0.0;                                 // measured over the last half second
+  double simSecondsPerWallSecond = 0.0;                        // measured over the last half second
+  int fluidCount = 0, boundaryCount = 0;
+
+  /// The water surface (HPMC, sim/include/sphxr/sim/surface.h) of this state; empty when extraction
+  /// is off (particle mode) or nothing was extracted yet.
+  sim::SurfaceMesh surface;
+  double surfaceMs = 0.0;        // wall ms of the extraction that made `surface`
+  float surfaceCellSize = 0.0f;  // m, the cell size it was extracted with
+  bool surfaceFresh = false;     // extracted for this state (else the previous state's mesh, kept to save time)
+
+  /// Paddles (interaction::PaddleSystem) and what the hands feel: haptic amplitude 0..1 per hand
+  /// (index 0 left, 1 right; PaddleSystem::HapticAmplitude).
+  std::vector<PaddlePose> paddles;
+  float haptic[2] = {0.0f, 0.0f};
+};
+
+/// The body-frame point a mouse places: the centre of the paddle's lowest primitive (the blade).
+sim::Vec3 PaddleWorkingPoint(const std::vector<sim::ShapePrimitive>& shapes);
+
+/// What to extract for a snapshot's surface.
+struct SurfaceRequest {
+  bool enabled = true;
+  sim::SurfaceParams params;  // cellSize 0: the particle spacing
+};
+
+/// Copies the solver's state into `out` (fluid, step info, counts), the paddles' poses and loads
+/// (`paddles` may be null) and, when `surface.enabled`, extracts the surface (timed).
+Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* paddles, const SurfaceRequest& surface,
+                       SimSnapshot* out);
+
+}  // namespace sphxr::app

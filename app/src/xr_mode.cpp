@@ -1,0 +1,434 @@
+#include "sphxr/app/xr_mode.h"
+
+// GL entry points from libepoxy; GLFW must not include its own GL header.
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <memory>
+#include <span>
+#include <thread>
+#include <vector>
+
+#include "sim_worker.h"
+#include "sphxr/app/desktop.h"
+#include "sphxr/app/pictures.h"
+#include "sphxr/app/quality.h"
+#include "sphxr/app/scene_file.h"
+#include "sphxr/common/log.h"
+#include "sphxr/interaction/hand.h"
+#include "sphxr/render/renderer.h"
+#include "sphxr/xr/session.h"
+
+// From glfw3native.h (which would also pull in Xlib.h and its macros): the X display GLFW opened.
+extern "C" struct _XDisplay* glfwGetX11Display(void);
+
+namespace sphxr::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string g_glfwError;
+void GlfwError(int code, const char* text) { g_glfwError = Format("%s (GLFW 0x%x)", text, code); }
+
+// ---- The hand-off to the simulation: hands in, haptics and the frame out. ----
+void SendHands(SimWorker& worker, const std::vector<interaction::HandInput>& hands) { worker.SetHands(hands); }
+float HapticAmplitude(const SimSnapshot& snap, int hand) { return snap.haptic[hand]; }
+render::FrameScene BuildFrameScene(const SimSnapshot& snap, render::RenderMode mode, render::ParticleColor color) {
+  return MakeFrameScene(snap, mode, color);  // surface mesh (or particles), paddles, tank
+}
+// ---- end of the hand-off ----
+
+glm::mat4 ToGlm(const xr::Mat4& m) { return glm::make_mat4(m.m.data()); }
+
+/// A paddle hangs from the hand along its body -y (paddle.h: blade below the grip); a controller's
+/// grip points along its -z. Body -> grip: +90 degrees about x (body -y becomes grip -z).
+constexpr xr::Quat kGripFromPaddle{0.70710678f, 0.0f, 0.0f, 0.70710678f};
+
+/// Where a hand's paddle may go: over the tank (5 cm beyond its sides) from its floor to 0.5 m above its
+/// top. A hand elsewhere (resting at the user's side, reaching past the tank) does not drag its paddle
+/// through the walls and floor: it counts as untracked, so the paddle holds, then withdraws above the
+/// water (paddle.h), and re-enters when the hand comes back.
+bool InReach(const sim::Vec3& p, const sim::Aabb& tank) {
+  constexpr float kSide = 0.05f, kAbove = 0.5f;
+  return p.x >= tank.min.x - kSide && p.x <= tank.max.x + kSide && p.z >= tank.min.z - kSide &&
+         p.z <= tank.max.z + kSide && p.y >= tank.min.y && p.y <= tank.max.y + kAbove;
+}
+
+interaction::HandInput ToHandInput(const xr::HandState& h, const sim::Vec3& offset, const sim::Aabb& tank,
+                                   double timeSeconds) {
+  interaction::HandInput in;
+  in.pose.position = {h.grip.position.x - offset.x, h.grip.position.y - offset.y, h.grip.position.z - offset.z};
+  in.tracked = h.poseValid && h.tracked && InReach(in.pose.position, tank);
+  const xr::Quat q = h.grip.orientation * kGripFromPaddle;
+  in.pose.orientation = {q.w, q.x, q.y, q.z};
+  in.hasVelocity = h.velocityValid;
+  in.linearVelocity = {h.linearVelocity.x, h.linearVelocity.y, h.linearVelocity.z};
+  in.angularVelocity = {h.angularVelocity.x, h.angularVelocity.y, h.angularVelocity.z};
+  in.trigger = h.trigger;
+  in.grip = h.squeeze;
+  in.time = timeSeconds;
+  return in;
+}
+
+double MeanSpeed(const sim::HostFluid& fluid) {
+  double sum = 0.0;
+  for (const sim::Vec4& v : fluid.velocity) sum += std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  return fluid.velocity.empty() ? 0.0 : sum / static_cast<double>(fluid.velocity.size());
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
+}
+
+/// Everything an XR run owns, destroyed in the order GL needs (the session's GL objects first, with
+/// the context current; the window last).
+struct XrApp {
+  Options options;
+  SceneFile scene;
+  sim::SceneSetup setup;  // the scene at the spacing in use
+  SimScene simScene;      // with a paddle for each hand; what reset restores
+  sim::Vec3 offset;       // play = sim + offset
+  GLFWwindow* window = nullptr;
+  bool imguiReady = false;
+  std::unique_ptr<render::Renderer> renderer;
+  std::unique_ptr<xr::Session> session;
+  std::unique_ptr<SimWorker> worker;
+  render::RenderMode mode = render::RenderMode::kWater;
+  render::ParticleColor color = render::ParticleColor::kSpeed;
+  float lastHaptic[xr::kHandCount] = {0, 0};
+  bool exitRequested = false;
+
+  ~XrApp() {
+    if (worker) worker->Stop();
+    if (window) glfwMakeContextCurrent(window);
+    session.reset();
+    renderer.reset();
+    if (imguiReady) {
+      ImGui_ImplOpenGL3_Shutdown();
+      ImGui_ImplGlfw_Shutdown();
+      ImGui::DestroyContext();
+    }
+    if (window) glfwDestroyWindow(window);
+    if (window || imguiReady) glfwTerminate();
+  }
+
+  void Panel(const SimSnapshot& snap, const XrOutcome& out) {
+    ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
+    ImGui::Begin("sphxr --xr");
+    ImGui::Text("%s, %dx%d per eye", session->runtimeName().c_str(), session->eyeWidth(), session->eyeHeight());
+    ImGui::Text("%s", xr::SessionStateName(session->state()));
+    if (ImGui::Button(worker->Paused() ? "run" : "pause")) worker->SetPaused(!worker->Paused());
+    ImGui::SameLine();
+    if (ImGui::Button("reset")) worker->Reset(simScene);
+    ImGui::SameLine();
+    if (ImGui::Button("end session")) RequestExit();
+    ImGui::Text("%d fluid + %d boundary particles", snap.fluidCount, snap.boundaryCount);
+    ImGui::Text("t = %.3f s, %.3g simulated s per wall s", snap.last.time, snap.simSecondsPerWallSecond);
+    const xr::FrameTimings& t = session->lastFrameTimings();
+    ImGui::Text("frame %lld: wait %.2f, update %.2f, eyes %.2f ms", static_cast<long long>(out.frames), t.waitMs,
+                t.updateMs, t.renderMs);
+    int m = static_cast<int>(mode);
+    ImGui::RadioButton("water", &m, 0);
+    ImGui::SameLine();
+    ImGui::RadioButton("particles", &m, 1);
+    if (m != static_cast<int>(mode)) {
+      mode = static_cast<render::RenderMode>(m);
+      SurfaceRequest surface = simScene.surface;
+      surface.enabled = mode == render::RenderMode::kWater;  // no surface extraction for particles
+      worker->SetSurface(surface);
+    }
+    const std::string error = worker->LastError();
+    if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
+    ImGui::End();
+  }
+
+  void RequestExit() {
+    if (exitRequested) return;
+    exitRequested = true;
+    if (Status s = session->RequestExit(); !s) SPHXR_LOG_WARN("%s", s.message().c_str());
+  }
+
+  /// The left eye's image, fitted into the window (aspect kept), while the image is still ours.
+  void Mirror(const xr::EyeView& eye) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window, &w, &h);
+    if (w <= 0 || h <= 0) return;
+    const float scale = std::min(static_cast<float>(w) / eye.width, static_cast<float>(h) / eye.height);
+    const int dw = static_cast<int>(eye.width * scale), dh = static_cast<int>(eye.height * scale);
+    const int dx = (w - dw) / 2, dy = (h - dh) / 2;
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glDisable(GL_SCISSOR_TEST);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, eye.framebuffer);
+    glBlitFramebuffer(eye.x, eye.y, eye.x + eye.width, eye.y + eye.height, dx, dy, dx + dw, dy + dh,
+                      GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer);  // xr restores its own binding after
+  }
+};
+
+Status OpenWindowAndSession(XrApp& app, XrOutcome* outcome) {
+  const Options& options = app.options;
+  glfwSetErrorCallback(GlfwError);
+  g_glfwError.clear();
+  if (!glfwInit()) return Status::Error("cannot open the mirror window: " + g_glfwError);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  render::RendererConfig config;
+  config.debug = config.debug || options.glDebug;
+  glfwWindowHint(GLFW_OPENGL_DEBUG_CONTEXT, config.debug ? GLFW_TRUE : GLFW_FALSE);
+  app.window = glfwCreateWindow(options.windowWidth, options.windowHeight, "sphxr (headset mirror: left eye)",
+                                nullptr, nullptr);
+  if (!app.window) {
+    glfwTerminate();
+    return Status::Error("cannot open an OpenGL 4.5 core window for the headset: " + g_glfwError);
+  }
+  glfwMakeContextCurrent(app.window);
+  glfwSwapInterval(0);  // the headset paces the loop, not the mirror
+  if (Status s = render::Renderer::Create(config, &app.renderer); !s) return s;
+
+  xr::GraphicsBinding binding;
+  binding.getProcAddress = [](const char* name) { return reinterpret_cast<void*>(glfwGetProcAddress(name)); };
+  if (Status s = xr::CurrentXlibGlxBinding(glfwGetX11Display(), &binding); !s) return s;
+  if (Status s = xr::Session::Create({}, binding, &app.session); !s) return s;
+  outcome->started = true;
+  SPHXR_LOG_INFO("headset: runtime '%s', %dx%d per eye, %s", app.session->runtimeName().c_str(),
+                 app.session->eyeWidth(), app.session->eyeHeight(), render::GlDescription());
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(app.window, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+  app.imguiReady = true;
+  return Status::Ok();
+}
+
+Status StartSimulation(XrApp& app) {
+  const Options& options = app.options;
+  sim::SolverConfig solverConfig;
+  solverConfig.device = options.device;
+  solverConfig.threads = options.threads;
+  if (options.threads == 0) {
+    // One core is left to the frame loop (and llvmpipe's rasteriser, on machines without a GPU).
+    solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
+  }
+  if (options.quality != 0 && options.spacing <= 0.0f) {
+    QualityChoice choice;
+    if (Status s = ChooseQuality(app.setup, solverConfig, 1.0, 1.0, &choice); !s) {
+      return Status::Error(options.scenePath + ": " + s.message());
+    }
+    app.setup.params.spacing = choice.spacing;
+  }
+  // Each controller holds a paddle: the scene's hand-held ones, else the default blade on a handle
+  // (sized at the spacing in use).
+  SceneFile atSpacing = app.scene;
+  atSpacing.setup = app.setup;
+  app.simScene = SimSceneFromFile(atSpacing, {0, 1});
+  app.simScene.surface.enabled = app.mode == render::RenderMode::kWater;
+  app.worker = std::make_unique<SimWorker>(solverConfig);
+  if (Status s = app.worker->Start(app.simScene); !s) return Status::Error(options.scenePath + ": " + s.message());
+  return Status::Ok();
+}
+
+}  // namespace
+
+sim::Vec3 XrSceneOffset(const sim::Aabb& tank, const XrPlacement& placement) {
+  return {placement.centerX - 0.5f * (tank.min.x + tank.max.x), placement.centerY - 0.5f * (tank.min.y + tank.max.y),
+          placement.centerZ - 0.5f * (tank.min.z + tank.max.z)};
+}
+
+bool XrRuntimeAvailable(std::string* why) {
+  const Status s = xr::ProbeRuntime();
+  if (!s && why) *why = s.message();
+  return static_cast<bool>(s);
+}
+
+Status RunXr(const Options& options, XrOutcome* outcome) {
+  *outcome = XrOutcome{};
+  XrApp app;
+  app.options = options;
+  if (Status s = LoadScene(options.scenePath, &app.scene); !s) return s;
+  for (const std::string& set : options.sets) {
+    if (Status s = SetSolverParam(&app.scene.setup, set); !s) return s;
+  }
+  if (options.spacing > 0.0f) app.scene.setup.params.spacing = options.spacing;
+  if (options.reuse >= 0) app.scene.setup.reuse.enabled = options.reuse == 1;
+  app.setup = app.scene.setup;
+  app.offset = XrSceneOffset(app.setup.tank);
+  app.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
+
+  if (!DisplayAvailable()) {
+    outcome->fallback = true;
+    return Status::Error("the headset needs a display for its mirror window and GL context (DISPLAY is not set)");
+  }
+  if (Status s = xr::ProbeRuntime(); !s) {  // before a window opens for nothing
+    outcome->fallback = true;
+    return s;
+  }
+  if (Status s = OpenWindowAndSession(app, outcome); !s) {
+    outcome->fallback = true;
+    return s;
+  }
+  if (Status s = StartSimulation(app); !s) return s;
+
+  const glm::mat4 sceneToPlay = glm::translate(glm::mat4(1.0f), glm::vec3(app.offset.x, app.offset.y, app.offset.z));
+  std::vector<double> intervals, busy;
+  std::shared_ptr<const SimSnapshot> previousSnap;
+  render::Image lastMirror;  // --screenshot: the window's last mirror image
+  Clock::time_point previousFrame{};
+  int64_t previousPeriodNs = 0;
+  const auto started = Clock::now();
+  while (true) {
+    glfwPollEvents();
+    if (glfwWindowShouldClose(app.window) || (options.frameLimit > 0 && outcome->frames >= options.frameLimit)) {
+      app.RequestExit();
+    }
+    const xr::EventResult ev = app.session->PollEvents();
+    for (xr::SessionState state : ev.transitions) {
+      outcome->states += (outcome->states.empty() ? "" : " ") + std::string(xr::SessionStateName(state));
+    }
+    if (ev.exit) {
+      outcome->lost = ev.lost;
+      outcome->message = ev.message;
+      break;
+    }
+    if (!ev.running) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      continue;
+    }
+    // The newest snapshot: drawn again when the simulation has not published since the last frame.
+    const std::shared_ptr<const SimSnapshot> snap = app.worker->Latest();
+    if (snap != previousSnap) {  // how much the water moves (the tests compare a stirred tank with a still one)
+      outcome->peakMeanFluidSpeed = std::max(outcome->peakMeanFluidSpeed, MeanSpeed(snap->fluid));
+      previousSnap = snap;
+    }
+    render::FrameScene frame;
+    bool mirrored = false;
+    const Status f = app.session->Frame(
+        [&](const xr::FrameInfo& info) {
+          ++outcome->frames;
+          const Clock::time_point now = Clock::now();
+          if (previousFrame != Clock::time_point{}) {
+            const double ms = std::chrono::duration<double, std::milli>(now - previousFrame).count();
+            intervals.push_back(ms);
+            if (previousPeriodNs > 0 && ms > 1.5e-6 * static_cast<double>(previousPeriodNs)) ++outcome->lateFrames;
+          }
+          previousFrame = now;
+          previousPeriodNs = info.displayPeriodNs;
+
+          const double displayTime = 1e-9 * static_cast<double>(info.predictedDisplayTimeNs);
+          std::vector<interaction::HandInput> hands;
+          for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, app.setup.tank, displayTime));
+          SendHands(*app.worker, hands);
+          for (int h = 0; h < xr::kHandCount; ++h) {
+            float amplitude = HapticAmplitude(*snap, h);
+            if (amplitude < 0.01f) amplitude = 0.0f;
+            if (amplitude == 0.0f && app.lastHaptic[h] == 0.0f) continue;  // stop once, not every frame
+            app.lastHaptic[h] = amplitude;
+            if (Status hs = app.session->ApplyHaptics(static_cast<xr::Hand>(h), amplitude); !hs) {
+              LogOnce("xr-haptics", LogLevel::kWarn, "%s", hs.message().c_str());
+            }
+          }
+          if (info.resetRequested) {
+            SPHXR_LOG_INFO("reset button: the scene starts again");
+            app.worker->Reset(app.simScene);
+          }
+          frame = BuildFrameScene(*snap, app.mode, app.color);
+        },
+        [&](const xr::FrameInfo&, const xr::EyeView& eye) {
+          // The renderer writes display-ready colour (the desktop window shows its bytes as they are):
+          // no second sRGB encoding, so the headset looks like the desktop window.
+          glDisable(GL_FRAMEBUFFER_SRGB);
+          render::View view;
+          view.view = ToGlm(eye.view) * sceneToPlay;
+          view.projection = ToGlm(eye.projection);
+          view.framebuffer = eye.framebuffer;
+          view.x = eye.x;
+          view.y = eye.y;
+          view.width = eye.width;
+          view.height = eye.height;
+          app.renderer->Draw(frame, std::span(&view, 1));
+          if (eye.eye == 0) {
+            app.Mirror(eye);
+            if (!options.screenshotPath.empty()) {  // the mirror as blitted, before the panel
+              int w = 0, h = 0;
+              glfwGetFramebufferSize(app.window, &w, &h);
+              if (w > 0 && h > 0) lastMirror = render::ReadPixels(0, 0, 0, w, h);
+              glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer);
+            }
+            mirrored = true;
+            ++outcome->rendered;
+          }
+        });
+    if (!f) {
+      // A failing frame call is a lost session in all but name: end it the same way.
+      SPHXR_LOG_WARN("%s", f.message().c_str());
+      outcome->lost = true;
+      outcome->message = f.message();
+      break;
+    }
+    const xr::FrameTimings& t = app.session->lastFrameTimings();
+    busy.push_back(t.syncMs + t.updateMs + t.renderMs + t.endMs);
+    if (mirrored) {
+      int w = 0, h = 0;
+      glfwGetFramebufferSize(app.window, &w, &h);
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      glViewport(0, 0, w, h);
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+      app.Panel(*snap, *outcome);
+      ImGui::Render();
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      glfwSwapBuffers(app.window);
+    }
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  if (!options.screenshotPath.empty()) {
+    if (lastMirror.width == 0) {
+      SPHXR_LOG_WARN("--screenshot %s: no frame was drawn, no picture", options.screenshotPath.c_str());
+    } else if (Status s = WritePng(options.screenshotPath, lastMirror); !s) {
+      SPHXR_LOG_WARN("%s", s.message().c_str());
+    } else {
+      SPHXR_LOG_INFO("mirror picture (the left eye, without the panel): %s (%dx%d)", options.screenshotPath.c_str(),
+                     lastMirror.width, lastMirror.height);
+    }
+  }
+  outcome->frameMsP50 = Percentile(intervals, 0.5);
+  outcome->frameMsP90 = Percentile(intervals, 0.9);
+  outcome->busyMsP50 = Percentile(busy, 0.5);
+  outcome->busyMsP90 = Percentile(busy, 0.9);
+  const std::shared_ptr<const SimSnapshot> last = app.worker->Latest();
+  outcome->meanFluidSpeed = MeanSpeed(last->fluid);
+  outcome->peakMeanFluidSpeed = std::max(outcome->peakMeanFluidSpeed, outcome->meanFluidSpeed);
+  std::printf("sphxr --xr: %s after %lld frames (%lld drawn) in %.1f s; frame interval p50 %.2f / p90 %.2f ms, "
+              "busy (all but xrWaitFrame) p50 %.2f / p90 %.2f ms, %lld late; simulation at t = %.3f s, %lld steps, "
+              "mean fluid speed %.4f m/s (peak %.4f); last snapshot: %.2f ms per step, surface %.2f ms\n",
+              outcome->message.c_str(), static_cast<long long>(outcome->frames), static_cast<long long>(outcome->rendered),
+              seconds, outcome->frameMsP50, outcome->frameMsP90, outcome->busyMsP50, outcome->busyMsP90,
+              static_cast<long long>(outcome->lateFrames), last->last.time, static_cast<long long>(last->steps),
+              outcome->meanFluidSpeed, outcome->peakMeanFluidSpeed, last->stepMs, last->surfaceMs);
+  std::printf("sphxr --xr: session states %s\n", outcome->states.c_str());
+  std::fflush(stdout);
+  return Status::Ok();
+}
+
+}  // namespace sphxr::app

@@ -1,0 +1,393 @@
+// `sphxr --xr`, the real program, through the real Khronos loader with the core validation layer,
+// against the simulated headset (scripted head and controller, eye images saved as PNG, haptic
+// requests logged): the session runs to a clean exit, both eyes show the water where the fluid is
+// (with the parallax of the eye distance), a missing runtime or a failing one falls back with one line
+// and exit 0, a session lost mid-run ends cleanly.
+#include <cmath>
+
+#include "xr_test_support.h"
+
+namespace sphxr::xr::test {
+namespace {
+
+struct AppRun {
+  int code = -1;
+  std::string out;  // stdout and stderr
+};
+
+AppRun RunSphxr(const std::string& args, const std::filesystem::path& dir) {
+  const std::filesystem::path output = dir / "sphxr_out.txt";
+  const std::string cmd = std::string(SPHXR_BINARY) + " " + args + " >" + output.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  AppRun r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(output);
+  r.out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return r;
+}
+
+int CountOf(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+/// A small tank (0.2 m cube, water 0.1 m deep, 4,000 particles at 1 cm): the app places its centre at
+/// (0, 1.0, -0.4) in the play space (app/include/sphxr/app/xr_mode.h).
+std::filesystem::path WriteScene(const std::filesystem::path& dir, const std::string& paddles = "") {
+  const std::filesystem::path path = dir / "scene.json";
+  std::ofstream(path) << R"({
+  "name": "xr_test_tank",
+  "solver": { "spacing": 0.01, "stiffness": 57000.0, "viscosity": 0.3, "boundary_viscosity": 0.3, "max_dt": 0.001 },
+  "tank": { "min": [0.0, 0.0, 0.0], "max": [0.2, 0.2, 0.2] },
+  "fluid": [ { "min": [0.0, 0.0, 0.0], "max": [0.2, 0.1, 0.2], "hydrostatic": true } ])"
+                      << paddles << R"(
+})";
+  return path;
+}
+
+constexpr int kEyeW = 200, kEyeH = 160;
+constexpr double kIpd = 0.064;
+// The head 0.2 m in front of the tank and 0.3 m above its centre, looking 30 degrees down.
+constexpr double kHeadX = 0.0, kHeadY = 1.3, kHeadZ = 0.2, kPitch = -30.0 * M_PI / 180.0;
+// The water in the play space: the scene's fluid block shifted by the app's placement.
+constexpr double kWaterMin[3] = {-0.1, 0.9, -0.5}, kWaterMax[3] = {0.1, 1.0, -0.3};
+
+void SetUpHeadset(SimHeadset& h, const std::string& rightController = "") {
+  h.env.Set("SPHXR_SIM_XR_EYE_SIZE", std::to_string(kEyeW) + "x" + std::to_string(kEyeH));
+  h.env.Set("SPHXR_SIM_XR_IPD", "0.064");
+  std::ofstream poses(h.dir / "poses.txt");
+  poses << "0 head " << kHeadX << " " << kHeadY << " " << kHeadZ << " " << std::sin(kPitch / 2) << " 0 0 "
+        << std::cos(kPitch / 2) << "\n";
+  poses << "0 left -0.3 0.8 0.1 0 0 0 1\n";  // the left hand at the side, away from the water
+  poses << (rightController.empty() ? "0 right 0.3 0.8 0.1 0 0 0 1\n" : rightController);
+  poses.close();
+  h.env.Set("SPHXR_SIM_XR_POSES", (h.dir / "poses.txt").string());
+}
+
+/// Pixel (x right, y down from the top) of a play-space point in one eye of the scripted head.
+bool Project(int eye, const double p[3], double* px, double* py) {
+  // Eye position: the head's, shifted by -/+ ipd/2 along the head's x axis (which the pitch keeps).
+  const double ex = kHeadX + (eye == 0 ? -0.5 : 0.5) * kIpd;
+  const double d[3] = {p[0] - ex, p[1] - kHeadY, p[2] - kHeadZ};
+  // Into the eye frame: rotate by -pitch about x.
+  const double c = std::cos(-kPitch), s = std::sin(-kPitch);
+  const double x = d[0], y = c * d[1] - s * d[2], z = s * d[1] + c * d[2];
+  if (z >= 0) return false;
+  const double tx = x / -z, ty = y / -z;
+  // sim_runtime's field of view: left eye -0.80/0.75/0.80/-0.85 rad, the right eye mirrored left-right.
+  const double l = std::tan(eye == 0 ? -0.80 : -0.75), r = std::tan(eye == 0 ? 0.75 : 0.80);
+  const double u = std::tan(0.80), dn = std::tan(-0.85);
+  *px = (tx - l) / (r - l) * kEyeW;
+  *py = kEyeH - (ty - dn) / (u - dn) * kEyeH;
+  return true;
+}
+
+struct Box2 {
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+};
+Box2 ProjectedWater(int eye) {
+  Box2 b;
+  for (int i = 0; i < 8; ++i) {
+    const double p[3] = {(i & 1) ? kWaterMax[0] : kWaterMin[0], (i & 2) ? kWaterMax[1] : kWaterMin[1],
+                         (i & 4) ? kWaterMax[2] : kWaterMin[2]};
+    double x = 0, y = 0;
+    EXPECT_TRUE(Project(eye, p, &x, &y));
+    b.x0 = std::min(b.x0, x), b.x1 = std::max(b.x1, x), b.y0 = std::min(b.y0, y), b.y1 = std::max(b.y1, y);
+  }
+  return b;
+}
+
+/// Water as the renderer shades it: blue-green with little red (measured: (42,116,143) to (78,122,145));
+/// the sky has more red (138,174,231 at its deepest), the floor is grey-blue, the tank's edges dark.
+bool IsWater(const uint8_t* p) { return p[0] < 100 && p[1] > p[0] + 25 && p[2] > p[0] + 40; }
+
+/// The last captured pair of eye images.
+std::pair<std::filesystem::path, std::filesystem::path> LastPair(const std::filesystem::path& dir) {
+  std::vector<std::string> lefts;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.find("_left.png") != std::string::npos) lefts.push_back(name);
+  }
+  std::sort(lefts.begin(), lefts.end());
+  if (lefts.empty()) return {};
+  std::string right = lefts.back();
+  right.replace(right.find("_left"), 5, "_right");
+  return {dir / lefts.back(), dir / right};
+}
+
+struct WaterPixels {
+  int count = 0, inside = 0;
+  double cx = 0, cy = 0;
+};
+WaterPixels FindWater(const std::filesystem::path& png, const Box2& box) {
+  WaterPixels w;
+  int width = 0, height = 0;
+  std::vector<uint8_t> px;
+  EXPECT_TRUE(ReadPng(png, &width, &height, &px)) << png;
+  EXPECT_EQ(width, kEyeW);
+  EXPECT_EQ(height, kEyeH);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      if (!IsWater(&px[(size_t(y) * width + x) * 4])) continue;
+      ++w.count;
+      w.cx += x + 0.5, w.cy += y + 0.5;
+      if (x + 0.5 >= box.x0 - 3 && x + 0.5 <= box.x1 + 3 && y + 0.5 >= box.y0 - 3 && y + 0.5 <= box.y1 + 3) ++w.inside;
+    }
+  if (w.count > 0) w.cx /= w.count, w.cy /= w.count;
+  return w;
+}
+
+const std::string kCommon = " --quality scene --threads 1 --window-size 160x120";
+
+TEST(XrApp, WaterInBothEyesWithParallaxAndACleanExit) {
+  SimHeadset headset("app_water");
+  SetUpHeadset(headset);
+  const auto frames = headset.dir / "frames";
+  std::filesystem::create_directories(frames);
+  headset.env.Set("SPHXR_SIM_XR_CAPTURE_DIR", frames.string());
+  headset.env.Set("SPHXR_SIM_XR_CAPTURE_EVERY", "10");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 30" + kCommon,
+                         headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("sphxr --xr: OpenXR session ended after 30 frames"), std::string::npos) << r.out;
+  // The specification's life cycle, as the simulated headset drives it, to the end.
+  EXPECT_NE(r.out.find("sphxr --xr: session states IDLE READY SYNCHRONIZED VISIBLE FOCUSED VISIBLE SYNCHRONIZED "
+                       "STOPPING IDLE EXITING\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(CountOf(r.out, "error"), 0) << r.out;
+  ExpectNoValidationErrors(headset);
+
+  const auto [left, right] = LastPair(frames);
+  ASSERT_TRUE(std::filesystem::exists(left)) << r.out;
+  ASSERT_TRUE(std::filesystem::exists(right));
+  const Box2 boxL = ProjectedWater(0), boxR = ProjectedWater(1);
+  const WaterPixels wl = FindWater(left, boxL), wr = FindWater(right, boxR);
+  const double area = (boxL.x1 - boxL.x0) * (boxL.y1 - boxL.y0);
+  std::printf("water pixels: left %d (%d inside the block's projection, %.0f px^2), right %d (%d); centroids x %.1f / %.1f\n",
+              wl.count, wl.inside, area, wr.count, wr.inside, wl.cx, wr.cx);
+  // The water covers most of where the fluid block projects, and almost nothing else.
+  EXPECT_GT(wl.count, 0.5 * area) << "left eye: " << wl.count << " water pixels, block " << area;
+  EXPECT_GT(wr.count, 0.5 * area) << "right eye: " << wr.count << " water pixels";
+  EXPECT_GT(wl.inside, 0.95 * wl.count);
+  EXPECT_GT(wr.inside, 0.95 * wr.count);
+  // Parallax: the water sits further right in the left eye, by about what the block's centre predicts.
+  const double centre[3] = {0.5 * (kWaterMin[0] + kWaterMax[0]), 0.5 * (kWaterMin[1] + kWaterMax[1]),
+                            0.5 * (kWaterMin[2] + kWaterMax[2])};
+  double xl, yl, xr, yr;
+  ASSERT_TRUE(Project(0, centre, &xl, &yl));
+  ASSERT_TRUE(Project(1, centre, &xr, &yr));
+  const double expected = xl - xr;
+  EXPECT_GT(expected, 5.0);
+  std::printf("parallax: %.1f px measured, %.1f px predicted for the block's centre\n", wl.cx - wr.cx, expected);
+  EXPECT_NEAR(wl.cx - wr.cx, expected, 0.35 * expected) << "left " << wl.cx << ", right " << wr.cx;
+  EXPECT_NEAR(wl.cy, wr.cy, 2.0);
+}
+
+/// The haptic requests of the simulated headset's log for one hand: (amplitude, stop) per line.
+std::vector<float> HapticAmplitudes(const std::filesystem::path& log, const std::string& hand) {
+  std::vector<float> out;
+  std::ifstream in(log);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    long frame = 0;
+    double time = 0;
+    std::string who;
+    float amplitude = 0;
+    if ((ss >> frame >> time >> who >> amplitude) && who == hand) out.push_back(amplitude);
+  }
+  return out;
+}
+
+/// The largest mean fluid speed over the run's snapshots, from the summary line ("(peak X)").
+double PeakMeanFluidSpeed(const std::string& out) {
+  const size_t p = out.find("mean fluid speed ");
+  if (p == std::string::npos) return -1.0;
+  const size_t q = out.find("(peak ", p);
+  return q == std::string::npos ? -1.0 : std::atof(out.c_str() + q + 6);
+}
+
+// A paddle held by the right hand: the default blade on a handle (paddle.h), blade below the grip.
+const std::string kRightPaddle = R"(,
+  "paddles": { "list": [ { "name": "right paddle", "hand": "right",
+    "shapes": [ { "box": { "center": [0.0, -0.05, 0.0], "half_extents": [0.006, 0.05, 0.04] } },
+                { "capsule": { "a": [0.0, 0.0, 0.0], "b": [0.0, 0.12, 0.0], "radius": 0.01 } } ],
+    "haptics": { "full_scale_force": 2.0, "time_constant": 0.05 } } ] })";
+
+TEST(XrApp, ScriptedControllersPaddleMovesTheWaterAndAsksForHaptics) {
+  // The right controller pointing down (grip -z to -y: the paddle upright), its blade 7 cm into the
+  // water (surface at y = 1.0 in the play space), sweeping across the tank and back every second.
+  const std::string stir =
+      "0 right -0.05 1.03 -0.4 -0.7071068 0 0 0.7071068 trigger=1\n"
+      "0.5 right 0.05 1.03 -0.4 -0.7071068 0 0 0.7071068 trigger=1\n"
+      "1 right -0.05 1.03 -0.4 -0.7071068 0 0 0.7071068 trigger=1\nloop 1\n";
+  // The same controller held 0.3 m above the tank: the paddle never touches the water.
+  const std::string still = "0 right 0 1.5 -0.4 -0.7071068 0 0 0.7071068 trigger=1\n";
+  struct Result {
+    AppRun run;
+    std::vector<float> right, left;
+  };
+  auto runWith = [&](const std::string& name, const std::string& poses) {
+    SimHeadset headset(name);
+    SetUpHeadset(headset, poses);
+    const auto haptics = headset.dir / "haptics.txt";
+    headset.env.Set("SPHXR_SIM_XR_HAPTICS_LOG", haptics.string());
+    Result r;
+    r.run = RunSphxr("--xr --scene " + WriteScene(headset.dir, kRightPaddle).string() +
+                         " --frame-limit 270 --spacing 0.02 --set stiffness=10000" + kCommon,
+                     headset.dir);
+    EXPECT_EQ(r.run.code, 0) << r.run.out;
+    ExpectNoValidationErrors(headset);
+    r.right = HapticAmplitudes(haptics, "right");
+    r.left = HapticAmplitudes(haptics, "left");
+    return r;
+  };
+  const Result stirred = runWith("app_paddle_stir", stir);
+  const Result held = runWith("app_paddle_still", still);
+  const double vStirred = PeakMeanFluidSpeed(stirred.run.out), vHeld = PeakMeanFluidSpeed(held.run.out);
+  std::printf("peak mean fluid speed: stirred %.4f m/s, paddle above the water %.4f m/s; right-hand haptic requests: %zu "
+              "(peak %.2f), %zu\n",
+              vStirred, vHeld, stirred.right.size(),
+              stirred.right.empty() ? 0.0f : *std::max_element(stirred.right.begin(), stirred.right.end()),
+              held.right.size());
+  EXPECT_GT(vStirred, 0.05) << stirred.run.out;
+  EXPECT_GT(vStirred, 3.0 * vHeld) << held.run.out;
+  // Haptics: the paddle in the water asked for them, the one above the water never did; the left hand
+  // holds nothing.
+  ASSERT_FALSE(stirred.right.empty()) << stirred.run.out;
+  EXPECT_GT(*std::max_element(stirred.right.begin(), stirred.right.end()), 0.05f);
+  EXPECT_TRUE(held.right.empty());
+  EXPECT_TRUE(stirred.left.empty());
+}
+
+TEST(XrApp, MirrorWindowShowsTheLeftEye) {
+  SimHeadset headset("app_mirror");
+  SetUpHeadset(headset);
+  const auto frames = headset.dir / "frames";
+  std::filesystem::create_directories(frames);
+  headset.env.Set("SPHXR_SIM_XR_CAPTURE_DIR", frames.string());
+  const auto mirror = headset.dir / "mirror.png";
+  // The window as large as an eye: the blit is 1:1, so the mirror must be the left eye's bytes.
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 5 --quality scene " +
+                                "--threads 1 --window-size " + std::to_string(kEyeW) + "x" + std::to_string(kEyeH) +
+                                " --screenshot " + mirror.string(),
+                            headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto [left, right] = LastPair(frames);
+  int w = 0, h = 0, lw = 0, lh = 0;
+  std::vector<uint8_t> m, l;
+  ASSERT_TRUE(ReadPng(mirror, &w, &h, &m)) << r.out;
+  ASSERT_TRUE(ReadPng(left, &lw, &lh, &l));
+  ASSERT_EQ(w, lw);
+  ASSERT_EQ(h, lh);
+  double diff = 0;
+  for (size_t i = 0; i < m.size(); ++i)
+    if (i % 4 != 3) diff += std::abs(int(m[i]) - int(l[i]));
+  diff /= 3.0 * w * h;
+  std::printf("mirror against the left eye: mean |difference| %.3f per channel\n", diff);
+  EXPECT_LT(diff, 1.0);  // the same bytes (no second sRGB encoding or decoding in the blit)
+  ExpectNoValidationErrors(headset);
+}
+
+TEST(XrApp, ResetButtonRestartsTheScene) {
+  SimHeadset headset("app_reset");
+  // The right controller's menu button (the simple controller's reset) pressed from 0.1 s on: one press.
+  SetUpHeadset(headset, "0 right 0.3 0.8 0.1 0 0 0 1\n0.1 right 0.3 0.8 0.1 0 0 0 1 menu=1\n");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 20" + kCommon,
+                            headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "reset button: the scene starts again"), 1) << r.out;
+  ExpectNoValidationErrors(headset);
+}
+
+TEST(XrApp, DefaultModeIsTheHeadsetWhenARuntimeAnswers) {
+  SimHeadset headset("app_default");
+  SetUpHeadset(headset);
+  const AppRun r = RunSphxr("--scene " + WriteScene(headset.dir).string() + " --frame-limit 5" + kCommon, headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("sphxr --xr: OpenXR session ended after 5 frames"), std::string::npos) << r.out;
+  ExpectNoValidationErrors(headset);
+}
+
+TEST(XrApp, NoRuntimeIsOneLineThenTheDesktopWindow) {
+  const auto dir = TempDir("app_noruntime");
+  ScopedEnv env;
+  env.Set("XR_RUNTIME_JSON", (dir / "missing_runtime.json").string());
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(dir).string() + " --frame-limit 3" + kCommon, dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "OpenXR"), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "no OpenXR runtime available"), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "sphxr --xr:"), 0) << r.out;  // no session summary: none ran
+  // A manifest whose runtime library is missing: the same one line.
+  std::ofstream(dir / "broken_runtime.json")
+      << R"({"file_format_version": "1.0.0", "runtime": {"name": "broken", "library_path": "./libmissing.so"}})";
+  env.Set("XR_RUNTIME_JSON", (dir / "broken_runtime.json").string());
+  const AppRun b = RunSphxr("--xr --scene " + WriteScene(dir).string() + " --frame-limit 3" + kCommon, dir);
+  ASSERT_EQ(b.code, 0) << b.out;
+  EXPECT_EQ(CountOf(b.out, "OpenXR"), 1) << b.out;
+  EXPECT_EQ(CountOf(b.out, "using the desktop window"), 1) << b.out;
+  // Without a mode flag, no runtime is not even worth a line: the desktop window is the default.
+  const AppRun d = RunSphxr("--scene " + WriteScene(dir).string() + " --frame-limit 3" + kCommon, dir);
+  ASSERT_EQ(d.code, 0) << d.out;
+  EXPECT_EQ(CountOf(d.out, "OpenXR"), 0) << d.out;
+}
+
+TEST(XrApp, RuntimeFailingAtSessionCreationIsOneLineThenTheDesktopWindow) {
+  SimHeadset headset("app_failsession");
+  headset.env.Set("SPHXR_SIM_XR_FAIL_SESSION", "1");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon,
+                         headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "xrCreateSession"), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
+}
+
+TEST(XrApp, NoDisplayIsOneLineThenHeadless) {
+  const auto dir = TempDir("app_nodisplay");
+  ScopedEnv env;
+  env.Set("XR_RUNTIME_JSON", SPHXR_SIM_RUNTIME_JSON);
+  env.Set("DISPLAY", "");
+  env.Set("WAYLAND_DISPLAY", "");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(dir).string() + " --time 0.005 --threads 1", dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "running headless"), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "display"), 1) << r.out;
+}
+
+TEST(XrApp, SessionLostMidRunEndsCleanlyInTheDesktopWindow) {
+  SimHeadset headset("app_lost");
+  SetUpHeadset(headset);
+  headset.env.Set("SPHXR_SIM_XR_LOSE_SESSION_AFTER_FRAMES", "10");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 20" + kCommon,
+                         headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "the XR session was lost"), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
+  EXPECT_NE(r.out.find("sphxr --xr: session states IDLE READY SYNCHRONIZED VISIBLE FOCUSED LOSS_PENDING\n"),
+            std::string::npos)
+      << r.out;
+  ExpectNoValidationErrors(headset);
+  // Lost after the frame limit's worth of frames: nothing left to show, the program exits.
+  SimHeadset again("app_lost_end");
+  SetUpHeadset(again);
+  again.env.Set("SPHXR_SIM_XR_LOSE_SESSION_AFTER_FRAMES", "5");
+  const AppRun e = RunSphxr("--xr --scene " + WriteScene(again.dir).string() + " --frame-limit 5" + kCommon, again.dir);
+  ASSERT_EQ(e.code, 0) << e.out;
+  EXPECT_EQ(CountOf(e.out, "the XR session was lost"), 1) << e.out;
+  EXPECT_EQ(CountOf(e.out, "exiting"), 1) << e.out;
+  // The instance lost instead of the session: the same clean end.
+  SimHeadset instance("app_lost_instance");
+  SetUpHeadset(instance);
+  instance.env.Set("SPHXR_SIM_XR_LOSE_INSTANCE_AFTER_FRAMES", "5");
+  const AppRun i = RunSphxr("--xr --scene " + WriteScene(instance.dir).string() + " --frame-limit 10" + kCommon,
+                            instance.dir);
+  ASSERT_EQ(i.code, 0) << i.out;
+  EXPECT_EQ(CountOf(i.out, "the XR session was lost"), 1) << i.out;
+  EXPECT_EQ(CountOf(i.out, "using the desktop window"), 1) << i.out;
+}
+
+}  // namespace
+}  // namespace sphxr::xr::test
