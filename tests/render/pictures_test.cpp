@@ -21,6 +21,7 @@
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/snapshot.h"
+#include "sphxr/render/interop.h"
 #include "support.h"
 
 namespace sphxr::test {
@@ -555,6 +556,61 @@ TEST(HeadlessPicturesTest, WaterScreenshotIsDrawnFromTheSurfaceMesh) {
   EXPECT_GT(differsFromSprites, 200) << "the mesh picture looks like the particle picture";
   EXPECT_GT(water, 2000);
   EXPECT_GE(water, changed * 95 / 100);
+}
+
+TEST(HeadlessPicturesTest, SnapshotWithTheSurfaceOnTheDeviceDrawsTheInteropMeshLikeTheHostMesh) {
+  // The GPU path's frame (SurfacePath::kInterop): the snapshot has no host mesh, MakeFrameScene draws the
+  // InteropMesh. No GPU here, so the solver (CPU backend) writes the mesh with WriteSurface into host memory
+  // and Upload fills the GL buffers that CUDA would fill through Map/Unmap; the picture must be the host
+  // path's, pixel for pixel.
+  TempDir dir("interop_picture");
+  app::SceneFile sf;
+  ASSERT_TRUE(app::ParseScene(kSmallScene, "small", &sf).ok());
+  sim::SolverConfig config;
+  config.threads = 1;
+  std::unique_ptr<sim::Solver> solver;
+  ASSERT_TRUE(sim::Solver::Create(sf.setup, config, &solver).ok());
+  for (int i = 0; i < 2; ++i) ASSERT_TRUE(solver->Step().ok());
+  app::SimSnapshot host, device;
+  ASSERT_TRUE(app::CaptureSnapshot(*solver, nullptr, {}, &host).ok());
+  ASSERT_TRUE(app::CaptureSnapshot(*solver, nullptr, {}, &device, app::SurfacePath::kInterop).ok());
+  host.setup = device.setup = sf.setup;
+  ASSERT_TRUE(device.surfaceOnDevice);
+  ASSERT_EQ(device.surfaceVertices, host.surface.VertexCount());
+  ASSERT_GT(host.surface.TriangleCount(), 100);
+  const int n = static_cast<int>(device.surfaceVertices);
+  std::vector<float> positions(3 * n), normals(3 * n);
+  ASSERT_TRUE(solver->WriteSurface({positions.data(), normals.data(), n}, nullptr).ok());
+  EXPECT_EQ(positions, host.surface.positions);  // the two phases give the extraction's mesh, bit for bit
+  EXPECT_EQ(normals, host.surface.normals);
+
+  std::unique_ptr<app::OfflinePictures> pictures;
+  ASSERT_TRUE(app::OfflinePictures::Create(320, 180, &pictures, true).ok());
+  std::unique_ptr<render::InteropMesh> mesh;
+  ASSERT_TRUE(render::InteropMesh::Create(n + 7, &mesh).ok());
+  ASSERT_TRUE(mesh->Upload(positions.data(), normals.data(), n).ok());
+  const render::FrameScene viaBuffers = app::MakeFrameScene(device, render::RenderMode::kWater,
+                                                            render::ParticleColor::kSpeed, mesh.get());
+  EXPECT_EQ(viaBuffers.deviceSurface, mesh.get());
+  EXPECT_TRUE(viaBuffers.surface.Empty());
+  const render::FrameScene viaHost = app::MakeFrameScene(host, render::RenderMode::kWater,
+                                                         render::ParticleColor::kSpeed, mesh.get());
+  EXPECT_EQ(viaHost.deviceSurface, nullptr) << "a host snapshot draws its own mesh";
+  EXPECT_EQ(app::MakeFrameScene(device, render::RenderMode::kParticles).deviceSurface, nullptr);
+  render::Image a, b;
+  ASSERT_TRUE(pictures->Write(viaHost, dir.File("host.png")).ok());
+  ASSERT_TRUE(pictures->Write(viaBuffers, dir.File("buffers.png")).ok());
+  ASSERT_TRUE(app::ReadPng(dir.File("host.png"), &a).ok());
+  ASSERT_TRUE(app::ReadPng(dir.File("buffers.png"), &b).ok());
+  ASSERT_EQ(a.rgba.size(), b.rgba.size());
+  int differing = 0, water = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i) differing += a.rgba[i] != b.rgba[i];
+  for (int yy = 0; yy < 180; ++yy) {
+    for (int xx = 0; xx < 320; ++xx) water += Watery(RenderFixture::Rgb(a, xx, yy));
+  }
+  EXPECT_EQ(differing, 0);
+  EXPECT_GT(water, 2000);
+  mesh.reset();  // its GL buffers go while the context is current
 }
 
 }  // namespace
