@@ -166,6 +166,7 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
   const SurfacePath path = m_path.load();
   const bool reuseSurface = surface.enabled && previous && previous->surfaceFresh && !m_paused &&
                             previous->surfaceOnDevice == (path == SurfacePath::kInterop) &&
+                            (!previous->surfaceOnDevice || previous->surfaceBuild == m_builtBuild) &&  // same solver
                             previous->surfaceCellSize > 0.0f && previous->steps > 0 &&
                             previous->surfaceMs * 5e-3 > Seconds(now - m_lastSurface) &&
                             (surface.params.cellSize <= 0.0f || surface.params.cellSize == previous->surfaceCellSize);
@@ -370,6 +371,13 @@ void SimWorker::FallBackToHostCopy(const std::string& why) {
   SPHXR_LOG_WARN("surface: CUDA-GL interop failed (%s); the mesh is copied to the host from now on", why.c_str());
   std::lock_guard lock(m_mutex);
   m_surfaceChanged = true;  // the next snapshot extracts a host copy at once
+  m_wake.notify_all();
+}
+
+void SimWorker::ForceSurfacePathForTests(SurfacePath path) {
+  m_path = path;
+  std::lock_guard lock(m_mutex);
+  m_surfaceChanged = true;
   m_wake.notify_all();
 }
 

@@ -81,6 +81,9 @@ class SimWorker {
   /// Interop failed (a GL context that is not on the CUDA device, ...): from the next snapshot on the
   /// mesh is copied to the host. Logged once.
   void FallBackToHostCopy(const std::string& why);
+  /// Tests: the interop path's bookkeeping and its fallback on a machine without a GPU (there every Map
+  /// fails, as on a machine whose GL context is not on the CUDA device). The next snapshot extracts anew.
+  void ForceSurfacePathForTests(SurfacePath path);
 
  private:
   std::unique_lock<std::mutex> LockSolver();

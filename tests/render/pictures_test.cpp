@@ -21,6 +21,7 @@
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/snapshot.h"
+#include "sim_worker.h"  // app/src: SimWorker, InteropSurface
 #include "sphxr/render/interop.h"
 #include "support.h"
 
@@ -611,6 +612,50 @@ TEST(HeadlessPicturesTest, SnapshotWithTheSurfaceOnTheDeviceDrawsTheInteropMeshL
   EXPECT_EQ(differing, 0);
   EXPECT_GT(water, 2000);
   mesh.reset();  // its GL buffers go while the context is current
+}
+
+TEST(HeadlessPicturesTest, InteropFailureFallsBackToHostCopiesOnce) {
+  // The GL thread's half of the interop path on a machine without a GPU: the worker (forced onto the
+  // interop path, its solver on the CPU) builds without copying; the first write creates the buffers and
+  // fails at Map, as it would where the GL context is not on the CUDA device; the worker then goes back
+  // to host copies, with one warning.
+  app::SceneFile sf;
+  ASSERT_TRUE(app::ParseScene(kSmallScene, "small", &sf).ok());
+  std::unique_ptr<app::OfflinePictures> pictures;  // a current GL context for the interop buffers
+  ASSERT_TRUE(app::OfflinePictures::Create(64, 64, &pictures, true).ok());
+  sim::SolverConfig config;
+  config.device = sim::Device::kCpu;
+  config.threads = 1;
+  LogCapture log;
+  app::SimWorker worker(config);
+  ASSERT_TRUE(worker.Start(app::SimSceneFromFile(sf)).ok());
+  worker.SetPaused(true);
+  worker.ForceSurfacePathForTests(app::SurfacePath::kInterop);
+  auto waitFor = [&](auto predicate) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    std::shared_ptr<const app::SimSnapshot> s = worker.Latest();
+    while (!predicate(*s) && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      s = worker.Latest();
+    }
+    return s;
+  };
+  const auto onDevice = waitFor([](const app::SimSnapshot& s) { return s.surfaceOnDevice; });
+  ASSERT_TRUE(onDevice->surfaceOnDevice);
+  EXPECT_GT(onDevice->surfaceBuild, 0u);
+  EXPECT_GT(onDevice->surfaceVertices, 300);
+  EXPECT_EQ(onDevice->surface.VertexCount(), 0);
+  app::InteropSurface interop;
+  EXPECT_EQ(interop.Update(worker, *onDevice), nullptr);
+  EXPECT_EQ(worker.Path(), app::SurfacePath::kHostCopy);
+  EXPECT_EQ(interop.Update(worker, *onDevice), nullptr);  // again: host path now, no second warning
+  const auto host = waitFor([](const app::SimSnapshot& s) { return !s.surfaceOnDevice && s.surface.VertexCount() > 0; });
+  EXPECT_FALSE(host->surfaceOnDevice);
+  EXPECT_EQ(host->surface.VertexCount(), onDevice->surfaceVertices) << "paused: the same state, the same mesh";
+  worker.Stop();
+  EXPECT_EQ(log.Count("CUDA-GL interop failed", LogLevel::kWarn), 1) << log.All();
+  EXPECT_EQ(log.Count("interop buffers grown"), 1) << log.All();
+  interop.Reset();  // its GL buffers go while the context is current
 }
 
 }  // namespace
