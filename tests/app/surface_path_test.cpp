@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <vector>
 
 #include "sim_worker.h"  // app/src: SimWorker, InteropSurface
 #include "sphxr/app/scene_file.h"
@@ -82,6 +83,17 @@ TEST(SurfacePathTest, InteropCaptureBuildsTheMeshWithoutCopyingIt) {
   EXPECT_EQ(device.surfaceVertices, host.surface.VertexCount());
   EXPECT_EQ(device.SurfaceTriangles(), host.SurfaceTriangles());
   EXPECT_EQ(device.surfaceCellSize, host.surfaceCellSize);
+  // The GL thread writes the build later, maybe after more steps (and a kept build again): the steps do
+  // not change what WriteSurface writes.
+  const int64_t n = device.surfaceVertices;
+  std::vector<float> p0(3 * n), n0(3 * n), p1(3 * n), n1(3 * n);
+  ASSERT_TRUE(solver->WriteSurface({p0.data(), n0.data(), n}, nullptr).ok());
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(solver->Step().ok());
+  ASSERT_TRUE(solver->WriteSurface({p1.data(), n1.data(), n}, nullptr).ok());
+  EXPECT_EQ(p0, host.surface.positions);
+  EXPECT_EQ(n0, host.surface.normals);
+  EXPECT_EQ(p1, p0);
+  EXPECT_EQ(n1, n0);
   SurfaceRequest off;
   off.enabled = false;
   ASSERT_TRUE(CaptureSnapshot(*solver, nullptr, off, &device, SurfacePath::kInterop).ok());
