@@ -63,6 +63,7 @@ struct DesktopApp::Impl {
   bool imguiReady = false;
   std::unique_ptr<render::Renderer> renderer;
   std::unique_ptr<SimWorker> worker;
+  InteropSurface interop;  // the surface on the GPU path (written in place; unused on the CPU backend)
   OrbitCamera camera;
   render::RenderMode mode = render::RenderMode::kWater;
   render::ParticleColor color = render::ParticleColor::kSpeed;
@@ -90,6 +91,7 @@ struct DesktopApp::Impl {
     if (worker) worker->Stop();
     worker.reset();
     if (window) glfwMakeContextCurrent(window);
+    interop.Reset();
     renderer.reset();
     if (imguiReady) {
       ImGui_ImplOpenGL3_Shutdown();
@@ -438,7 +440,7 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     }
     if (mode == render::RenderMode::kWater) {
       ImGui::TextDisabled("surface: HPMC, %lld triangles, cell %.4f m, %.2f ms per extraction",
-                          static_cast<long long>(snap.surface.TriangleCount()), snap.surfaceCellSize, snap.surfaceMs);
+                          static_cast<long long>(snap.SurfaceTriangles()), snap.surfaceCellSize, snap.surfaceMs);
     } else {
       ImGui::TextDisabled("surface: not extracted in particle mode");
     }
@@ -549,8 +551,10 @@ bool DesktopApp::Frame(render::Image* capture) {
 
   int fbw = 0, fbh = 0;
   glfwGetFramebufferSize(m.window, &fbw, &fbh);
-  const render::FrameScene frame = MakeFrameScene(*snap, m.mode, m.color);
-  m.surfaceTriangles = frame.surface.vertexCount / 3;
+  // GPU path: the snapshot's mesh is still in the solver; it is written into the GL buffers here (once per build).
+  const render::InteropMesh* deviceSurface = m.interop.Update(*m.worker, *snap);
+  const render::FrameScene frame = MakeFrameScene(*snap, m.mode, m.color, deviceSurface);
+  m.surfaceTriangles = (frame.deviceSurface ? frame.deviceSurface->VertexCount() : frame.surface.vertexCount) / 3;
   const auto t0 = std::chrono::steady_clock::now();
   if (fbw > 0 && fbh > 0) {
     render::View view;

@@ -165,9 +165,12 @@ void AppendPaddleSolids(const PaddlePose& paddle, std::vector<render::SolidMesh>
   }
 }
 
-render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMode mode, render::ParticleColor color) {
+render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMode mode, render::ParticleColor color,
+                                  const render::InteropMesh* deviceSurface) {
   render::FrameScene f = MakeFrameScene(snapshot.setup, snapshot.fluid, mode, color);
-  if (mode == render::RenderMode::kWater && snapshot.surface.VertexCount() > 0) {
+  if (mode == render::RenderMode::kWater && snapshot.surfaceOnDevice) {
+    f.deviceSurface = deviceSurface;  // null (nothing written yet): the particles are drawn as water
+  } else if (mode == render::RenderMode::kWater && snapshot.surface.VertexCount() > 0) {
     f.surface.positions = snapshot.surface.positions.data();
     f.surface.normals = snapshot.surface.normals.data();
     f.surface.vertexCount = static_cast<int>(snapshot.surface.VertexCount());

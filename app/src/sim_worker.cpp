@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -66,6 +67,15 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
 
 Status SimWorker::Start(const SimScene& scene) {
   if (Status s = Build(scene, &m_solver, &m_paddles); !s) return s;
+  m_path = ChooseSurfacePath(m_solver->ActiveDevice());
+  if (m_path.load() == SurfacePath::kInterop) {
+    LogOnce("surface-path", LogLevel::kInfo,
+            "surface: solver on the CUDA device: the mesh is written into the GL buffers in place (CUDA-GL interop, "
+            "no host copy)");
+  } else {
+    LogOnce("surface-path", LogLevel::kInfo,
+            "surface: solver on the CPU: the mesh is copied into each snapshot and uploaded to GL (host path)");
+  }
   m_nextPaddleFrame = 0.0;
   {
     std::lock_guard lock(m_mutex);
@@ -153,18 +163,32 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
   // The surface costs about a step or two: extracted again only when it keeps under a fifth of the
   // worker's time (or the state is about to stand still: paused, a single step, a new cell size).
   const auto now = Clock::now();
+  const SurfacePath path = m_path.load();
   const bool reuseSurface = surface.enabled && previous && previous->surfaceFresh && !m_paused &&
+                            previous->surfaceOnDevice == (path == SurfacePath::kInterop) &&
+                            (!previous->surfaceOnDevice || previous->surfaceBuild == m_builtBuild) &&  // same solver
                             previous->surfaceCellSize > 0.0f && previous->steps > 0 &&
                             previous->surfaceMs * 5e-3 > Seconds(now - m_lastSurface) &&
                             (surface.params.cellSize <= 0.0f || surface.params.cellSize == previous->surfaceCellSize);
   SurfaceRequest request = surface;
   if (reuseSurface) request.enabled = false;
-  if (Status s = CaptureSnapshot(*m_solver, m_paddles.get(), request, snap.get()); !s) {
-    std::lock_guard lock(m_mutex);
-    m_error = "surface: " + s.message();
+  {
+    std::unique_lock solverLock = LockSolver();
+    if (Status s = CaptureSnapshot(*m_solver, m_paddles.get(), request, snap.get(), path); !s) {
+      std::lock_guard lock(m_mutex);
+      m_error = "surface: " + s.message();
+    }
+    if (snap->surfaceOnDevice) {  // built in the solver: the GL thread writes this build (WriteSurfaceInto)
+      m_builtBuild = ++m_builds;
+      m_builtVertices = snap->surfaceVertices;
+      snap->surfaceBuild = m_builtBuild;
+    }
   }
   if (reuseSurface) {
-    snap->surface = previous->surface;
+    snap->surface = previous->surface;  // host path: shared copy; interop path: the solver still holds the build
+    snap->surfaceOnDevice = previous->surfaceOnDevice;
+    snap->surfaceVertices = previous->surfaceVertices;
+    snap->surfaceBuild = previous->surfaceBuild;
     snap->surfaceMs = previous->surfaceMs;
     snap->surfaceCellSize = previous->surfaceCellSize;
     snap->surfaceFresh = false;
@@ -220,8 +244,11 @@ void SimWorker::Run() {
         std::lock_guard lock(m_mutex);
         m_error = s.message();
       } else {
+        std::unique_lock solverLock = LockSolver();
         m_paddles = std::move(freshPaddles);  // bound to the old solver: replaced first
         m_solver = std::move(fresh);
+        m_builtBuild = 0;  // the new solver has built no surface yet
+        solverLock.unlock();
         m_nextPaddleFrame = 0.0;
         {
           std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
@@ -256,6 +283,7 @@ void SimWorker::Run() {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));  // ahead of real time
     } else {
       if (stepRequested) --m_stepRequests;
+      std::unique_lock solverLock = LockSolver();
       if (m_paddles && m_solver->Time() >= m_nextPaddleFrame - 1e-9) {
         // A paddle frame: the newest hands become the paddles' targets one frame ahead in simulated time.
         m_nextPaddleFrame = m_solver->Time() + 1.0 / m_scene.paddleFrameRate;
@@ -293,6 +321,84 @@ void SimWorker::Run() {
     }
     if (dirty && (Seconds(now - lastPublish) >= 1.0 / 60.0 || m_paused)) publishNow(now);
   }
+}
+
+std::unique_lock<std::mutex> SimWorker::LockSolver() {
+  // std::mutex is not fair: a worker stepping back to back would take it again at once, so a waiting
+  // surface writer (the GL thread, a short call) goes first.
+  while (m_surfaceWriters.load() > 0) std::this_thread::yield();
+  return std::unique_lock(m_solverMutex);
+}
+
+Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build) {
+  *build = 0;
+  if (m_path.load() != SurfacePath::kInterop) {
+    return Status::Error("surface: the solver is on the CPU; its mesh is copied to the host, not written through interop");
+  }
+  ++m_surfaceWriters;
+  std::unique_lock solverLock(m_solverMutex);
+  --m_surfaceWriters;
+  if (m_builtBuild == 0) return Status::Ok();
+  const int64_t vertices = m_builtVertices;
+  constexpr int64_t kMaxVertices = int64_t{1} << 26;  // InteropMesh::Create's limit
+  if (vertices > kMaxVertices) {
+    return Status::Error(Format("surface: %lld vertices do not fit the interop buffers (at most %lld): raise "
+                                "surface.cell_size",
+                                static_cast<long long>(vertices), static_cast<long long>(kMaxVertices)));
+  }
+  if (!*mesh || (*mesh)->Capacity() < vertices) {
+    // Geometric growth, as the solver's own buffer (docs/surface.md): O(log) re-creations, each logged.
+    const int64_t old = *mesh ? (*mesh)->Capacity() : 0;
+    const int64_t grown = std::min(kMaxVertices, std::max<int64_t>({vertices + vertices / 4, old + old / 2, 3 * 4096}));
+    mesh->reset();  // unregisters the old buffers from CUDA before the new ones are made
+    if (Status s = render::InteropMesh::Create(static_cast<int>(grown), mesh); !s) return s;
+    SPHXR_LOG_INFO("surface: interop buffers grown from %lld to %lld vertices (%.1f MiB) for a mesh of %lld triangles",
+                   static_cast<long long>(old), static_cast<long long>(grown), 24.0 * static_cast<double>(grown) / 1048576.0,
+                   static_cast<long long>(vertices / 3));
+  }
+  render::InteropMesh::DevicePointers target;
+  if (Status s = (*mesh)->Map(&target); !s) return s;
+  sim::SurfaceStats stats;
+  const Status written = m_solver->WriteSurface({target.positions, target.normals, target.capacity}, &stats);
+  if (Status s = (*mesh)->Unmap(written ? static_cast<int>(vertices) : 0); !s) return s;
+  if (!written) return written;
+  *build = m_builtBuild;
+  return Status::Ok();
+}
+
+void SimWorker::FallBackToHostCopy(const std::string& why) {
+  if (m_path.exchange(SurfacePath::kHostCopy) == SurfacePath::kHostCopy) return;
+  SPHXR_LOG_WARN("surface: CUDA-GL interop failed (%s); the mesh is copied to the host from now on", why.c_str());
+  std::lock_guard lock(m_mutex);
+  m_surfaceChanged = true;  // the next snapshot extracts a host copy at once
+  m_wake.notify_all();
+}
+
+void SimWorker::ForceSurfacePathForTests(SurfacePath path) {
+  m_path = path;
+  std::lock_guard lock(m_mutex);
+  m_surfaceChanged = true;
+  m_wake.notify_all();
+}
+
+const render::InteropMesh* InteropSurface::Update(SimWorker& worker, const SimSnapshot& snap) {
+  if (!snap.surfaceOnDevice) return nullptr;
+  if (snap.surfaceBuild > m_written) {
+    uint64_t build = 0;
+    if (Status s = worker.WriteSurfaceInto(&m_mesh, &build); !s) {
+      worker.FallBackToHostCopy(s.message());
+      m_written = 0;
+      return nullptr;
+    }
+    if (build == 0) return nullptr;  // the solver was replaced and has built nothing yet
+    m_written = build;               // the newest build: at least the snapshot's
+  }
+  return m_mesh && m_mesh->VertexCount() > 0 ? m_mesh.get() : nullptr;
+}
+
+void InteropSurface::Reset() {
+  m_mesh.reset();
+  m_written = 0;
 }
 
 }  // namespace sphxr::app

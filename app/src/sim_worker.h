@@ -18,6 +18,7 @@
 #include "sphxr/common/status.h"
 #include "sphxr/interaction/hand.h"
 #include "sphxr/interaction/paddle.h"
+#include "sphxr/render/interop.h"
 #include "sphxr/sim/solver.h"
 
 namespace sphxr::app {
@@ -67,7 +68,25 @@ class SimWorker {
   std::string LastError() const;
   void Stop();
 
+  /// How the water surface reaches GL: ChooseSurfacePath of the solver's device (logged once at Start),
+  /// kHostCopy after FallBackToHostCopy.
+  SurfacePath Path() const { return m_path.load(); }
+  /// The GPU path's GL side (call on the GL thread, context current): writes the solver's newest surface
+  /// (its last BuildSurface) into `*mesh` through CUDA-GL interop: grows it first (a new InteropMesh,
+  /// at least 1.25x the vertices) when the mesh does not fit, Maps, Solver::WriteSurface, Unmaps with the
+  /// vertex count. Holds the solver lock, so the worker neither steps nor extracts meanwhile (the call
+  /// waits for a step in progress). `*build` gets the build written (SimSnapshot::surfaceBuild), 0 when
+  /// the solver has built none. Errors: the host-copy path, and any interop failure.
+  Status WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build);
+  /// Interop failed (a GL context that is not on the CUDA device, ...): from the next snapshot on the
+  /// mesh is copied to the host. Logged once.
+  void FallBackToHostCopy(const std::string& why);
+  /// Tests: the interop path's bookkeeping and its fallback on a machine without a GPU (there every Map
+  /// fails, as on a machine whose GL context is not on the CUDA device). The next snapshot extracts anew.
+  void ForceSurfacePathForTests(SurfacePath path);
+
  private:
+  std::unique_lock<std::mutex> LockSolver();
   void Run();
   void Publish(double stageMs[], double stepMs);
   Status Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
@@ -91,6 +110,29 @@ class SimWorker {
   std::atomic<int> m_stepRequests{0};
   double m_rateSteps = 0.0, m_rateSim = 0.0;
   std::chrono::steady_clock::time_point m_lastSurface{};
+  // The solver lock: the worker holds it while it steps, extracts or replaces the solver; the GL thread
+  // while it writes the surface (WriteSurfaceInto). Pending writers go first (LockSolver).
+  std::mutex m_solverMutex;
+  std::atomic<int> m_surfaceWriters{0};
+  std::atomic<SurfacePath> m_path{SurfacePath::kHostCopy};
+  uint64_t m_builds = 0;        // surfaces built so far (all solvers); guarded by m_solverMutex
+  uint64_t m_builtBuild = 0;    // the current solver's last build on the interop path (0: none)
+  int64_t m_builtVertices = 0;  // its vertex count
+};
+
+/// The GL thread's half of the GPU surface path (desktop window, headset): the InteropMesh the worker's
+/// solver writes into. Destroy it with the GL context current.
+class InteropSurface {
+ public:
+  /// For a snapshot whose surface stayed on the device (SimSnapshot::surfaceOnDevice): brings the mesh
+  /// up to the snapshot's build (one write per build) and returns it for FrameScene::deviceSurface; else
+  /// null (draw the snapshot's host mesh). A failure switches the worker to host copies (logged once).
+  const render::InteropMesh* Update(SimWorker& worker, const SimSnapshot& snap);
+  void Reset();
+
+ private:
+  std::unique_ptr<render::InteropMesh> m_mesh;
+  uint64_t m_written = 0;  // the newest build in m_mesh
 };
 
 }  // namespace sphxr::app

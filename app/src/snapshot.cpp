@@ -18,8 +18,16 @@ sim::Vec3 PaddleWorkingPoint(const std::vector<sim::ShapePrimitive>& shapes) {
   return best;
 }
 
+const char* SurfacePathName(SurfacePath path) {
+  return path == SurfacePath::kInterop ? "CUDA-GL interop" : "host copy";
+}
+
+SurfacePath ChooseSurfacePath(sim::Device activeDevice) {
+  return activeDevice == sim::Device::kCuda ? SurfacePath::kInterop : SurfacePath::kHostCopy;
+}
+
 Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* paddles, const SurfaceRequest& surface,
-                       SimSnapshot* out) {
+                       SimSnapshot* out, SurfacePath path) {
   solver.Download(&out->fluid);
   out->last = solver.LastStep();
   out->steps = solver.GetTotals().steps;
@@ -46,6 +54,8 @@ Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* pad
     out->haptic[1] = paddles->HapticAmplitude(interaction::Holder::kRightHand);
   }
   out->surfaceFresh = false;
+  out->surfaceOnDevice = false;
+  out->surfaceVertices = 0;
   if (!surface.enabled) {
     out->surface = {};
     out->surfaceMs = 0.0;
@@ -53,7 +63,14 @@ Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* pad
   }
   const auto t0 = std::chrono::steady_clock::now();
   sim::SurfaceStats stats;
-  if (Status s = solver.ExtractSurface(surface.params, &out->surface, &stats); !s) return s;
+  if (path == SurfacePath::kInterop) {
+    out->surface = {};  // the mesh stays in the solver until the GL thread writes it (WriteSurface)
+    if (Status s = solver.BuildSurface(surface.params, &stats); !s) return s;
+    out->surfaceOnDevice = true;
+    out->surfaceVertices = stats.vertices;
+  } else if (Status s = solver.ExtractSurface(surface.params, &out->surface, &stats); !s) {
+    return s;
+  }
   out->surfaceMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   out->surfaceCellSize = stats.grid.cellSize;
   out->surfaceFresh = true;

@@ -44,8 +44,9 @@ void GlfwError(int code, const char* text) { g_glfwError = Format("%s (GLFW 0x%x
 // ---- The hand-off to the simulation: hands in, haptics and the frame out. ----
 void SendHands(SimWorker& worker, const std::vector<interaction::HandInput>& hands) { worker.SetHands(hands); }
 float HapticAmplitude(const SimSnapshot& snap, int hand) { return snap.haptic[hand]; }
-render::FrameScene BuildFrameScene(const SimSnapshot& snap, render::RenderMode mode, render::ParticleColor color) {
-  return MakeFrameScene(snap, mode, color);  // surface mesh (or particles), paddles, tank
+render::FrameScene BuildFrameScene(const SimSnapshot& snap, render::RenderMode mode, render::ParticleColor color,
+                                   const render::InteropMesh* deviceSurface) {
+  return MakeFrameScene(snap, mode, color, deviceSurface);  // surface mesh (or particles), paddles, tank
 }
 // ---- end of the hand-off ----
 
@@ -106,6 +107,7 @@ struct XrApp {
   std::unique_ptr<render::Renderer> renderer;
   std::unique_ptr<xr::Session> session;
   std::unique_ptr<SimWorker> worker;
+  InteropSurface interop;  // the surface on the GPU path (written in place; unused on the CPU backend)
   render::RenderMode mode = render::RenderMode::kWater;
   render::ParticleColor color = render::ParticleColor::kSpeed;
   float lastHaptic[xr::kHandCount] = {0, 0};
@@ -115,6 +117,7 @@ struct XrApp {
     if (worker) worker->Stop();
     if (window) glfwMakeContextCurrent(window);
     session.reset();
+    interop.Reset();
     renderer.reset();
     if (imguiReady) {
       ImGui_ImplOpenGL3_Shutdown();
@@ -351,7 +354,8 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
             SPHXR_LOG_INFO("reset button: the scene starts again");
             app.worker->Reset(app.simScene);
           }
-          frame = BuildFrameScene(*snap, app.mode, app.color);
+          // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
+          frame = BuildFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));
         },
         [&](const xr::FrameInfo&, const xr::EyeView& eye) {
           // The renderer writes display-ready colour (the desktop window shows its bytes as they are):

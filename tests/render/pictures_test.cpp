@@ -21,6 +21,8 @@
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/snapshot.h"
+#include "sim_worker.h"  // app/src: SimWorker, InteropSurface
+#include "sphxr/render/interop.h"
 #include "support.h"
 
 namespace sphxr::test {
@@ -555,6 +557,105 @@ TEST(HeadlessPicturesTest, WaterScreenshotIsDrawnFromTheSurfaceMesh) {
   EXPECT_GT(differsFromSprites, 200) << "the mesh picture looks like the particle picture";
   EXPECT_GT(water, 2000);
   EXPECT_GE(water, changed * 95 / 100);
+}
+
+TEST(HeadlessPicturesTest, SnapshotWithTheSurfaceOnTheDeviceDrawsTheInteropMeshLikeTheHostMesh) {
+  // The GPU path's frame (SurfacePath::kInterop): the snapshot has no host mesh, MakeFrameScene draws the
+  // InteropMesh. No GPU here, so the solver (CPU backend) writes the mesh with WriteSurface into host memory
+  // and Upload fills the GL buffers that CUDA would fill through Map/Unmap; the picture must be the host
+  // path's, pixel for pixel.
+  TempDir dir("interop_picture");
+  app::SceneFile sf;
+  ASSERT_TRUE(app::ParseScene(kSmallScene, "small", &sf).ok());
+  sim::SolverConfig config;
+  config.threads = 1;
+  std::unique_ptr<sim::Solver> solver;
+  ASSERT_TRUE(sim::Solver::Create(sf.setup, config, &solver).ok());
+  for (int i = 0; i < 2; ++i) ASSERT_TRUE(solver->Step().ok());
+  app::SimSnapshot host, device;
+  ASSERT_TRUE(app::CaptureSnapshot(*solver, nullptr, {}, &host).ok());
+  ASSERT_TRUE(app::CaptureSnapshot(*solver, nullptr, {}, &device, app::SurfacePath::kInterop).ok());
+  host.setup = device.setup = sf.setup;
+  ASSERT_TRUE(device.surfaceOnDevice);
+  ASSERT_EQ(device.surfaceVertices, host.surface.VertexCount());
+  ASSERT_GT(host.surface.TriangleCount(), 100);
+  const int n = static_cast<int>(device.surfaceVertices);
+  std::vector<float> positions(3 * n), normals(3 * n);
+  ASSERT_TRUE(solver->WriteSurface({positions.data(), normals.data(), n}, nullptr).ok());
+  EXPECT_EQ(positions, host.surface.positions);  // the two phases give the extraction's mesh, bit for bit
+  EXPECT_EQ(normals, host.surface.normals);
+
+  std::unique_ptr<app::OfflinePictures> pictures;
+  ASSERT_TRUE(app::OfflinePictures::Create(320, 180, &pictures, true).ok());
+  std::unique_ptr<render::InteropMesh> mesh;
+  ASSERT_TRUE(render::InteropMesh::Create(n + 7, &mesh).ok());
+  ASSERT_TRUE(mesh->Upload(positions.data(), normals.data(), n).ok());
+  const render::FrameScene viaBuffers = app::MakeFrameScene(device, render::RenderMode::kWater,
+                                                            render::ParticleColor::kSpeed, mesh.get());
+  EXPECT_EQ(viaBuffers.deviceSurface, mesh.get());
+  EXPECT_TRUE(viaBuffers.surface.Empty());
+  const render::FrameScene viaHost = app::MakeFrameScene(host, render::RenderMode::kWater,
+                                                         render::ParticleColor::kSpeed, mesh.get());
+  EXPECT_EQ(viaHost.deviceSurface, nullptr) << "a host snapshot draws its own mesh";
+  EXPECT_EQ(app::MakeFrameScene(device, render::RenderMode::kParticles).deviceSurface, nullptr);
+  render::Image a, b;
+  ASSERT_TRUE(pictures->Write(viaHost, dir.File("host.png")).ok());
+  ASSERT_TRUE(pictures->Write(viaBuffers, dir.File("buffers.png")).ok());
+  ASSERT_TRUE(app::ReadPng(dir.File("host.png"), &a).ok());
+  ASSERT_TRUE(app::ReadPng(dir.File("buffers.png"), &b).ok());
+  ASSERT_EQ(a.rgba.size(), b.rgba.size());
+  int differing = 0, water = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i) differing += a.rgba[i] != b.rgba[i];
+  for (int yy = 0; yy < 180; ++yy) {
+    for (int xx = 0; xx < 320; ++xx) water += Watery(RenderFixture::Rgb(a, xx, yy));
+  }
+  EXPECT_EQ(differing, 0);
+  EXPECT_GT(water, 2000);
+  mesh.reset();  // its GL buffers go while the context is current
+}
+
+TEST(HeadlessPicturesTest, InteropFailureFallsBackToHostCopiesOnce) {
+  // The GL thread's half of the interop path on a machine without a GPU: the worker (forced onto the
+  // interop path, its solver on the CPU) builds without copying; the first write creates the buffers and
+  // fails at Map, as it would where the GL context is not on the CUDA device; the worker then goes back
+  // to host copies, with one warning.
+  app::SceneFile sf;
+  ASSERT_TRUE(app::ParseScene(kSmallScene, "small", &sf).ok());
+  std::unique_ptr<app::OfflinePictures> pictures;  // a current GL context for the interop buffers
+  ASSERT_TRUE(app::OfflinePictures::Create(64, 64, &pictures, true).ok());
+  sim::SolverConfig config;
+  config.device = sim::Device::kCpu;
+  config.threads = 1;
+  LogCapture log;
+  app::SimWorker worker(config);
+  ASSERT_TRUE(worker.Start(app::SimSceneFromFile(sf)).ok());
+  worker.SetPaused(true);
+  worker.ForceSurfacePathForTests(app::SurfacePath::kInterop);
+  auto waitFor = [&](auto predicate) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    std::shared_ptr<const app::SimSnapshot> s = worker.Latest();
+    while (!predicate(*s) && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      s = worker.Latest();
+    }
+    return s;
+  };
+  const auto onDevice = waitFor([](const app::SimSnapshot& s) { return s.surfaceOnDevice; });
+  ASSERT_TRUE(onDevice->surfaceOnDevice);
+  EXPECT_GT(onDevice->surfaceBuild, 0u);
+  EXPECT_GT(onDevice->surfaceVertices, 300);
+  EXPECT_EQ(onDevice->surface.VertexCount(), 0);
+  app::InteropSurface interop;
+  EXPECT_EQ(interop.Update(worker, *onDevice), nullptr);
+  EXPECT_EQ(worker.Path(), app::SurfacePath::kHostCopy);
+  EXPECT_EQ(interop.Update(worker, *onDevice), nullptr);  // again: host path now, no second warning
+  const auto host = waitFor([](const app::SimSnapshot& s) { return !s.surfaceOnDevice && s.surface.VertexCount() > 0; });
+  EXPECT_FALSE(host->surfaceOnDevice);
+  EXPECT_EQ(host->surface.VertexCount(), onDevice->surfaceVertices) << "paused: the same state, the same mesh";
+  worker.Stop();
+  EXPECT_EQ(log.Count("CUDA-GL interop failed", LogLevel::kWarn), 1) << log.All();
+  EXPECT_EQ(log.Count("interop buffers grown"), 1) << log.All();
+  interop.Reset();  // its GL buffers go while the context is current
 }
 
 }  // namespace

@@ -26,9 +26,12 @@ render::FrameScene MakeFrameScene(const sim::SceneSetup& scene, const sim::HostF
 /// The full FrameScene of a snapshot, what the desktop window, the headset and headless pictures draw:
 /// tank, obstacles, particles, the water surface (water mode, when the snapshot has one; else the
 /// particles are drawn as water) and the paddles (render::SolidMesh per box and capsule at the body's
-/// pose). The snapshot must outlive the returned scene.
+/// pose). The snapshot must outlive the returned scene. GPU path: a snapshot whose surface stayed on the
+/// device (SimSnapshot::surfaceOnDevice) draws `deviceSurface` (GL buffers written in place, see
+/// InteropSurface in app/src/sim_worker.h) as FrameScene::deviceSurface instead.
 render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMode mode,
-                                  render::ParticleColor color = render::ParticleColor::kSpeed);
+                                  render::ParticleColor color = render::ParticleColor::kSpeed,
+                                  const render::InteropMesh* deviceSurface = nullptr);
 /// The solids of one paddle at its pose (appended to `out`).
 void AppendPaddleSolids(const PaddlePose& paddle, std::vector<render::SolidMesh>* out);
 

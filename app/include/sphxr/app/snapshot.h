@@ -40,6 +40,13 @@ struct SimSnapshot {
   double surfaceMs = 0.0;        // wall ms of the extraction that made `surface`
   float surfaceCellSize = 0.0f;  // m, the cell size it was extracted with
   bool surfaceFresh = false;     // extracted for this state (else the previous state's mesh, kept to save time)
+  /// GPU path (SurfacePath::kInterop): the mesh was built in the solver (BuildSurface) and not copied:
+  /// `surface` is empty, the mesh has `surfaceVertices` vertices and the GL thread writes it into its
+  /// render::InteropMesh (SimWorker::WriteSurfaceInto). `surfaceBuild` numbers the worker's builds.
+  bool surfaceOnDevice = false;
+  int64_t surfaceVertices = 0;
+  uint64_t surfaceBuild = 0;
+  int64_t SurfaceTriangles() const { return (surfaceOnDevice ? surfaceVertices : surface.VertexCount()) / 3; }
 
   /// Paddles (interaction::PaddleSystem) and what the hands feel: haptic amplitude 0..1 per hand
   /// (index 0 left, 1 right; PaddleSystem::HapticAmplitude).
@@ -56,9 +63,19 @@ struct SurfaceRequest {
   sim::SurfaceParams params;  // cellSize 0: the particle spacing
 };
 
+/// How the water surface reaches GL. kHostCopy: the mesh is copied into each snapshot and uploaded
+/// every frame (the CPU backend, where the mesh is in host memory anyway). kInterop: the solver only
+/// builds the mesh (field + pyramid) and the GL thread has it written straight into mapped GL buffers
+/// (CUDA-GL interop, no host copy).
+enum class SurfacePath { kHostCopy, kInterop };
+const char* SurfacePathName(SurfacePath path);
+/// kInterop exactly when the solver runs on the CUDA device (Solver::ActiveDevice()).
+SurfacePath ChooseSurfacePath(sim::Device activeDevice);
+
 /// Copies the solver's state into `out` (fluid, step info, counts), the paddles' poses and loads
-/// (`paddles` may be null) and, when `surface.enabled`, extracts the surface (timed).
+/// (`paddles` may be null) and, when `surface.enabled`, extracts the surface (timed): a host copy, or
+/// with SurfacePath::kInterop only BuildSurface (`out->surfaceOnDevice`, `out->surfaceVertices`).
 Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* paddles, const SurfaceRequest& surface,
-                       SimSnapshot* out);
+                       SimSnapshot* out, SurfacePath path = SurfacePath::kHostCopy);
 
 }  // namespace sphxr::app

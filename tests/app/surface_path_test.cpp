@@ -1,0 +1,105 @@
+// How the water surface reaches GL (docs/rendering.md, "The surface's two paths"): copied to the host
+// on the CPU backend, written in place through CUDA-GL interop when the solver runs on the CUDA device.
+// No GPU here: the choice and the CPU side are tested; the interop write itself has never run.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "sim_worker.h"  // app/src: SimWorker, InteropSurface
+#include "sphxr/app/scene_file.h"
+#include "sphxr/app/snapshot.h"
+#include "support.h"
+
+namespace sphxr::app {
+namespace {
+
+// 720 particles in a small tank: a surface of some hundreds of triangles.
+constexpr const char* kSmallScene = R"({
+  "name": "small",
+  "solver": { "spacing": 0.01, "max_dt": 0.001 },
+  "tank": { "min": [0, 0, 0], "max": [0.2, 0.15, 0.1] },
+  "fluid": [ { "min": [0.04, 0.0, 0.02], "max": [0.16, 0.10, 0.08] } ]
+})";
+
+TEST(SurfacePathTest, InteropOnlyForASolverOnTheCudaDevice) {
+  EXPECT_EQ(ChooseSurfacePath(sim::Device::kCuda), SurfacePath::kInterop);
+  EXPECT_EQ(ChooseSurfacePath(sim::Device::kCpu), SurfacePath::kHostCopy);
+  EXPECT_EQ(ChooseSurfacePath(sim::Device::kAuto), SurfacePath::kHostCopy);  // never an active device
+  EXPECT_STREQ(SurfacePathName(SurfacePath::kInterop), "CUDA-GL interop");
+  EXPECT_STREQ(SurfacePathName(SurfacePath::kHostCopy), "host copy");
+}
+
+TEST(SurfacePathTest, WorkerOnTheCpuPublishesTheHostMeshAndSaysSoOnce) {
+  SceneFile scene;
+  ASSERT_TRUE(ParseScene(kSmallScene, "small", &scene).ok());
+  sim::SolverConfig config;
+  config.device = sim::Device::kCpu;
+  config.threads = 1;
+  test::LogCapture log;
+  ResetLogOnce();
+  SimWorker worker(config);
+  ASSERT_TRUE(worker.Start(SimSceneFromFile(scene)).ok());
+  EXPECT_EQ(worker.Path(), SurfacePath::kHostCopy);
+  const std::shared_ptr<const SimSnapshot> snap = worker.Latest();
+  ASSERT_TRUE(snap);
+  EXPECT_TRUE(snap->surfaceFresh);
+  EXPECT_FALSE(snap->surfaceOnDevice);
+  EXPECT_EQ(snap->surfaceBuild, 0u);
+  EXPECT_GT(snap->surface.TriangleCount(), 100);
+  EXPECT_EQ(snap->SurfaceTriangles(), snap->surface.TriangleCount());
+  // The GL side has nothing to write on this path: it draws the snapshot's host mesh.
+  std::unique_ptr<render::InteropMesh> mesh;
+  uint64_t build = 7;
+  const Status s = worker.WriteSurfaceInto(&mesh, &build);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("copied to the host"), std::string::npos) << s.message();
+  EXPECT_EQ(build, 0u);
+  EXPECT_FALSE(mesh);
+  InteropSurface interop;
+  EXPECT_EQ(interop.Update(worker, *snap), nullptr);
+  worker.Stop();
+  EXPECT_EQ(log.Count("surface: solver on the CPU"), 1) << log.All();
+  EXPECT_EQ(log.Count("CUDA-GL interop"), 0) << log.All();
+}
+
+TEST(SurfacePathTest, InteropCaptureBuildsTheMeshWithoutCopyingIt) {
+  // The snapshot side of the GPU path, run on the CPU backend (BuildSurface is backend-independent):
+  // the solver keeps the mesh, the snapshot carries only its size.
+  SceneFile scene;
+  ASSERT_TRUE(ParseScene(kSmallScene, "small", &scene).ok());
+  sim::SolverConfig config;
+  config.device = sim::Device::kCpu;
+  config.threads = 1;
+  std::unique_ptr<sim::Solver> solver;
+  ASSERT_TRUE(sim::Solver::Create(scene.setup, config, &solver).ok());
+  SimSnapshot host, device;
+  ASSERT_TRUE(CaptureSnapshot(*solver, nullptr, {}, &host).ok());
+  ASSERT_TRUE(CaptureSnapshot(*solver, nullptr, {}, &device, SurfacePath::kInterop).ok());
+  EXPECT_FALSE(host.surfaceOnDevice);
+  EXPECT_TRUE(device.surfaceOnDevice);
+  EXPECT_TRUE(device.surfaceFresh);
+  EXPECT_EQ(device.surface.VertexCount(), 0);
+  EXPECT_EQ(device.surfaceVertices, host.surface.VertexCount());
+  EXPECT_EQ(device.SurfaceTriangles(), host.SurfaceTriangles());
+  EXPECT_EQ(device.surfaceCellSize, host.surfaceCellSize);
+  // The GL thread writes the build later, maybe after more steps (and a kept build again): the steps do
+  // not change what WriteSurface writes.
+  const int64_t n = device.surfaceVertices;
+  std::vector<float> p0(3 * n), n0(3 * n), p1(3 * n), n1(3 * n);
+  ASSERT_TRUE(solver->WriteSurface({p0.data(), n0.data(), n}, nullptr).ok());
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(solver->Step().ok());
+  ASSERT_TRUE(solver->WriteSurface({p1.data(), n1.data(), n}, nullptr).ok());
+  EXPECT_EQ(p0, host.surface.positions);
+  EXPECT_EQ(n0, host.surface.normals);
+  EXPECT_EQ(p1, p0);
+  EXPECT_EQ(n1, n0);
+  SurfaceRequest off;
+  off.enabled = false;
+  ASSERT_TRUE(CaptureSnapshot(*solver, nullptr, off, &device, SurfacePath::kInterop).ok());
+  EXPECT_FALSE(device.surfaceOnDevice);
+  EXPECT_EQ(device.SurfaceTriangles(), 0);
+}
+
+}  // namespace
+}  // namespace sphxr::app
