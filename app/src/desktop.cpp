@@ -497,6 +497,11 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     if (ImGui::Checkbox("reuse on", &r.enabled)) Rebuild();
     ImGui::SameLine();
     ImGui::Text("active fraction %.1f %%", 100.0 * snap.last.activeFraction);
+    ImGui::TextUnformatted("preset:");
+    for (const char* preset : {"accurate", "balanced", "fast"}) {
+      ImGui::SameLine();
+      if (ImGui::SmallButton(preset) && sim::ApplyReusePreset(preset, &r)) Rebuild();  // turns reuse on
+    }
     for (const ParamDesc& p : ParamRegistry()) {
       if (p.group == "reuse" && editor(p) && r.enabled) Rebuild();
     }
