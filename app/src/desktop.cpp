@@ -19,6 +19,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <vector>
 
+#include "gl_window.h"
 #include "sphxr/app/param_registry.h"
 #include "sim_worker.h"
 #include "sphxr/app/pictures.h"
@@ -33,9 +34,6 @@
 
 namespace sphxr::app {
 namespace {
-
-std::string g_glfwError;  // the last GLFW error, for one-line messages
-void GlfwError(int code, const char* text) { g_glfwError = Format("%s (GLFW 0x%x)", text, code); }
 
 /// Orbit camera: yaw/pitch around a target, at a distance; pans move the target.
 struct OrbitCamera {
@@ -93,13 +91,7 @@ struct DesktopApp::Impl {
     if (window) glfwMakeContextCurrent(window);
     interop.Reset();
     renderer.reset();
-    if (imguiReady) {
-      ImGui_ImplOpenGL3_Shutdown();
-      ImGui_ImplGlfw_Shutdown();
-      ImGui::DestroyContext();
-    }
-    if (window) glfwDestroyWindow(window);
-    glfwTerminate();
+    CloseGlWindow(window, imguiReady);
   }
 
   void FrameTank() {
@@ -248,22 +240,14 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   if (options.reuse >= 0) m.scene.setup.reuse.enabled = options.reuse == 1;
   m.setup = m.scene.setup;
 
-  glfwSetErrorCallback(GlfwError);
-  g_glfwError.clear();
-  if (!glfwInit()) return Status::Error("cannot open a window: " + g_glfwError);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   render::RendererConfig config;
   config.debug = config.debug || options.glDebug;
-  glfwWindowHint(GLFW_OPENGL_DEBUG_CONTEXT, config.debug ? GLFW_TRUE : GLFW_FALSE);
-  m.window = glfwCreateWindow(options.windowWidth, options.windowHeight, "sphxr", nullptr, nullptr);
-  if (!m.window) {
-    return Status::Error("cannot open an OpenGL 4.5 core window: " + g_glfwError + " (the renderer needs GL 4.5)");
-  }
-  glfwMakeContextCurrent(m.window);
-  glfwSwapInterval(options.vsync ? 1 : 0);
+  GlWindowRequest request;
+  request.width = options.windowWidth;
+  request.height = options.windowHeight;
+  request.debug = config.debug;
+  request.vsync = options.vsync;
+  if (Status s = OpenGlWindow(request, &m.window); !s) return s;
   if (Status s = render::Renderer::Create(config, &m.renderer); !s) return s;
   SPHXR_LOG_INFO("desktop window %dx%d, %s", options.windowWidth, options.windowHeight, render::GlDescription());
 
@@ -285,12 +269,7 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
     if (action != GLFW_PRESS || (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard)) return;
     static_cast<DesktopApp*>(glfwGetWindowUserPointer(w))->OnKey(key);
   });
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
-  ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(m.window, true);
-  ImGui_ImplOpenGL3_Init("#version 450 core");
+  InitImGui(m.window);
   m.imguiReady = true;
 
   std::error_code ec;

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "gl_window.h"
 #include "sim_worker.h"
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/pictures.h"
@@ -37,18 +38,6 @@ namespace sphxr::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string g_glfwError;
-void GlfwError(int code, const char* text) { g_glfwError = Format("%s (GLFW 0x%x)", text, code); }
-
-// ---- The hand-off to the simulation: hands in, haptics and the frame out. ----
-void SendHands(SimWorker& worker, const std::vector<interaction::HandInput>& hands) { worker.SetHands(hands); }
-float HapticAmplitude(const SimSnapshot& snap, int hand) { return snap.haptic[hand]; }
-render::FrameScene BuildFrameScene(const SimSnapshot& snap, render::RenderMode mode, render::ParticleColor color,
-                                   const render::InteropMesh* deviceSurface) {
-  return MakeFrameScene(snap, mode, color, deviceSurface);  // surface mesh (or particles), paddles, tank
-}
-// ---- end of the hand-off ----
 
 glm::mat4 ToGlm(const xr::Mat4& m) { return glm::make_mat4(m.m.data()); }
 
@@ -119,13 +108,7 @@ struct XrApp {
     session.reset();
     interop.Reset();
     renderer.reset();
-    if (imguiReady) {
-      ImGui_ImplOpenGL3_Shutdown();
-      ImGui_ImplGlfw_Shutdown();
-      ImGui::DestroyContext();
-    }
-    if (window) glfwDestroyWindow(window);
-    if (window || imguiReady) glfwTerminate();
+    CloseGlWindow(window, imguiReady);
   }
 
   void Panel(const SimSnapshot& snap, const XrOutcome& out) {
@@ -186,24 +169,16 @@ struct XrApp {
 
 Status OpenWindowAndSession(XrApp& app, XrOutcome* outcome) {
   const Options& options = app.options;
-  glfwSetErrorCallback(GlfwError);
-  g_glfwError.clear();
-  if (!glfwInit()) return Status::Error("cannot open the mirror window: " + g_glfwError);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   render::RendererConfig config;
   config.debug = config.debug || options.glDebug;
-  glfwWindowHint(GLFW_OPENGL_DEBUG_CONTEXT, config.debug ? GLFW_TRUE : GLFW_FALSE);
-  app.window = glfwCreateWindow(options.windowWidth, options.windowHeight, "sphxr (headset mirror: left eye)",
-                                nullptr, nullptr);
-  if (!app.window) {
-    glfwTerminate();
-    return Status::Error("cannot open an OpenGL 4.5 core window for the headset: " + g_glfwError);
-  }
-  glfwMakeContextCurrent(app.window);
-  glfwSwapInterval(0);  // the headset paces the loop, not the mirror
+  GlWindowRequest request;
+  request.width = options.windowWidth;
+  request.height = options.windowHeight;
+  request.title = "sphxr (headset mirror: left eye)";
+  request.what = "the headset's mirror window";
+  request.debug = config.debug;
+  request.vsync = false;  // the headset paces the loop, not the mirror
+  if (Status s = OpenGlWindow(request, &app.window); !s) return s;
   if (Status s = render::Renderer::Create(config, &app.renderer); !s) return s;
 
   xr::GraphicsBinding binding;
@@ -214,12 +189,7 @@ Status OpenWindowAndSession(XrApp& app, XrOutcome* outcome) {
   SPHXR_LOG_INFO("headset: runtime '%s', %dx%d per eye, %s", app.session->runtimeName().c_str(),
                  app.session->eyeWidth(), app.session->eyeHeight(), render::GlDescription());
 
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;
-  ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(app.window, true);
-  ImGui_ImplOpenGL3_Init("#version 450 core");
+  InitImGui(app.window);
   app.imguiReady = true;
   return Status::Ok();
 }
@@ -340,9 +310,9 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
           const double displayTime = 1e-9 * static_cast<double>(info.predictedDisplayTimeNs);
           std::vector<interaction::HandInput> hands;
           for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, app.setup.tank, displayTime));
-          SendHands(*app.worker, hands);
+          app.worker->SetHands(hands);
           for (int h = 0; h < xr::kHandCount; ++h) {
-            float amplitude = HapticAmplitude(*snap, h);
+            float amplitude = snap->haptic[h];
             if (amplitude < 0.01f) amplitude = 0.0f;
             if (amplitude == 0.0f && app.lastHaptic[h] == 0.0f) continue;  // stop once, not every frame
             app.lastHaptic[h] = amplitude;
@@ -355,7 +325,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
             app.worker->Reset(app.simScene);
           }
           // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
-          frame = BuildFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));
+          frame = MakeFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));
         },
         [&](const xr::FrameInfo&, const xr::EyeView& eye) {
           // The renderer writes display-ready colour (the desktop window shows its bytes as they are):
