@@ -24,13 +24,8 @@
 
 namespace {
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double Ms(std::chrono::steady_clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+using sphxr::bench::Median;
+using sphxr::bench::Ms;
 
 }  // namespace
 

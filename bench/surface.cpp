@@ -41,8 +41,6 @@ const char* kUsage =
     "  --csv FILE   append one row per cell size\n"
     "  --scene FILE (default " SPHXR_SCENES_DIR "/dam_break_1m.json)\n";
 
-double Ms(std::chrono::steady_clock::duration d) { return 1e3 * std::chrono::duration<double>(d).count(); }
-
 int Run(int argc, char** argv) {
   int threads = 2, repeat = 15;
   double time = 0.5;

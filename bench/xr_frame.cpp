@@ -29,11 +29,7 @@ using namespace sphxr;
 
 struct Stats {
   std::vector<double> v;
-  double Pct(double p) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    return v[std::min(v.size() - 1, size_t(p * double(v.size() - 1) + 0.5))];
-  }
+  double Pct(double p) const { return bench::Quantile(v, p); }
 };
 
 bool RunOnce(const char* label, bool validation, int frames) {
