@@ -270,14 +270,6 @@ class BackendImpl final : public Backend {
 #undef SPHXR_DEVICE_FIELD
   };
 
-  template <class T>
-  static T* Raw(Vector<T>& v) {
-    return thrust::raw_pointer_cast(v.data());
-  }
-  template <class T>
-  static const T* Raw(const Vector<T>& v) {
-    return thrust::raw_pointer_cast(v.data());
-  }
 
   template <class T>
   Vector<T>& Scratch() {

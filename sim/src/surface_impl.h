@@ -20,6 +20,13 @@
 
 namespace sphxr::sim {
 
+/// The raw pointer to a thrust vector's elements (host or device; const stays const), for the stages'
+/// plain views. Shared by the step's and the surface's launchers.
+template <class V>
+auto Raw(V& v) {
+  return thrust::raw_pointer_cast(v.data());
+}
+
 /// The particles as the field stage reads them: sorted positions and a neighbour grid built for them.
 struct SurfaceParticles {
   const Vec4* position;
@@ -161,15 +168,6 @@ class SurfaceImpl final : public SurfaceExtractor {
   }
 
  private:
-  template <class T>
-  static T* Raw(Vector<T>& v) {
-    return thrust::raw_pointer_cast(v.data());
-  }
-  template <class T>
-  static const T* Raw(const Vector<T>& v) {
-    return thrust::raw_pointer_cast(v.data());
-  }
-
   FieldView Field(const SurfaceGrid& grid, float iso) const {
     return FieldView{grid.origin, grid.cellSize, 0.5f / grid.cellSize, grid.nx, grid.ny, grid.nz, iso, Raw(m_field)};
   }
