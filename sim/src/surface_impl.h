@@ -44,7 +44,9 @@ class SurfaceImpl final : public SurfaceExtractor {
   /// `source` re-grids the backend's particles (their grid is stale after a step) and returns them.
   explicit SurfaceImpl(std::function<SurfaceParticles()> source) : m_source(std::move(source)) {
     const McTables& t = kMcTables;
-    m_vertexCount.assign(t.vertexCount, t.vertexCount + 256);
+    std::vector<uint32_t> word(256);
+    for (int c = 0; c < 256; ++c) word[c] = t.vertexCount[c] | (static_cast<uint32_t>(c) << PyramidView::kCaseShift);
+    m_baseWord.assign(word.begin(), word.end());
     m_edges.assign(&t.edges[0][0], &t.edges[0][0] + 256 * kMcMaxVertices);
   }
 
@@ -90,19 +92,19 @@ class SurfaceImpl final : public SurfaceExtractor {
     // Every sample is written by exactly one block of the field stage; NaN first makes a miss visible.
     thrust::fill(policy, m_field.begin(), m_field.end(), std::numeric_limits<float>::quiet_NaN());
 
-    // Near flags for the neighbour-grid cells under the lattice.
+    // Blocks of B^3 neighbour-grid cells under the lattice: B as large as keeps a block within
+    // FieldStage::kMaxBlock samples per axis (a cell holds up to ceil(ratio) + 1 samples per axis).
     int c0[3], c1[3];
     p.grid.CellOf(grid.origin, &c0[0], &c0[1], &c0[2]);
     p.grid.CellOf(grid.origin + Vec3{(grid.nx - 1) * cs, (grid.ny - 1) * cs, (grid.nz - 1) * cs}, &c1[0], &c1[1], &c1[2]);
-    const int nearDims[3] = {c1[0] - c0[0] + 1, c1[1] - c0[1] + 1, c1[2] - c0[2] + 1};
-    const int nearCount = nearDims[0] * nearDims[1] * nearDims[2];
-    m_near.resize(static_cast<size_t>(nearCount));
-    thrust::for_each_n(policy, thrust::counting_iterator<int>(0), nearCount,
-                       NearCellsStage{p.grid, c0[0], c0[1], c0[2], nearDims[0], nearDims[1], Raw(m_near)});
-    FieldView f = Field(grid, job.isoLevel);
-    thrust::for_each_n(policy, thrust::counting_iterator<int>(0), nearCount,
-                       FieldStage{p.grid, p.position, job.kernel, job.volume, f, c0[0], c0[1], c0[2], nearDims[0],
-                                  nearDims[1], Raw(m_near), Raw(m_field)});
+    const int perCell = static_cast<int>(std::ceil(p.grid.cellSize / cs));
+    const int block = std::max(1, (FieldStage::kMaxBlock - 1) / std::max(1, perCell));
+    int blocks[3];
+    for (int a = 0; a < 3; ++a) blocks[a] = (c1[a] - c0[a]) / block + 1;
+    const FieldView f = Field(grid, job.isoLevel);
+    thrust::for_each_n(policy, thrust::counting_iterator<int>(0), blocks[0] * blocks[1] * blocks[2],
+                       FieldStage{p.grid, p.position, job.kernel, job.volume, f, c0[0], c0[1], c0[2], c1[0], c1[1],
+                                  c1[2], block, blocks[0], blocks[1], Raw(m_field)});
     return BuildPyramid(grid, job.isoLevel, begin, stats);
   }
 
@@ -117,7 +119,6 @@ class SurfaceImpl final : public SurfaceExtractor {
       return Status::Error("surface: the lattice must have at most 2^30 samples and a positive cell size");
     }
     m_field.assign(field.begin(), field.end());
-    m_near.clear();
     return BuildPyramid(grid, isoLevel, begin, stats);
   }
 
@@ -172,7 +173,8 @@ class SurfaceImpl final : public SurfaceExtractor {
     return FieldView{grid.origin, grid.cellSize, 0.5f / grid.cellSize, grid.nx, grid.ny, grid.nz, iso, Raw(m_field)};
   }
 
-  /// Levels: 0 = one node per cell; each level above halves every dimension (rounding up) until 1x1x1.
+  /// Levels: 0 = one node per cell; each level above halves every dimension (rounding up) until 1x1x1
+  /// (at least two levels: the base and the apex).
   Status BuildPyramid(const SurfaceGrid& grid, float iso, Clock::time_point begin, SurfaceStats* stats) {
     auto policy = Traits::Policy();
     Traits::Sync();
@@ -199,22 +201,25 @@ class SurfaceImpl final : public SurfaceExtractor {
                    m_pyramid.bricks[level][2];
         }
         m_pyramid.levels = level + 1;
-        if (d[0] == 1 && d[1] == 1 && d[2] == 1) break;
+        if (level > 0 && d[0] == 1 && d[1] == 1 && d[2] == 1) break;  // a single cell still gets a level 1
         for (int& x : d) x = (x + 1) / 2;
       }
       m_nodes.resize(static_cast<size_t>(total));
       m_nodes[static_cast<size_t>(cells)] = 0;
       m_pyramid.count = Raw(m_nodes);
       const FieldView f = Field(grid, iso);
-      thrust::for_each_n(policy, thrust::counting_iterator<int>(0), static_cast<int>(cells),
-                         BaseLevelStage{f, m_pyramid, Raw(m_vertexCount)});
-      for (int level = 1; level < m_pyramid.levels; ++level) {
+      // The base and level 1 in one pass over the field, then one launch per level up to the apex.
+      const int top = m_pyramid.levels - 1;
+      const int* b1 = m_pyramid.bricks[1];
+      const int segments = (b1[0] + BaseLevelStage::kSegment - 1) / BaseLevelStage::kSegment;
+      thrust::for_each_n(policy, thrust::counting_iterator<int>(0), segments * b1[1] * b1[2],
+                         BaseLevelStage{f, m_pyramid, Raw(m_baseWord), segments});
+      for (int level = 2; level <= top; ++level) {
         const int* b = m_pyramid.bricks[level];
-        thrust::for_each_n(policy, thrust::counting_iterator<int>(0), 8 * b[0] * b[1] * b[2],
+        thrust::for_each_n(policy, thrust::counting_iterator<int>(0), b[0] * b[1] * b[2],
                            ReduceLevelStage{m_pyramid, level});
       }
-      const uint32_t apex = m_nodes[static_cast<size_t>(m_pyramid.offset[m_pyramid.levels - 1])];
-      m_vertices = apex;
+      m_vertices = m_nodes[static_cast<size_t>(m_pyramid.offset[top] + 7)];  // the apex: its brick's last sum
       stats->baseBytes = cells * static_cast<int64_t>(sizeof(uint32_t));
       stats->pyramidBytes = total * static_cast<int64_t>(sizeof(uint32_t));
     }
@@ -224,7 +229,7 @@ class SurfaceImpl final : public SurfaceExtractor {
     stats->vertices = m_vertices;
     stats->triangles = m_vertices / 3;
     stats->pyramidLevels = m_pyramid.levels;
-    stats->fieldBytes = static_cast<int64_t>(m_field.size() * sizeof(float) + m_near.size());
+    stats->fieldBytes = static_cast<int64_t>(m_field.size() * sizeof(float));
     stats->capacity = m_capacity;
     stats->fieldSeconds = std::chrono::duration<double>(fieldDone - begin).count();
     stats->pyramidSeconds = std::chrono::duration<double>(pyramidDone - fieldDone).count();
@@ -242,10 +247,9 @@ class SurfaceImpl final : public SurfaceExtractor {
   }
 
   std::function<SurfaceParticles()> m_source;
-  Vector<uint8_t> m_vertexCount;  // the case table on this system
+  Vector<uint32_t> m_baseWord;    // per case: vertex count | case << kCaseShift, on this system
   Vector<int8_t> m_edges;
   Vector<float> m_field;
-  Vector<uint8_t> m_near;
   Vector<uint32_t> m_nodes;       // every pyramid level, base first
   PyramidView m_pyramid{};
   SurfaceGrid m_grid;

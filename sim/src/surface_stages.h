@@ -4,13 +4,13 @@
 // surface_impl.h launches them with thrust on the OpenMP system (CPU backend) or the CUDA system.
 //
 //   1. bounds     the fluid's bounding box (a reduction); the sample lattice covers it plus a margin
-//   2. near       per neighbour-grid cell under the lattice: is any fluid particle in its 27 cells?
-//   3. field      phi at every sample, gathered through the neighbour grid's cellStart/cellEnd, one
-//                 work item per neighbour cell for the samples in it; a block that is not near is
-//                 written as zeros without reading a particle
-//   4. base       level 0 of the pyramid: the vertex count of each cell's marching-cubes case
-//   5. reduce     level l node = sum of its 2x2x2 children in level l-1, up to the apex (the total)
-//   6. traverse   one thread per output vertex: walk down from the apex, at each level skipping the
+//   2. field      phi at every sample, through the neighbour grid's cellStart/cellEnd: one work item
+//                 per block of neighbour cells adds each candidate particle's kernel to the block's
+//                 samples within its reach (a clipped box); a block with no particle in reach writes zeros
+//   3. base       level 0 of the pyramid: the vertex count of each cell's marching-cubes case (and the
+//                 case), fused with level 1 (the 2x2x2 sums of the base) in one pass over the field
+//   4. reduce     level l node = sum of its 2x2x2 children in level l-1, up to the apex (the total)
+//   5. traverse   one thread per output vertex: walk down from the apex, at each level skipping the
 //                 children whose counts lie before the vertex's index, to its cell and the vertex's
 //                 slot there; the case table names the edge; the position is interpolated on it and the
 //                 normal is -grad phi (central differences), interpolated the same way.
@@ -74,32 +74,16 @@ struct FieldView {
   }
 };
 
-// ---- 2. near flags: neighbour-grid cells [c0, c0 + n) that have fluid in their 27 cells ----------
-struct NearCellsStage {
-  GridView grid;
-  int c0x, c0y, c0z;
-  int nx, ny;  // extent of the flagged block (nz implied by the launch size)
-  uint8_t* near;
-  SPHXR_HD void operator()(int b) const {
-    const int cx = c0x + b % nx, cy = c0y + (b / nx) % ny, cz = c0z + b / (nx * ny);
-    uint8_t any = 0;
-    for (int z = cz - 1; z <= cz + 1 && !any; ++z)
-      for (int y = cy - 1; y <= cy + 1; ++y)
-        for (int x = cx - 1; x <= cx + 1; ++x) {
-          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
-          if (grid.fluidStart[grid.Linear(x, y, z)] != kEmptyCell) any = 1;
-        }
-    near[b] = any;
-  }
-};
-
-// ---- 3. the field: phi(x) = sum_j V W(|x - x_j|), V = m / rho0 --------------------------------------
-/// One neighbour-grid cell of the near block: the samples whose cell (GridView::CellOf) it is share
-/// their 27 candidate cells, so the candidates are read once for all of them, and each candidate is
-/// tested against the samples' planes, rows and points in turn (a plane beyond the support skips its
-/// rows). Per sample the particles are summed in the order of ForEachInCells (z, y, x, then the cell's
-/// range), so the value is the same as a per-sample gather. A block of more than kMaxBlock samples along
-/// an axis (cells much finer than the support) gathers sample by sample.
+// ---- 2. the field: phi(x) = sum_j V W(|x - x_j|), V = m / rho0 --------------------------------------
+/// One work item per block of B x B x B neighbour-grid cells under the lattice, for all the samples
+/// whose cell (GridView::CellOf) lies in the block (at most kMaxBlock per axis). The candidates are the
+/// particles of the block's cells and of the ring of cells around it, read once; each one adds its
+/// kernel to the samples inside its reach box [q - H, q + H], clipped to the block's samples
+/// arithmetically, so a sample is tested only against particles whose box holds it. Per sample the
+/// particles are added in the order of ForEachInCells (z, y, x, then the cell's range) restricted to
+/// the particles within the support: the value is that of a per-sample gather up to the rounding of
+/// r^2. A block with no particle in reach writes zeros. Lattices much finer than the support (more than
+/// kMaxBlock samples per neighbour cell) gather sample by sample.
 struct FieldStage {
   static constexpr int kMaxBlock = 8;
   GridView grid;
@@ -107,8 +91,10 @@ struct FieldStage {
   CubicSpline kernel;
   float volume;          // m / rho0 = dx^3
   FieldView field;
-  int c0x, c0y, c0z, nearNx, nearNy;
-  const uint8_t* near;
+  int c0x, c0y, c0z;     // the first neighbour cell under the lattice
+  int c1x, c1y, c1z;     // the last one
+  int block;             // B, neighbour cells per block and axis
+  int blocksX, blocksY;  // blocks per axis (blocksZ implied by the launch size)
   float* out;
 
   /// Samples [first, first + count) along one axis whose neighbour cell is c (CellOf's arithmetic).
@@ -130,20 +116,41 @@ struct FieldStage {
     *count = b - a + 1;
   }
 
+  /// Samples of neighbour cells [c, c + n) along one axis, clipped to the last cell under the lattice.
+  SPHXR_HD SPHXR_INLINE void BlockRange(int c, int last, int cells, float gridOrigin, float latticeOrigin,
+                                        int samples, int* first, int* count) const {
+    const int e = c + block - 1 < last ? c + block - 1 : last;
+    int a, na, b, nb;
+    AxisRange(c, cells, gridOrigin, grid.invCellSize, grid.cellSize, latticeOrigin, field.cellSize, samples, &a, &na);
+    AxisRange(e, cells, gridOrigin, grid.invCellSize, grid.cellSize, latticeOrigin, field.cellSize, samples, &b, &nb);
+    *first = a;
+    *count = b + nb - a;
+  }
+
+  /// Indices [lo, hi] of the samples first + i (i in [0, n)) at spacing h with |s_i - q| < reach.
+  SPHXR_HD SPHXR_INLINE static void Clip(float q, float first, float invH, float reachCells, int n, int* lo, int* hi) {
+    const float t = (q - first) * invH;
+    const int a = static_cast<int>(ceilf(t - reachCells)), b = static_cast<int>(floorf(t + reachCells));
+    *lo = a < 0 ? 0 : a;
+    *hi = b > n - 1 ? n - 1 : b;
+  }
+
   SPHXR_HD void operator()(int b) const {
-    const int cx = c0x + b % nearNx, cy = c0y + (b / nearNx) % nearNy, cz = c0z + b / (nearNx * nearNy);
+    const int bx = b % blocksX, by = (b / blocksX) % blocksY, bz = b / (blocksX * blocksY);
+    const int cx = c0x + bx * block, cy = c0y + by * block, cz = c0z + bz * block;
     int i0, ni, j0, nj, k0, nk;
-    AxisRange(cx, grid.nx, grid.origin.x, grid.invCellSize, grid.cellSize, field.origin.x, field.cellSize, field.nx, &i0, &ni);
-    AxisRange(cy, grid.ny, grid.origin.y, grid.invCellSize, grid.cellSize, field.origin.y, field.cellSize, field.ny, &j0, &nj);
-    AxisRange(cz, grid.nz, grid.origin.z, grid.invCellSize, grid.cellSize, field.origin.z, field.cellSize, field.nz, &k0, &nk);
+    BlockRange(cx, c1x, grid.nx, grid.origin.x, field.origin.x, field.nx, &i0, &ni);
+    BlockRange(cy, c1y, grid.ny, grid.origin.y, field.origin.y, field.ny, &j0, &nj);
+    BlockRange(cz, c1z, grid.nz, grid.origin.z, field.origin.z, field.nz, &k0, &nk);
     if (ni <= 0 || nj <= 0 || nk <= 0) return;
-    if (!near[b]) {
-      for (int k = 0; k < nk; ++k)
-        for (int j = 0; j < nj; ++j)
-          for (int i = 0; i < ni; ++i) out[field.Index(i0 + i, j0 + j, k0 + k)] = 0.0f;
-      return;
-    }
     const CubicSpline w = kernel;
+    // The block's cells and their ring.
+    const int ex = cx + block - 1 < c1x ? cx + block - 1 : c1x;
+    const int ey = cy + block - 1 < c1y ? cy + block - 1 : c1y;
+    const int ez = cz + block - 1 < c1z ? cz + block - 1 : c1z;
+    const int x0 = cx > 0 ? cx - 1 : 0, x1 = ex < grid.nx - 1 ? ex + 1 : ex;
+    const int y0 = cy > 0 ? cy - 1 : 0, y1 = ey < grid.ny - 1 ? ey + 1 : ey;
+    const int z0 = cz > 0 ? cz - 1 : 0, z1 = ez < grid.nz - 1 ? ez + 1 : ez;
     if (ni > kMaxBlock || nj > kMaxBlock || nk > kMaxBlock) {
       for (int k = 0; k < nk; ++k)
         for (int j = 0; j < nj; ++j)
@@ -158,39 +165,38 @@ struct FieldStage {
           }
       return;
     }
-    float xs[kMaxBlock], ys[kMaxBlock], zs[kMaxBlock];
-    for (int i = 0; i < ni; ++i) xs[i] = field.origin.x + static_cast<float>(i0 + i) * field.cellSize;
-    for (int j = 0; j < nj; ++j) ys[j] = field.origin.y + static_cast<float>(j0 + j) * field.cellSize;
-    for (int k = 0; k < nk; ++k) zs[k] = field.origin.z + static_cast<float>(k0 + k) * field.cellSize;
     float sum[kMaxBlock * kMaxBlock * kMaxBlock];
     for (int s = 0; s < ni * nj * nk; ++s) sum[s] = 0.0f;
-    const int z0 = cz > 0 ? cz - 1 : 0, z1 = cz < grid.nz - 1 ? cz + 1 : cz;
-    const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy < grid.ny - 1 ? cy + 1 : cy;
-    const int x0 = cx > 0 ? cx - 1 : 0, x1 = cx < grid.nx - 1 ? cx + 1 : cx;
+    const Vec3 first = field.Point(i0, j0, k0);
+    const float h = field.cellSize, invH = 1.0f / h, reach = w.H * invH;
     for (int z = z0; z <= z1; ++z)
-      for (int y = y0; y <= y1; ++y)
+      for (int y = y0; y <= y1; ++y) {
+        const uint32_t row = grid.Linear(0, y, z);
         for (int x = x0; x <= x1; ++x) {
-          const uint32_t c = grid.Linear(x, y, z);
-          const uint32_t s0 = grid.fluidStart[c];
+          const uint32_t s0 = grid.fluidStart[row + x];
           if (s0 == kEmptyCell) continue;
-          const uint32_t s1 = grid.fluidEnd[c];
+          const uint32_t s1 = grid.fluidEnd[row + x];
           for (uint32_t p = s0; p < s1; ++p) {
             const Vec4 q = position[p];
-            for (int k = 0; k < nk; ++k) {
-              const float dz = zs[k] - q.z, dz2 = dz * dz;
-              if (dz2 >= w.H2) continue;
-              for (int j = 0; j < nj; ++j) {
-                const float dy = ys[j] - q.y, dyz2 = dz2 + dy * dy;
+            int ia, ib, ja, jb, ka, kb;
+            Clip(q.x, first.x, invH, reach, ni, &ia, &ib);
+            Clip(q.y, first.y, invH, reach, nj, &ja, &jb);
+            Clip(q.z, first.z, invH, reach, nk, &ka, &kb);
+            for (int k = ka; k <= kb; ++k) {
+              const float dz = first.z + static_cast<float>(k) * h - q.z, dz2 = dz * dz;
+              for (int j = ja; j <= jb; ++j) {
+                const float dy = first.y + static_cast<float>(j) * h - q.y, dyz2 = dz2 + dy * dy;
                 if (dyz2 >= w.H2) continue;
-                float* row = sum + (k * nj + j) * ni;
-                for (int i = 0; i < ni; ++i) {
-                  const float dx = xs[i] - q.x, r2 = dyz2 + dx * dx;
-                  if (r2 < w.H2) row[i] += w.W(sqrtf(r2));
+                float* line = sum + (k * nj + j) * ni;
+                for (int i = ia; i <= ib; ++i) {
+                  const float dx = first.x + static_cast<float>(i) * h - q.x, r2 = dyz2 + dx * dx;
+                  if (r2 < w.H2) line[i] += w.W(sqrtf(r2));
                 }
               }
             }
           }
         }
+      }
     for (int k = 0; k < nk; ++k)
       for (int j = 0; j < nj; ++j)
         for (int i = 0; i < ni; ++i) out[field.Index(i0 + i, j0 + j, k0 + k)] = volume * sum[(k * nj + j) * ni + i];
@@ -198,12 +204,19 @@ struct FieldStage {
 };
 
 /// The pyramid's levels in one array: level 0 is one node per cell, each level above halves every
-/// dimension (rounding up) until the apex, a single node. Level 0 is linear (x fastest; exactly one
-/// count per cell, then one zero, the sentinel that children beyond the base's edge read). Levels
-/// above are stored in 2x2x2 bricks (node (x, y, z) in brick (x/2, y/2, z/2), slot x&1 + 2 (y&1) +
-/// 4 (z&1); slots beyond a level's edge hold 0), so the 8 children of a node of level >= 2 are 32
-/// contiguous bytes. Padding only the small upper levels keeps the pyramid within ~1.15x its base.
+/// dimension (rounding up) until the apex, a single node.
+/// - Level 0 (the base) is linear, x fastest: one word per cell, its vertex count in the low byte and
+///   its marching-cubes case above it (kCaseShift), so that the traversal does not read the cell's 8
+///   samples again; then one zero, the sentinel that children beyond the base's edge read.
+/// - Levels >= 1 are stored in 2x2x2 bricks (node (x, y, z) in brick (x/2, y/2, z/2), slot x&1 +
+///   2 (y&1) + 4 (z&1); slots beyond a level's edge count 0), and a slot holds the running sum of the
+///   brick's counts up to and including its own. So the 8 children of a node of level >= 2 are 32
+///   contiguous bytes whose last word is the node's count, and the traversal picks a child with 8
+///   independent compares. Padding only the levels above the base keeps the pyramid within ~1.16x its
+///   base.
 struct PyramidView {
+  static constexpr int kCaseShift = 8;
+  static constexpr uint32_t kCountMask = 0xffu;
   int levels;
   int dims[kMaxPyramidLevels][3];    // nodes per axis
   int bricks[kMaxPyramidLevels][3];  // ceil(dims / 2), levels >= 1
@@ -211,102 +224,152 @@ struct PyramidView {
   int sentinel;                      // index of a 0 (after the base level)
   uint32_t* count;
 
-  /// Level >= 1: the node of slot n (n in [0, 8 * bricks)); false for a padding slot.
-  SPHXR_HD SPHXR_INLINE bool Decode(int level, int n, int* x, int* y, int* z) const {
-    const int b = n >> 3, sub = n & 7;
-    const int bx = b % bricks[level][0], by = (b / bricks[level][0]) % bricks[level][1];
-    const int bz = b / (bricks[level][0] * bricks[level][1]);
-    *x = 2 * bx + (sub & 1);
-    *y = 2 * by + ((sub >> 1) & 1);
-    *z = 2 * bz + (sub >> 2);
-    return *x < dims[level][0] && *y < dims[level][1] && *z < dims[level][2];
+  /// Level >= 1: the 8 running sums of brick (x, y, z); the last is the count of its parent node.
+  SPHXR_HD SPHXR_INLINE const uint32_t* Brick(int level, int x, int y, int z) const {
+    return count + offset[level] + 8 * (x + bricks[level][0] * (y + bricks[level][1] * z));
   }
-  /// The counts of the 8 children of node (x, y, z) of `level` (>= 1), x fastest; 0 beyond an edge.
-  SPHXR_HD SPHXR_INLINE void Children(int level, int x, int y, int z, uint32_t n[8]) const {
-    if (level >= 2) {
-      const uint32_t* c = count + offset[level - 1] + 8 * (x + bricks[level - 1][0] * (y + bricks[level - 1][1] * z));
-      for (int k = 0; k < 8; ++k) n[k] = c[k];
-      return;
-    }
-    const int* d = dims[0];
-    const int first = 2 * x + d[0] * (2 * y + d[1] * 2 * z);
-    const bool inX = 2 * x + 1 < d[0], inY = 2 * y + 1 < d[1], inZ = 2 * z + 1 < d[2];
-    for (int k = 0; k < 8; ++k) {
-      const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
-      const bool inside = (!dx || inX) && (!dy || inY) && (!dz || inZ);
-      n[k] = count[inside ? first + dx + d[0] * (dy + d[1] * dz) : sentinel];
-    }
+  /// The vertex count of a level >= 1 node.
+  SPHXR_HD SPHXR_INLINE uint32_t Total(int level, int x, int y, int z) const {
+    if (level == 0) return count[x + dims[0][0] * (y + dims[0][1] * z)] & kCountMask;
+    return Brick(level - 1, x, y, z)[7];
   }
 };
 
-SPHXR_HD SPHXR_INLINE int McCase(const FieldView& f, int i, int j, int k) {
-  int mask = 0;
-  for (int c = 0; c < 8; ++c) {
-    const float v = f.value[f.Index(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))];
-    if (v > f.iso) mask |= 1 << c;
-  }
-  return mask;
-}
-
-// ---- 4. base level: vertices of each cell's case ---------------------------------------------------
+// ---- 3. base level and level 1, fused: vertices of each cell's case, and their 2x2x2 sums ---------
+/// One work item per row segment of level-1 bricks: kSegment bricks along x at brick row (by, bz),
+/// i.e. cells [4 kSegment seg, + 4 kSegment) x [4 by, 4 by + 4) x [4 bz, 4 bz + 4). Each of the 16 cell
+/// rows is one plain loop along x over its 4 sample rows (8 compares and a table look-up per cell,
+/// written so that the compiler vectorises it); then the rows' words are summed 2x2x2 into the
+/// segment's level-1 nodes (the counts are the words' low bytes and 8 of them stay below 256, so the
+/// sum of 8 words masked once is the sum of their counts), written as their bricks' running sums.
+/// Every level-1 slot, padding included, is written.
 struct BaseLevelStage {
+  static constexpr int kSegment = 8;  // level-1 bricks per work item along x
   FieldView field;
   PyramidView pyramid;
-  const uint8_t* vertexCount;  // McTables::vertexCount on this system
-  SPHXR_HD void operator()(int c) const {
-    const int cnx = field.nx - 1, cny = field.ny - 1;
-    const int i = c % cnx, j = (c / cnx) % cny, k = c / (cnx * cny);
-    pyramid.count[c] = vertexCount[McCase(field, i, j, k)];
+  const uint32_t* baseWord;  // per case: its vertex count | case << kCaseShift, on this system
+  int segments;              // per brick row: ceil(bricks[1][0] / kSegment)
+
+  SPHXR_HD void operator()(int item) const {
+    const int seg = item % segments, by = (item / segments) % pyramid.bricks[1][1];
+    const int bz = item / (segments * pyramid.bricks[1][1]);
+    const int cnx = field.nx - 1, cny = field.ny - 1, cnz = field.nz - 1;
+    const int i0 = 4 * kSegment * seg, j0 = 4 * by, k0 = 4 * bz;
+    const int n = cnx - i0 < 4 * kSegment ? cnx - i0 : 4 * kSegment;  // cells along x
+    const int rj = cny - j0 < 4 ? cny - j0 : 4, rk = cnz - k0 < 4 ? cnz - k0 : 4;
+    const float iso = field.iso;
+    uint32_t* base = pyramid.count;
+    for (int ck = 0; ck < rk; ++ck)
+      for (int cj = 0; cj < rj; ++cj) {
+        const float* __restrict__ a0 = field.value + field.Index(i0, j0 + cj, k0 + ck);
+        const float* __restrict__ a1 = a0 + field.nx;
+        const float* __restrict__ a2 = a0 + field.nx * field.ny;
+        const float* __restrict__ a3 = a2 + field.nx;
+        uint32_t mcCase[4 * kSegment];  // first the cases (a loop the compiler vectorises), then the look-ups
+        for (int i = 0; i < n; ++i) {
+          mcCase[i] = (a0[i] > iso ? 1u : 0u) | (a0[i + 1] > iso ? 2u : 0u) | (a1[i] > iso ? 4u : 0u) |
+                      (a1[i + 1] > iso ? 8u : 0u) | (a2[i] > iso ? 16u : 0u) | (a2[i + 1] > iso ? 32u : 0u) |
+                      (a3[i] > iso ? 64u : 0u) | (a3[i + 1] > iso ? 128u : 0u);
+        }
+        uint32_t* out = base + i0 + cnx * (j0 + cj + cny * (k0 + ck));
+        for (int i = 0; i < n; ++i) out[i] = baseWord[mcCase[i]];
+      }
+    // Level-1 nodes (x, J, K) of the segment, J, K in {0, 1}: the sum of their existing cells.
+    uint32_t node[2 * kSegment][4];
+    for (int x = 0; x < 2 * kSegment; ++x)
+      for (int r = 0; r < 4; ++r) node[x][r] = 0;
+    for (int ck = 0; ck < rk; ++ck)
+      for (int cj = 0; cj < rj; ++cj) {
+        const uint32_t* row = base + i0 + cnx * (j0 + cj + cny * (k0 + ck));
+        uint32_t* to = &node[0][(cj >> 1) + 2 * (ck >> 1)];
+        for (int i = 0; i + 1 < n; i += 2) to[4 * (i >> 1)] += row[i] + row[i + 1];
+        if (n & 1) to[4 * (n >> 1)] += row[n - 1];
+      }
+    const int bricks = pyramid.bricks[1][0] - kSegment * seg < kSegment ? pyramid.bricks[1][0] - kSegment * seg : kSegment;
+    for (int b = 0; b < bricks; ++b) {
+      uint32_t* to = pyramid.count + pyramid.offset[1] +
+                     8 * (kSegment * seg + b + pyramid.bricks[1][0] * (by + pyramid.bricks[1][1] * bz));
+      uint32_t sum = 0;
+      for (int c = 0; c < 8; ++c) to[c] = sum += node[2 * b + (c & 1)][c >> 1] & PyramidView::kCountMask;
+    }
   }
 };
 
-// ---- 5. one reduction level: node = sum of its 2x2x2 children ----------------------------------------
+// ---- 4. one reduction level (>= 2): node = sum of its 2x2x2 children ---------------------------------
+/// One work item per brick of the level written: each slot's count is the last running sum of its
+/// children's brick one level down (0 beyond the level's edge); the slots get their running sums.
 struct ReduceLevelStage {
   PyramidView pyramid;
-  int level;  // the level written (>= 1)
-  SPHXR_HD void operator()(int n) const {
-    int x, y, z;
+  int level;  // the level written (>= 2)
+  SPHXR_HD void operator()(int b) const {
+    const int* nb = pyramid.bricks[level];
+    const int bx = b % nb[0], by = (b / nb[0]) % nb[1], bz = b / (nb[0] * nb[1]);
     uint32_t sum = 0;
-    if (pyramid.Decode(level, n, &x, &y, &z)) {
-      uint32_t child[8];
-      pyramid.Children(level, x, y, z, child);
-      for (int c = 0; c < 8; ++c) sum += child[c];
+    uint32_t* out = pyramid.count + pyramid.offset[level] + 8 * b;
+    for (int c = 0; c < 8; ++c) {
+      const int x = 2 * bx + (c & 1), y = 2 * by + ((c >> 1) & 1), z = 2 * bz + (c >> 2);
+      const bool inside = x < pyramid.dims[level][0] && y < pyramid.dims[level][1] && z < pyramid.dims[level][2];
+      sum += inside ? pyramid.Brick(level - 1, x, y, z)[7] : 0u;
+      out[c] = sum;
     }
-    pyramid.count[pyramid.offset[level] + n] = sum;
   }
 };
 
-// ---- 6. traversal: one thread per output vertex ------------------------------------------------------
+// ---- 5. traversal: one thread per output vertex ------------------------------------------------------
 struct TraverseStage {
   FieldView field;
   PyramidView pyramid;
   const int8_t* edges;  // McTables::edges on this system, kMcMaxVertices per case
   float* positions;     // xyz per vertex
   float* normals;
+
+  /// The child whose range of running sums holds key (the number of sums at or below it; sums are
+  /// non-decreasing and the last is above key), and key made relative to that child. Branch-free, so
+  /// that consecutive vertices' descents overlap in the processor.
+  SPHXR_HD SPHXR_INLINE static int Select(const uint32_t sums[8], uint32_t* key) {
+    const uint32_t k = *key;
+    uint32_t p[8];
+    for (int c = 0; c < 8; ++c) p[c] = sums[c] <= k ? 1u : 0u;
+    // A tree of sums (short dependency chain), then the running sum before the child.
+    const int skip = static_cast<int>(((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7])));
+    const uint32_t before = sums[skip > 0 ? skip - 1 : 0];
+    *key = k - (skip > 0 ? before : 0u);
+    return skip;
+  }
+
   SPHXR_HD void operator()(int64_t v) const {
     // Walk down: at each level the children are taken in a fixed order (x fastest), so the vertices
-    // of a cell are contiguous and in the order of its case's list. Branch-free: the 8 counts (one
-    // brick above the base), their running sums, and the number of children that end at or before the key.
+    // of a cell are contiguous and in the order of its case's list. Above level 1 the children's
+    // running sums are one brick: the child is the number of them at or below the key.
     uint32_t key = static_cast<uint32_t>(v);
     int x = 0, y = 0, z = 0;
-    for (int level = pyramid.levels - 1; level > 0; --level) {
-      uint32_t n[8];
-      pyramid.Children(level, x, y, z, n);
-      uint32_t sum = 0, before = 0;
-      int skip = 0;
-      for (int c = 0; c < 8; ++c) {
-        sum += n[c];
-        const bool past = sum <= key;
-        skip += past ? 1 : 0;
-        before = past ? sum : before;
+    for (int level = pyramid.levels - 1; level > 1; --level) {
+      const uint32_t* sums = pyramid.Brick(level - 1, x, y, z);
+      const int skip = Select(sums, &key);
+      x = 2 * x + (skip & 1);
+      y = 2 * y + ((skip >> 1) & 1);
+      z = 2 * z + (skip >> 2);
+    }
+    const int* d = pyramid.dims[0];
+    {
+      // Level 1 -> the base: the 8 cells' counts, linear (a child beyond the edge reads the sentinel).
+      const int first = 2 * x + d[0] * (2 * y + d[1] * 2 * z);
+      const bool inX = 2 * x + 1 < d[0], inY = 2 * y + 1 < d[1], inZ = 2 * z + 1 < d[2];
+      uint32_t sums[8];
+      uint32_t sum = 0;
+      for (int k = 0; k < 8; ++k) {
+        const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
+        const bool inside = (!dx || inX) && (!dy || inY) && (!dz || inZ);
+        sum += pyramid.count[inside ? first + dx + d[0] * (dy + d[1] * dz) : pyramid.sentinel] & PyramidView::kCountMask;
+        sums[k] = sum;
       }
-      key -= before;
+      const int skip = Select(sums, &key);
       x = 2 * x + (skip & 1);
       y = 2 * y + ((skip >> 1) & 1);
       z = 2 * z + (skip >> 2);
     }
     // (x, y, z) is the cell, key the vertex's slot in its case's list.
-    const int mcCase = McCase(field, x, y, z);
+    const int mcCase = static_cast<int>(pyramid.count[x + d[0] * (y + d[1] * z)] >> PyramidView::kCaseShift);
     const int edge = edges[mcCase * kMcMaxVertices + static_cast<int>(key)];
     const int axis = edge / 4, o = edge % 4;
     int a[3] = {x, y, z};

@@ -308,6 +308,32 @@ TEST(SurfaceTable, RandomFieldsGiveClosedOrientedSurfaces) {
   }
 }
 
+TEST(SurfaceTable, RandomFieldsOnOddAndTinyLatticesMatchTheReference) {
+  // The pyramid's edges: every lattice from 2 to 11 samples per axis (odd and even cell counts, a
+  // single cell, levels of one node along an axis), random values up to the lattice's border.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const int sizes[] = {2, 3, 4, 5, 6, 7, 10, 11};
+  int64_t triangles = 0;
+  for (int nx : sizes)
+    for (int ny : sizes)
+      for (int nz : sizes) {
+        SurfaceGrid g;
+        g.origin = Vec3{-0.3f, 0.1f, 0.7f};
+        g.cellSize = 0.05f;
+        g.nx = nx;
+        g.ny = ny;
+        g.nz = nz;
+        std::vector<float> f(static_cast<size_t>(g.Samples()));
+        for (float& v : f) v = u(rng);
+        const SurfaceMesh m = Hpmc(g, f, 0.5f);
+        SCOPED_TRACE(::testing::Message() << nx << " x " << ny << " x " << nz);
+        ExpectSameTriangles(m, ReferenceMarchingCubes(g, f, 0.5f));  // (random gradients: normals ill-conditioned)
+        triangles += m.TriangleCount();
+      }
+  EXPECT_GT(triangles, 10000);
+}
+
 // ---- analytic fields -----------------------------------------------------------------------------------
 
 TEST(Surface, SphereMatchesReferenceAndAnalyticAreaAndVolume) {
@@ -668,6 +694,46 @@ TEST(SurfaceParticles, FieldMatchesABruteForceSumAndExtractionDoesNotChangeTheSi
   EXPECT_GT(g.origin.x, lo.x - m - g.cellSize);
   EXPECT_GE(g.origin.y + (g.ny - 1) * g.cellSize, hi.y + m);
   EXPECT_LT(g.origin.y + (g.ny - 2) * g.cellSize, hi.y + m);
+}
+
+TEST(SurfaceParticles, FieldMatchesABruteForceSumAtEveryCellSize) {
+  // The field stage's blocks: 3 x 3 x 3 neighbour cells per block at 1.6 and 1 spacing, one at 0.5, and
+  // sample by sample below (blocks of more than 8 samples per axis); a moving, splashing state.
+  SceneSetup scene = SmallDamBreak();
+  auto solver = CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  ASSERT_TRUE(StepN(*solver, 120));
+  const HostFluid fluid = DownloadFluid(*solver);
+  const sim::CubicSpline w = sim::CubicSpline::Make(solver->SupportRadius());
+  const float dx = scene.params.spacing, volume = dx * dx * dx;
+  for (float factor : {1.6f, 1.0f, 0.5f, 0.3f, 0.2f}) {
+    SCOPED_TRACE(::testing::Message() << "cell size " << factor << " spacing");
+    sim::SurfaceParams params;
+    params.cellSize = factor * dx;
+    SurfaceStats stats;
+    ASSERT_TRUE(solver->BuildSurface(params, &stats).ok());
+    SurfaceGrid g;
+    std::vector<float> field;
+    solver->BackendForTests()->Surface()->DownloadField(&g, &field);
+    ASSERT_EQ(static_cast<int64_t>(field.size()), g.Samples());
+    double worst = 0.0, peak = 0.0;
+    for (int kz = 0; kz < g.nz; ++kz)
+      for (int j = 0; j < g.ny; ++j)
+        for (int i = 0; i < g.nx; ++i) {
+          const Vec3 x{g.origin.x + i * g.cellSize, g.origin.y + j * g.cellSize, g.origin.z + kz * g.cellSize};
+          double sum = 0.0;
+          for (const Vec4& q : fluid.position) {
+            const Vec3 d = x - Xyz(q);
+            if (sim::Dot(d, d) < w.H2) sum += volume * w.W(sim::Length(d));
+          }
+          const float got = field[static_cast<size_t>(i + g.nx * (j + g.ny * kz))];
+          ASSERT_TRUE(std::isfinite(got)) << "sample " << i << ", " << j << ", " << kz << " not written";
+          worst = std::max(worst, std::fabs(sum - got));
+          peak = std::max(peak, sum);
+        }
+    EXPECT_LT(worst, 1e-5 * std::max(1.0, peak));
+    EXPECT_GT(peak, 0.9);
+  }
 }
 
 }  // namespace
