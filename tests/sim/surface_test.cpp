@@ -637,6 +637,28 @@ TEST(SurfaceParticles, WaterAtRestInABoxHasItsSurfaceAtTheFreeSurfaceHeight) {
   EXPECT_EQ(t.misoriented, 0);
 }
 
+/// The field at every sample against the kernel sum over all particles (brute force, doubles): the
+/// largest absolute difference and the largest value. Fails the test if a sample was not written.
+void CompareFieldWithBruteForce(const SurfaceGrid& g, const std::vector<float>& field, const std::vector<Vec4>& positions,
+                                const sim::CubicSpline& w, float volume, double* worst, double* peak) {
+  *worst = 0.0;
+  *peak = 0.0;
+  for (int kz = 0; kz < g.nz; ++kz)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const Vec3 x{g.origin.x + i * g.cellSize, g.origin.y + j * g.cellSize, g.origin.z + kz * g.cellSize};
+        double sum = 0.0;
+        for (const Vec4& q : positions) {
+          const Vec3 d = x - Xyz(q);
+          if (sim::Dot(d, d) < w.H2) sum += volume * w.W(sim::Length(d));
+        }
+        const float got = field[static_cast<size_t>(i + g.nx * (j + g.ny * kz))];
+        ASSERT_TRUE(std::isfinite(got)) << "sample " << i << ", " << j << ", " << kz << " not written";
+        *worst = std::max(*worst, std::fabs(sum - got));
+        *peak = std::max(*peak, sum);
+      }
+}
+
 TEST(SurfaceParticles, FieldMatchesABruteForceSumAndExtractionDoesNotChangeTheSimulation) {
   SceneSetup scene = SmallDamBreak();
   auto a = CreateOrFail(scene);
@@ -670,17 +692,8 @@ TEST(SurfaceParticles, FieldMatchesABruteForceSumAndExtractionDoesNotChangeTheSi
   const sim::CubicSpline w = sim::CubicSpline::Make(b->SupportRadius());
   const float dx = scene.params.spacing, volume = dx * dx * dx;
   double worst = 0.0, peak = 0.0;
-  for (int kz = 0; kz < g.nz; ++kz)
-    for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const Vec3 x{g.origin.x + i * g.cellSize, g.origin.y + j * g.cellSize, g.origin.z + kz * g.cellSize};
-        double sum = 0.0;
-        for (const Vec4& q : fb.position) sum += volume * w.W(sim::Length(x - Xyz(q)));
-        const float got = field[static_cast<size_t>(i + g.nx * (j + g.ny * kz))];
-        ASSERT_TRUE(std::isfinite(got)) << "sample " << i << ", " << j << ", " << kz << " not written";
-        worst = std::max(worst, std::fabs(sum - got));
-        peak = std::max(peak, sum);
-      }
+  CompareFieldWithBruteForce(g, field, fb.position, w, volume, &worst, &peak);
+  if (HasFatalFailure()) return;
   EXPECT_LT(worst, 1e-5);
   EXPECT_GT(peak, 0.9);
   // The lattice covers the particles' bounding box plus the margin (the support radius), no more.
@@ -717,20 +730,8 @@ TEST(SurfaceParticles, FieldMatchesABruteForceSumAtEveryCellSize) {
     solver->BackendForTests()->Surface()->DownloadField(&g, &field);
     ASSERT_EQ(static_cast<int64_t>(field.size()), g.Samples());
     double worst = 0.0, peak = 0.0;
-    for (int kz = 0; kz < g.nz; ++kz)
-      for (int j = 0; j < g.ny; ++j)
-        for (int i = 0; i < g.nx; ++i) {
-          const Vec3 x{g.origin.x + i * g.cellSize, g.origin.y + j * g.cellSize, g.origin.z + kz * g.cellSize};
-          double sum = 0.0;
-          for (const Vec4& q : fluid.position) {
-            const Vec3 d = x - Xyz(q);
-            if (sim::Dot(d, d) < w.H2) sum += volume * w.W(sim::Length(d));
-          }
-          const float got = field[static_cast<size_t>(i + g.nx * (j + g.ny * kz))];
-          ASSERT_TRUE(std::isfinite(got)) << "sample " << i << ", " << j << ", " << kz << " not written";
-          worst = std::max(worst, std::fabs(sum - got));
-          peak = std::max(peak, sum);
-        }
+    CompareFieldWithBruteForce(g, field, fluid.position, w, volume, &worst, &peak);
+    if (HasFatalFailure()) return;
     EXPECT_LT(worst, 1e-5 * std::max(1.0, peak));
     EXPECT_GT(peak, 0.9);
   }
