@@ -1,0 +1,141 @@
+// sphxr_bench_rest: how still water at rest really is (docs/physics.md, "Hydrostatics").
+//
+// Runs a scene (default scenes/tank_rest.json) in windows of fixed simulated length and prints, per
+// window, the particle drift (median, 90th percentile, maximum, in spacings) and the mean and maximum
+// speed; at the end the layer-averaged pressure against rho0 g depth, each particle compared at its own
+// depth below the free surface (the top particle's centre plus half a spacing). It reports; it never
+// asserts. A drift that does not fall from window to window means something keeps doing work on the
+// water; the hydrostatic test (tests/validation/hydrostatic_test.cpp) looks at one window only.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "sphxr/app/scene_file.h"
+#include "sphxr/sim/solver.h"
+
+namespace {
+
+using sphxr::sim::HostFluid;
+using sphxr::sim::Vec4;
+
+void Usage() {
+  std::fprintf(stderr,
+               "usage: sphxr_bench_rest [--scene FILE] [--windows N] [--window S] [--threads N]\n"
+               "  --scene FILE  scene (default %s/tank_rest.json)\n"
+               "  --windows N   number of windows (default 6)\n"
+               "  --window S    simulated seconds per window (default 0.5)\n"
+               "  --threads N   CPU backend threads (default 0 = all cores)\n",
+               SPHXR_SCENES_DIR);
+}
+
+bool ParsePositive(const char* text, double* out) {
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scenePath = std::string(SPHXR_SCENES_DIR) + "/tank_rest.json";
+  double windows = 6, window = 0.5, threads = 0;
+  for (int a = 1; a < argc; ++a) {
+    const bool hasValue = a + 1 < argc;
+    if (!std::strcmp(argv[a], "--scene") && hasValue) {
+      scenePath = argv[++a];
+    } else if (!std::strcmp(argv[a], "--windows") && hasValue) {
+      if (!ParsePositive(argv[++a], &windows)) return std::fprintf(stderr, "sphxr_bench_rest: --windows wants a positive number\n"), 2;
+    } else if (!std::strcmp(argv[a], "--window") && hasValue) {
+      if (!ParsePositive(argv[++a], &window)) return std::fprintf(stderr, "sphxr_bench_rest: --window wants positive seconds\n"), 2;
+    } else if (!std::strcmp(argv[a], "--threads") && hasValue) {
+      if (!ParsePositive(argv[++a], &threads)) return std::fprintf(stderr, "sphxr_bench_rest: --threads wants a positive count\n"), 2;
+    } else {
+      Usage();
+      return 2;
+    }
+  }
+  sphxr::app::SceneFile scene;
+  if (sphxr::Status s = sphxr::app::LoadScene(scenePath, &scene); !s) {
+    std::fprintf(stderr, "sphxr_bench_rest: %s\n", s.message().c_str());
+    return 1;
+  }
+  sphxr::sim::SolverConfig config;
+  config.threads = static_cast<int>(threads);
+  std::unique_ptr<sphxr::sim::Solver> solver;
+  if (sphxr::Status s = sphxr::sim::Solver::Create(scene.setup, config, &solver); !s) {
+    std::fprintf(stderr, "sphxr_bench_rest: %s\n", s.message().c_str());
+    return 1;
+  }
+  const float dx = scene.setup.params.spacing;
+  std::printf("scene %s: %lld fluid particles, spacing %g m; %d windows of %g s\n", scenePath.c_str(),
+              static_cast<long long>(solver->FluidCount()), dx, static_cast<int>(windows), window);
+  std::printf("| window (s) | drift median | q90 | max (spacings) | mean speed (mm/s) | max speed (mm/s) | clamped |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|\n");
+  HostFluid previous;
+  solver->Download(&previous);
+  for (int w = 1; w <= static_cast<int>(windows); ++w) {
+    int64_t clamped = 0;
+    while (solver->Time() < window * w - 1e-9) {
+      if (sphxr::Status s = solver->Step(); !s) {
+        std::fprintf(stderr, "sphxr_bench_rest: %s\n", s.message().c_str());
+        return 1;
+      }
+      clamped += solver->LastStep().clamped;
+    }
+    HostFluid current;
+    solver->Download(&current);
+    std::unordered_map<uint32_t, Vec4> start;
+    for (size_t i = 0; i < previous.size(); ++i) start[previous.id[i]] = previous.position[i];
+    std::vector<float> drift;
+    double speedSum = 0.0;
+    float speedMax = 0.0f;
+    for (size_t i = 0; i < current.size(); ++i) {
+      const Vec4 a = current.position[i], b = start.at(current.id[i]);
+      drift.push_back(std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z)) / dx);
+      const Vec4 u = current.velocity[i];
+      const float speed = std::sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
+      speedSum += speed;
+      speedMax = std::max(speedMax, speed);
+    }
+    std::sort(drift.begin(), drift.end());
+    std::printf("| %.2f-%.2f | %.3f | %.3f | %.3f | %.2f | %.2f | %lld |\n", window * (w - 1), window * w,
+                drift[drift.size() / 2], drift[drift.size() * 9 / 10], drift.back(),
+                1e3 * speedSum / static_cast<double>(current.size()), 1e3 * speedMax, static_cast<long long>(clamped));
+    std::fflush(stdout);
+    previous = std::move(current);
+  }
+  // Layer pressures at the end, each particle against rho0 g times its own depth.
+  const float rho0 = scene.setup.params.restDensity, g = -scene.setup.gravity.y;
+  float top = -1e30f;
+  for (const Vec4& p : previous.position) top = std::max(top, p.y);
+  const float surface = top + 0.5f * dx;
+  const float depthTotal = surface - scene.setup.tank.min.y;
+  const int layers = static_cast<int>(depthTotal / dx) + 1;
+  std::vector<double> pressure(layers, 0.0), reference(layers, 0.0), count(layers, 0.0);
+  for (size_t i = 0; i < previous.size(); ++i) {
+    const float depth = surface - previous.position[i].y;
+    const int l = static_cast<int>(depth / dx);
+    if (l < 0 || l >= layers) continue;
+    pressure[l] += previous.pressure[i];
+    reference[l] += rho0 * g * depth;
+    count[l] += 1.0;
+  }
+  std::printf("\n| layer from the surface | depth (m) | particles | p / (rho0 g depth) |\n|---:|---:|---:|---:|\n");
+  double worst = 0.0;
+  for (int l = 0; l < layers; ++l) {
+    if (count[l] < 20) continue;
+    const double depth = (l + 0.5) * dx, ratio = pressure[l] / reference[l];
+    if (depth >= 0.2 * depthTotal) worst = std::max(worst, std::fabs(ratio - 1.0));
+    std::printf("| %d | %.4f | %.0f | %.4f |\n", l, depth, count[l], ratio);
+  }
+  std::printf("\nworst |p / (rho0 g depth) - 1| over the lower 80 %% of the depth: %.2f %%\n", 100.0 * worst);
+  return 0;
+}
