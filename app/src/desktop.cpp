@@ -232,12 +232,7 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   std::unique_ptr<DesktopApp> app(new DesktopApp());
   Impl& m = *app->m_impl;
   m.options = options;
-  if (Status s = LoadScene(options.scenePath, &m.scene); !s) return s;
-  for (const std::string& set : options.sets) {
-    if (Status s = SetSolverParam(&m.scene.setup, set); !s) return s;
-  }
-  if (options.spacing > 0.0f) m.scene.setup.params.spacing = options.spacing;
-  if (options.reuse >= 0) m.scene.setup.reuse.enabled = options.reuse == 1;
+  if (Status s = LoadSceneWithOptions(options, &m.scene); !s) return s;
   m.setup = m.scene.setup;
 
   render::RendererConfig config;

@@ -267,17 +267,22 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
   return Status::Ok();
 }
 
+Status LoadSceneWithOptions(const Options& options, SceneFile* scene) {
+  if (Status s = LoadScene(options.scenePath, scene); !s) return s;
+  // A preset from the command line replaces the scene's reuse parameters; --set reuse.* then overrides.
+  if (!options.reusePreset.empty()) sim::ApplyReusePreset(options.reusePreset, &scene->setup.reuse);
+  for (const std::string& set : options.sets) {
+    if (Status s = SetSolverParam(&scene->setup, set); !s) return s;
+  }
+  if (options.spacing > 0.0f) scene->setup.params.spacing = options.spacing;
+  if (options.reuse >= 0) scene->setup.reuse.enabled = options.reuse == 1;
+  return Status::Ok();
+}
+
 Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
-  if (Status s = LoadScene(options.scenePath, &scene); !s) return s;
-  // A preset from the command line replaces the scene's reuse parameters; --set reuse.* then overrides.
-  if (!options.reusePreset.empty()) sim::ApplyReusePreset(options.reusePreset, &scene.setup.reuse);
-  for (const std::string& set : options.sets) {
-    if (Status s = SetSolverParam(&scene.setup, set); !s) return s;
-  }
-  if (options.spacing > 0.0f) scene.setup.params.spacing = options.spacing;
-  if (options.reuse >= 0) scene.setup.reuse.enabled = options.reuse == 1;
+  if (Status s = LoadSceneWithOptions(options, &scene); !s) return s;
   if (options.quality == 1 && options.spacing <= 0.0f) {
     sim::SolverConfig probe;
     probe.device = options.device;

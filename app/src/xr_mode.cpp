@@ -238,12 +238,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   *outcome = XrOutcome{};
   XrApp app;
   app.options = options;
-  if (Status s = LoadScene(options.scenePath, &app.scene); !s) return s;
-  for (const std::string& set : options.sets) {
-    if (Status s = SetSolverParam(&app.scene.setup, set); !s) return s;
-  }
-  if (options.spacing > 0.0f) app.scene.setup.params.spacing = options.spacing;
-  if (options.reuse >= 0) app.scene.setup.reuse.enabled = options.reuse == 1;
+  if (Status s = LoadSceneWithOptions(options, &app.scene); !s) return s;
   app.setup = app.scene.setup;
   app.offset = XrSceneOffset(app.setup.tank);
   app.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;

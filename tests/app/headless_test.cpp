@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sphxr/app/headless.h"
+#include "sphxr/app/scene_file.h"
 #include "support.h"
 
 namespace sphxr::app {
@@ -73,6 +74,32 @@ TEST(CommandLineTest, AcceptsEveryFlag) {
   EXPECT_EQ(o.mode, Mode::kDesktop);
   ASSERT_TRUE(Parse({"--xr"}, &o).ok());
   EXPECT_EQ(o.mode, Mode::kXr);
+}
+
+TEST(CommandLineTest, EveryModeLoadsTheSceneWithTheSameOverrides) {
+  // LoadSceneWithOptions is what the headless runner, the window and --xr start from: a --reuse preset
+  // replaces the scene's reuse parameters, --set then overrides one of them, --spacing the spacing.
+  Options o;
+  ASSERT_TRUE(Parse({"--scene", SPHXR_SCENES_DIR "/dam_break.json", "--reuse", "balanced", "--set", "reuse.idle=2",
+                     "--set", "stiffness=123456", "--spacing", "0.02"},
+                    &o)
+                  .ok());
+  SceneFile scene;
+  const Status s = LoadSceneWithOptions(o, &scene);
+  ASSERT_TRUE(s.ok()) << s.message();
+  sim::ReuseParams balanced;
+  ASSERT_TRUE(sim::ApplyReusePreset("balanced", &balanced));
+  EXPECT_TRUE(scene.setup.reuse.enabled);
+  EXPECT_FLOAT_EQ(scene.setup.reuse.threshold, balanced.threshold);
+  EXPECT_FLOAT_EQ(scene.setup.reuse.accelTolerance, balanced.accelTolerance);
+  EXPECT_EQ(scene.setup.reuse.idle, 2) << "--set comes after the preset";
+  EXPECT_FLOAT_EQ(scene.setup.params.stiffness, 123456.0f);
+  EXPECT_FLOAT_EQ(scene.setup.params.spacing, 0.02f);
+
+  ASSERT_TRUE(Parse({"--scene", SPHXR_SCENES_DIR "/dam_break.json", "--reuse", "balanced", "--set", "nonsense=1"}, &o).ok());
+  const Status bad = LoadSceneWithOptions(o, &scene);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("nonsense"), std::string::npos) << bad.message();
 }
 
 TEST(CommandLineTest, DefaultsWhenNothingIsGiven) {

@@ -50,6 +50,12 @@ struct Options {
 Status ParseCommandLine(int argc, const char* const* argv, Options* out);
 std::string UsageText();
 
+struct SceneFile;
+/// Loads options.scenePath and applies the command line's changes to it, in the order every mode uses:
+/// a --reuse preset replaces the scene's reuse parameters, then each --set, then --spacing, then
+/// --reuse on|off. The headless runner, the desktop window and --xr all start from this.
+Status LoadSceneWithOptions(const Options& options, SceneFile* scene);
+
 /// What a headless run measured (also printed as the summary).
 struct RunSummary {
   int fluid = 0;
