@@ -29,6 +29,16 @@ using sim::SceneSetup;
 using sim::Vec3;
 using sim::Vec4;
 
+/// A scene file's text: a water block of 12 x 10 x 6 = 720 particles in a 0.2 x 0.15 x 0.1 m tank (a
+/// surface of some hundreds of triangles), for the app and render tests.
+constexpr const char* kSmallTankScene = R"({
+  "name": "small",
+  "solver": { "spacing": 0.01, "max_dt": 0.001 },
+  "tank": { "min": [0, 0, 0], "max": [0.2, 0.15, 0.1] },
+  "fluid": [ { "min": [0.04, 0.0, 0.02], "max": [0.16, 0.10, 0.08] } ],
+  "run": { "steps": 2 }
+})";
+
 inline Aabb Box(Vec3 min, Vec3 max) { return Aabb{min, max}; }
 
 inline FluidBlock Block(Vec3 min, Vec3 max, Vec3 velocity = {}) { return FluidBlock{Aabb{min, max}, velocity}; }

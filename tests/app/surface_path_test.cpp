@@ -14,13 +14,7 @@
 namespace sphxr::app {
 namespace {
 
-// 720 particles in a small tank: a surface of some hundreds of triangles.
-constexpr const char* kSmallScene = R"({
-  "name": "small",
-  "solver": { "spacing": 0.01, "max_dt": 0.001 },
-  "tank": { "min": [0, 0, 0], "max": [0.2, 0.15, 0.1] },
-  "fluid": [ { "min": [0.04, 0.0, 0.02], "max": [0.16, 0.10, 0.08] } ]
-})";
+using test::kSmallTankScene;  // tests/support.h: 720 particles, some hundreds of triangles
 
 TEST(SurfacePathTest, InteropOnlyForASolverOnTheCudaDevice) {
   EXPECT_EQ(ChooseSurfacePath(sim::Device::kCuda), SurfacePath::kInterop);
@@ -32,7 +26,7 @@ TEST(SurfacePathTest, InteropOnlyForASolverOnTheCudaDevice) {
 
 TEST(SurfacePathTest, WorkerOnTheCpuPublishesTheHostMeshAndSaysSoOnce) {
   SceneFile scene;
-  ASSERT_TRUE(ParseScene(kSmallScene, "small", &scene).ok());
+  ASSERT_TRUE(ParseScene(kSmallTankScene, "small", &scene).ok());
   sim::SolverConfig config;
   config.device = sim::Device::kCpu;
   config.threads = 1;
@@ -67,7 +61,7 @@ TEST(SurfacePathTest, InteropCaptureBuildsTheMeshWithoutCopyingIt) {
   // The snapshot side of the GPU path, run on the CPU backend (BuildSurface is backend-independent):
   // the solver keeps the mesh, the snapshot carries only its size.
   SceneFile scene;
-  ASSERT_TRUE(ParseScene(kSmallScene, "small", &scene).ok());
+  ASSERT_TRUE(ParseScene(kSmallTankScene, "small", &scene).ok());
   sim::SolverConfig config;
   config.device = sim::Device::kCpu;
   config.threads = 1;

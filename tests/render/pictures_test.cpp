@@ -28,14 +28,7 @@
 namespace sphxr::test {
 namespace {
 
-// A small scene: a water block of 12 x 10 x 6 = 720 particles in a 0.2 x 0.15 x 0.1 m tank.
-constexpr const char* kSmallScene = R"({
-  "name": "small",
-  "solver": { "spacing": 0.01, "max_dt": 0.001 },
-  "tank": { "min": [0, 0, 0], "max": [0.2, 0.15, 0.1] },
-  "fluid": [ { "min": [0.04, 0.0, 0.02], "max": [0.16, 0.10, 0.08] } ],
-  "run": { "steps": 2 }
-})";
+constexpr const char* kSmallScene = kSmallTankScene;  // tests/support.h: 720 particles
 
 std::string ArtifactPath(const std::string& name) {
   std::filesystem::create_directories(SPHXR_TEST_ARTIFACTS_DIR);
