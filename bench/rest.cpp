@@ -26,11 +26,14 @@ using sphxr::sim::Vec4;
 
 void Usage() {
   std::fprintf(stderr,
-               "usage: sphxr_bench_rest [--scene FILE] [--windows N] [--window S] [--threads N]\n"
+               "usage: sphxr_bench_rest [--scene FILE] [--windows N] [--window S] [--threads N] [--wall-pressure W] [--detail]\n"
                "  --scene FILE  scene (default %s/tank_rest.json)\n"
                "  --windows N   number of windows (default 6)\n"
                "  --window S    simulated seconds per window (default 0.5)\n"
-               "  --threads N   CPU backend threads (default 0 = all cores)\n",
+               "  --threads N   CPU backend threads (default 0 = all cores)\n"
+               "  --wall-pressure W  mirrored | wall_density: override the scene's tank.wall_pressure\n"
+               "  --detail      the 12 largest drifts of the last window; per layer the mean height and the\n"
+               "                pressure and density of the particles 2.5 spacings or more from the side walls\n",
                SPHXR_SCENES_DIR);
 }
 
@@ -47,6 +50,8 @@ bool ParsePositive(const char* text, double* out) {
 int main(int argc, char** argv) {
   std::string scenePath = std::string(SPHXR_SCENES_DIR) + "/tank_rest.json";
   double windows = 6, window = 0.5, threads = 0;
+  bool detail = false;
+  std::string wallPressure;
   for (int a = 1; a < argc; ++a) {
     const bool hasValue = a + 1 < argc;
     if (!std::strcmp(argv[a], "--scene") && hasValue) {
@@ -55,6 +60,12 @@ int main(int argc, char** argv) {
       if (!ParsePositive(argv[++a], &windows)) return std::fprintf(stderr, "sphxr_bench_rest: --windows wants a positive number\n"), 2;
     } else if (!std::strcmp(argv[a], "--window") && hasValue) {
       if (!ParsePositive(argv[++a], &window)) return std::fprintf(stderr, "sphxr_bench_rest: --window wants positive seconds\n"), 2;
+    } else if (!std::strcmp(argv[a], "--detail")) {
+      detail = true;
+    } else if (!std::strcmp(argv[a], "--wall-pressure") && hasValue) {
+      wallPressure = argv[++a];
+      if (wallPressure != "mirrored" && wallPressure != "wall_density")
+        return std::fprintf(stderr, "sphxr_bench_rest: --wall-pressure wants mirrored or wall_density\n"), 2;
     } else if (!std::strcmp(argv[a], "--threads") && hasValue) {
       if (!ParsePositive(argv[++a], &threads)) return std::fprintf(stderr, "sphxr_bench_rest: --threads wants a positive count\n"), 2;
     } else {
@@ -67,6 +78,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sphxr_bench_rest: %s\n", s.message().c_str());
     return 1;
   }
+  if (wallPressure == "mirrored") scene.setup.wallPressure = sphxr::sim::SceneSetup::WallPressure::kMirrored;
+  if (wallPressure == "wall_density") scene.setup.wallPressure = sphxr::sim::SceneSetup::WallPressure::kWallDensity;
   sphxr::sim::SolverConfig config;
   config.threads = static_cast<int>(threads);
   std::unique_ptr<sphxr::sim::Solver> solver;
@@ -105,6 +118,16 @@ int main(int argc, char** argv) {
       speedSum += speed;
       speedMax = std::max(speedMax, speed);
     }
+    if (detail && w == static_cast<int>(windows)) {
+      std::vector<std::pair<float, size_t>> worst;
+      for (size_t i = 0; i < drift.size(); ++i) worst.push_back({drift[i], i});
+      std::sort(worst.rbegin(), worst.rend());
+      for (int k = 0; k < 12; ++k) {
+        const Vec4 q = current.position[worst[k].second];
+        std::printf("  drift %.3f at x %.2f y %.2f z %.2f (spacings from tank min)\n", worst[k].first,
+                    (q.x - scene.setup.tank.min.x) / dx, (q.y - scene.setup.tank.min.y) / dx, (q.z - scene.setup.tank.min.z) / dx);
+      }
+    }
     std::sort(drift.begin(), drift.end());
     std::printf("| %.2f-%.2f | %.3f | %.3f | %.3f | %.2f | %.2f | %lld |\n", window * (w - 1), window * w,
                 drift[drift.size() / 2], drift[drift.size() * 9 / 10], drift.back(),
@@ -134,7 +157,20 @@ int main(int argc, char** argv) {
     if (count[l] < 20) continue;
     const double depth = (l + 0.5) * dx, ratio = pressure[l] / reference[l];
     if (depth >= 0.2 * depthTotal) worst = std::max(worst, std::fabs(ratio - 1.0));
-    std::printf("| %d | %.4f | %.0f | %.4f |\n", l, depth, count[l], ratio);
+    std::printf("| %d | %.4f | %.0f | %.4f |", l, depth, count[l], ratio);
+    if (detail) {
+      double ys = 0, n = 0, pin = 0, rin = 0, nin = 0;
+      for (size_t i = 0; i < previous.size(); ++i) {
+        const Vec4 q = previous.position[i];
+        if (static_cast<int>((surface - q.y) / dx) != l) continue;
+        ys += q.y; n += 1;
+        const bool interior = q.x > scene.setup.tank.min.x + 2.5f * dx && q.x < scene.setup.tank.max.x - 2.5f * dx &&
+                              q.z > scene.setup.tank.min.z + 2.5f * dx && q.z < scene.setup.tank.max.z - 2.5f * dx;
+        if (interior) { pin += previous.pressure[i] / (rho0 * g * (surface - q.y)); rin += previous.density[i]; nin += 1; }
+      }
+      std::printf(" y/dx %.3f interior p %.4f rho-1 %.1f ppm (%g)", ys / n / dx, pin / nin, (rin / nin / rho0 - 1) * 1e6, nin);
+    }
+    std::printf("\n");
   }
   std::printf("\nworst |p / (rho0 g depth) - 1| over the lower 80 %% of the depth: %.2f %%\n", 100.0 * worst);
   return 0;

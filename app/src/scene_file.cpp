@@ -97,7 +97,7 @@ class Reader {
     {
       const json& tank = root["tank"];
       if (!tank.is_object()) return Error("tank", "must be an object");
-      CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity"});
+      CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity", "wall_pressure"});
       if (Status st = Box(tank, "tank", &s.tank); !st) return st;
       if (tank.contains("open_top")) {
         if (!tank["open_top"].is_boolean()) return Error("tank.open_top", "must be true or false");
@@ -108,6 +108,13 @@ class Reader {
         if (Status st = Number(tank["floor_viscosity"], "tank.floor_viscosity", &v); !st) return st;
         if (v < 0 || v > 10) return Error("tank.floor_viscosity", "must be from 0 to 10 (artificial viscosity alpha)");
         s.floorViscosity = static_cast<float>(v);
+      }
+      if (tank.contains("wall_pressure")) {
+        const json& w = tank["wall_pressure"];
+        const std::string v = w.is_string() ? w.get<std::string>() : "";
+        if (v == "mirrored") s.wallPressure = sim::SceneSetup::WallPressure::kMirrored;
+        else if (v == "wall_density") s.wallPressure = sim::SceneSetup::WallPressure::kWallDensity;
+        else return Error("tank.wall_pressure", "must be \"mirrored\" or \"wall_density\"");
       }
       if (tank.contains("boundary_layers")) {
         if (!tank["boundary_layers"].is_number_integer()) return Error("tank.boundary_layers", "must be an integer");

@@ -46,8 +46,10 @@ class BackendImpl final : public Backend {
     const int nb = static_cast<int>(boundary.size());
     Vector<Vec4> unsorted(boundary.position.begin(), boundary.position.end());
     Vector<float> unsortedAlpha(boundary.viscosity.begin(), boundary.viscosity.end());
+    Vector<float> unsortedReference(boundary.invReference.begin(), boundary.invReference.end());
     m_boundary.resize(nb);
     m_boundaryAlpha.resize(nb);
+    m_boundaryInvReference.resize(nb);
     Vector<uint32_t> keys(nb), order(nb);
     thrust::fill(Traits::Policy(), m_boundaryStart.begin(), m_boundaryStart.end(), kEmptyCell);
     thrust::fill(Traits::Policy(), m_boundaryEnd.begin(), m_boundaryEnd.end(), kEmptyCell);
@@ -59,6 +61,9 @@ class BackendImpl final : public Backend {
       Vector<Vec4> sorted(nb);
       thrust::gather(Traits::Policy(), order.begin(), order.end(), unsorted.begin(), sorted.begin());
       thrust::gather(Traits::Policy(), order.begin(), order.end(), unsortedAlpha.begin(), m_boundaryAlpha.begin());
+      if (unsortedReference.size() == static_cast<size_t>(nb)) {  // walls with their own density only
+        thrust::gather(Traits::Policy(), order.begin(), order.end(), unsortedReference.begin(), m_boundaryInvReference.begin());
+      }
       thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
                          CellRangeStage{g, Raw(sorted), Raw(keys), Raw(m_boundaryStart), Raw(m_boundaryEnd), nb});
       g = View();
@@ -129,6 +134,12 @@ class BackendImpl final : public Backend {
       }
     };
 
+    // 3c. the walls' own pressure
+    if (physics.wallDensity) {
+      if (m_boundaryPressureTerm.size() != m_boundary.size()) m_boundaryPressureTerm.resize(m_boundary.size());
+      thrust::for_each_n(policy, first, static_cast<int>(m_boundary.size()),
+                         WallPressureStage{View(), fv, physics, Raw(m_boundaryPressureTerm)});
+    }
     // 4. density and pressure
     overComputing(DensityStage{View(), fv, Neighbours(physics), physics});
     if (Status s = lap(Stage::kDensity); !s) return s;
@@ -378,6 +389,8 @@ class BackendImpl final : public Backend {
     g.boundaryNear = Raw(m_boundaryNear);
     g.boundary = Raw(m_boundary);
     g.boundaryAlpha = Raw(m_boundaryAlpha);
+    g.boundaryPressureTerm = Raw(m_boundaryPressureTerm);
+    g.boundaryInvReference = Raw(m_boundaryInvReference);
     g.bodyCount = static_cast<int>(m_hostStates.size());
     g.bodyStart = Raw(m_bodyStart);
     g.bodyEnd = Raw(m_bodyEnd);
@@ -400,6 +413,8 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step  // per-step scratch (stages.h NeighbourList)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
+  mutable Vector<float> m_boundaryPressureTerm;
+  Vector<float> m_boundaryInvReference;
   // Moving boundaries (body_stages.h): canonical body-frame particles, their sorted world copies.
   Vector<Vec4> m_bodyLocal;        // body frame, w = Psi_b
   Vector<uint32_t> m_bodyOfLocal;  // body index of each canonical particle

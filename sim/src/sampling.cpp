@@ -222,6 +222,47 @@ float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers) {
   return static_cast<float>(lattice.Dx3() * missing / boundary);
 }
 
+float WallFluidSum(const CubicSpline& kernel, float dx) {
+  const RestLattice lattice{kernel, dx, 1};
+  // Seen from the boundary particle at -1: the fluid points at i >= 0 are at offsets i + 1.
+  return static_cast<float>(lattice.SumFluid(1, lattice.reach + 1, [&](int i, int j, int k) { return lattice.W(i, j, k); }));
+}
+
+std::vector<float> WallInverseReferences(const SceneSetup& scene, const CubicSpline& kernel,
+                                         const std::vector<Vec4>& boundary, float floorFraction) {
+  const float dx = scene.params.spacing;
+  const Aabb& tank = scene.tank;
+  const int64_t n[3] = {FitCount(tank.max.x - tank.min.x, dx), FitCount(tank.max.y - tank.min.y, dx),
+                        FitCount(tank.max.z - tank.min.z, dx)};
+  const float lo[3] = {tank.min.x, tank.min.y, tank.min.z};
+  const int reach = static_cast<int>(std::ceil(kernel.H / dx)) + 1;
+  const float floorSum = floorFraction * WallFluidSum(kernel, dx);
+  std::vector<float> out(boundary.size());
+  for (size_t b = 0; b < boundary.size(); ++b) {
+    const float xb[3] = {boundary[b].x, boundary[b].y, boundary[b].z};
+    int64_t from[3], to[3];
+    for (int a = 0; a < 3; ++a) {
+      const int64_t c = static_cast<int64_t>(std::floor((xb[a] - lo[a]) / dx - 0.5f));
+      from[a] = std::max<int64_t>(0, c - reach);
+      to[a] = std::min<int64_t>(n[a] - 1, c + reach + 1);
+    }
+    double sum = 0.0;
+    for (int64_t k = from[2]; k <= to[2]; ++k)
+      for (int64_t j = from[1]; j <= to[1]; ++j)
+        for (int64_t i = from[0]; i <= to[0]; ++i) {
+          const Vec3 p{lo[0] + (static_cast<float>(i) + 0.5f) * dx, lo[1] + (static_cast<float>(j) + 0.5f) * dx,
+                       lo[2] + (static_cast<float>(k) + 0.5f) * dx};
+          const float r = std::sqrt((p.x - xb[0]) * (p.x - xb[0]) + (p.y - xb[1]) * (p.y - xb[1]) + (p.z - xb[2]) * (p.z - xb[2]));
+          if (r >= kernel.H) continue;
+          bool blocked = false;
+          for (const Aabb& o : scene.obstacles) blocked = blocked || InsideExpanded(o, p, 0.5f * dx);
+          if (!blocked) sum += kernel.W(r);
+        }
+    out[b] = static_cast<float>(1.0 / std::max<double>(sum, floorSum));
+  }
+  return out;
+}
+
 int NeighbourCapacity(float supportFactor) {
   const double lattice = 4.0 / 3.0 * 3.14159265358979 * supportFactor * supportFactor * supportFactor;
   return static_cast<int>(std::ceil(1.4 * lattice));

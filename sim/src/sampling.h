@@ -34,6 +34,18 @@ float WallDensityCorrection(const CubicSpline& kernel, float dx, int layers);
 /// 4.7 % above it at 2.5 dx, where using the density factor let particles sink into the walls.
 float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers);
 
+/// sum_f W_bf for a boundary particle of the first sheet of a flat wall with the fluid's rest lattice
+/// beside it (the fluid's first layer one spacing away): the reference of the walls' own density.
+float WallFluidSum(const CubicSpline& kernel, float dx);
+
+/// For each boundary particle, 1 / sum_f W_bf over the fluid's rest lattice filling the whole tank
+/// (minus obstacles): the reference its own density is measured against (BoundaryPressureStage). Edges
+/// and corners see a quarter and an eighth of the fluid a flat wall sees, and get a reference to match.
+/// The reference is floored at `floorFraction` of the flat wall's, so that a particle behind the first
+/// sheet, which sees almost no fluid at rest, does not turn one stray neighbour into a huge pressure.
+std::vector<float> WallInverseReferences(const SceneSetup& scene, const CubicSpline& kernel,
+                                         const std::vector<Vec4>& boundary, float floorFraction);
+
 /// Neighbour-list slots per fluid particle: 1.4 x the rest-lattice count (4/3) pi support_factor^3,
 /// room for 40 % compression or clustering before a particle falls back to scanning its cells.
 int NeighbourCapacity(float supportFactor);

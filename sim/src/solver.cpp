@@ -178,6 +178,7 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.invRestDensity = 1.0f / p.restDensity;
   ph.boundaryGamma = WallDensityCorrection(ph.kernel, p.spacing, scene.boundaryLayers);
   ph.boundaryGradScale = WallGradientCorrection(ph.kernel, p.spacing, scene.boundaryLayers) / ph.boundaryGamma;
+  ph.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity;
   ph.maxNeighbours = NeighbourCapacity(p.supportFactor);
   // Moving bodies are one-sheet shells (interaction::SamplePaddle): their own flat-wall corrections.
   ph.bodyGradScale = WallGradientCorrection(ph.kernel, p.spacing, 1) / WallDensityCorrection(ph.kernel, p.spacing, 1);
@@ -318,6 +319,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
   SampleBoundary(scene, &boundary.position, &boundary.viscosity);
 
   const Physics physics = MakePhysics(scene);
+  if (physics.wallDensity) boundary.invReference = WallInverseReferences(scene, physics.kernel, boundary.position, 0.25f);
   if (Status s = solver->m_backend->Init(MakeGridShape(scene), physics, fluid, boundary); !s) return s;
   if (!scene.bodies.empty()) solver->InitBodies(physics);
   WarnAboutSettings(scene, physics.soundSpeed);

@@ -60,6 +60,8 @@ struct GridView {
   const uint32_t* boundaryEnd;
   const Vec4* boundary;  // xyz position, w = Psi_b (kg)
   const float* boundaryAlpha;  // artificial viscosity alpha of each boundary particle's wall
+  const float* boundaryInvReference;  // per boundary particle: 1 / its rest-lattice fluid sum
+  const float* boundaryPressureTerm;  // per boundary particle, this step: p_b / rho_b^2 (BoundaryPressureStage)
   const uint8_t* boundaryNear; // per cell: 1 when a boundary particle lies in its 27 cells
   // Moving boundaries (paddles, body_stages.h): particles re-sorted every step with their own ranges.
   int bodyCount;                  // 0: no moving boundary; the pointers below are then unused
@@ -153,6 +155,7 @@ struct Physics {
   float reuseCellCount;         // N_CPN
   float reuseAccelTolerance2;   // (tolerance)^2, m^2/s^4: a larger change of acceleration keeps i active
   int reuseCooldown;            // steps a particle so flagged stays active before it is classified again
+  bool wallDensity;             // walls with their own density (WallPressureStage), else mirrored pressure
   float bodyGradScale;          // as boundaryGradScale, for the one-sheet shells of moving bodies
   float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
   float stiffness;      // Tait B
@@ -225,6 +228,32 @@ struct BoundaryNearStage {
           if (grid.boundaryStart[grid.Linear(x, y, z)] != kEmptyCell) near = 1;
         }
     out[c] = near;
+  }
+};
+
+// ---- wall pressure (every step): each wall particle's own density from the fluid around it -----------
+/// rho_b = rho0 sum_f W_bf / R_b with R_b the same sum over the fluid's rest lattice filling the tank
+/// (sampling.h, WallInverseReferences): the wall particle is as compressed as the water beside it.
+/// p_b = Tait(rho_b). The force's pair term p_i/rho_i^2 + p_b/rho_b^2 is then the derivative of an
+/// energy (the fluid's and the walls' own, each a function of the particle positions only), so still
+/// water comes to rest. Mirroring (p_b = p_i) is not such a derivative and pumps a ~1 cm/s circulation
+/// (docs/physics.md, "Hydrostatics").
+struct WallPressureStage {
+  GridView grid;
+  FluidView fluid;
+  Physics ph;
+  float* out;  // p_b / rho_b^2
+  SPHXR_HD void operator()(int b) const {
+    const Vec3 xb = Xyz(grid.boundary[b]);
+    const CubicSpline k = ph.kernel;
+    float sum = 0.0f;
+    ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xb, [&](uint32_t, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 < k.H2) sum += k.W(sqrtf(r2));
+    });
+    const float rho = ph.restDensity * sum * grid.boundaryInvReference[b];
+    const float p = TaitPressure(ph, rho);
+    out[b] = p > 0.0f ? p / (rho * rho) : 0.0f;
   }
 };
 
@@ -431,10 +460,12 @@ struct ForceStage {
     } else {
       ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, fluidNeighbour);
     }
-    // Wall pressure: mirrored (p_b = p_i, Akinci et al. 2012), but never below the average pressure of
-    // i's fluid neighbours (the extrapolation of Adami et al. 2012, taken at i). Near the free surface
-    // p_i is clamped to 0 while the particles below it push it with their own p_j > 0; mirroring alone
-    // then gives the wall no strength and the particle sinks into it.
+    // Wall pressure. Mirrored (the default): p_b = p_i (Akinci et al. 2012), but never below the average
+    // pressure of i's fluid neighbours (the extrapolation of Adami et al. 2012, taken at i). Near the free
+    // surface p_i is clamped to 0 while the particles below it push it with their own p_j > 0; mirroring
+    // alone then gives the wall no strength and the particle sinks into it. Wall density (tank
+    // "wall_pressure": "wall_density"): p_b/rho_b^2 of each wall particle from WallPressureStage.
+    // Moving bodies always use the mirrored pressure.
     if (nearWall) {
       const float pWall = fmaxf(fluid.pressure[i], pAverage / weight);
       const float wallPressureTerm = ph.boundaryGradScale * (pTermI + pWall / (rhoi * rhoi));
@@ -442,7 +473,7 @@ struct ForceStage {
       ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
         const float r2 = Dot(d, d);
         if (r2 >= k.H2 || r2 == 0.0f) return;
-        float term = wallPressureTerm;
+        float term = ph.wallDensity ? ph.boundaryGradScale * (pTermI + grid.boundaryPressureTerm[j]) : wallPressureTerm;
         const float vx = Dot(vi, d);  // static walls: v_b = 0
         if (vx < 0.0f) term -= grid.boundaryAlpha[j] * viscWall * vx / (r2 + eps);
         a -= d * (grid.boundary[j].w * term * k.GradFactor(sqrtf(r2)));

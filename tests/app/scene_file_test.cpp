@@ -82,7 +82,8 @@ TEST(SceneFileTest, FullSceneParsesEveryKey) {
     "solver": { "spacing": 0.01, "support_factor": 2.5, "rest_density": 998, "stiffness": 1e5, "exponent": 7,
                 "viscosity": 0.1, "boundary_viscosity": 0.2, "cfl": 0.3, "max_dt": 5e-4, "fixed_dt": 1e-4 },
     "gravity": [0, -1.62, 0],
-    "tank": { "min": [-1, 0, -0.5], "max": [1, 1, 0.5], "open_top": false, "boundary_layers": 2, "floor_viscosity": 0.5 },
+    "tank": { "min": [-1, 0, -0.5], "max": [1, 1, 0.5], "open_top": false, "boundary_layers": 2, "floor_viscosity": 0.5,
+              "wall_pressure": "wall_density" },
     "fluid": [ { "min": [-1, 0, -0.5], "max": [0, 0.5, 0.5], "velocity": [1, 0, -2] },
                { "min": [0.5, 0.5, 0], "max": [0.6, 0.6, 0.1] } ],
     "obstacles": [ { "min": [0.2, 0, -0.1], "max": [0.3, 0.2, 0.1] } ],
@@ -107,6 +108,7 @@ TEST(SceneFileTest, FullSceneParsesEveryKey) {
   EXPECT_FALSE(scene.setup.openTop);
   EXPECT_EQ(scene.setup.boundaryLayers, 2);
   EXPECT_FLOAT_EQ(scene.setup.floorViscosity, 0.5f);
+  EXPECT_EQ(scene.setup.wallPressure, sim::SceneSetup::WallPressure::kWallDensity);
   ASSERT_EQ(scene.setup.fluid.size(), 2u);
   EXPECT_FLOAT_EQ(scene.setup.fluid[0].velocity.z, -2.0f);
   ASSERT_EQ(scene.setup.obstacles.size(), 1u);
@@ -225,6 +227,8 @@ TEST(SceneFileTest, WrongTypesRefused) {
   ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "boundary_layers": 9 } })",
                 {"tank.boundary_layers", "1 to 4"});
   ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "floor_viscosity": -1 } })", {"tank.floor_viscosity"});
+  ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "wall_pressure": "adami" } })",
+                {"tank.wall_pressure", "mirrored", "wall_density"});
   ExpectRefused(R"({ "fluid": { "min": [0,0,0], "max": [1,1,1] }, )" + tank + "}", {"fluid", "array"});
   ExpectRefused(R"({ "fluid": [ 3 ], )" + tank + "}", {"fluid[0]", "object"});
   ExpectRefused(R"({ "fluid": [ { "min": [0,0,0], "max": [1,1,1] }, { "min": [0,0,0] } ], )" + tank + "}",

@@ -2,6 +2,7 @@
 // density correction (sim/src/sampling.h) against a brute-force density sum.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -228,6 +229,48 @@ double FlatWallDensity(const CubicSpline& k, float dx, int layers, float gamma, 
       }
   const double mass = rho0 * dx * dx * dx;
   return mass * fluid + gamma * rho0 * boundary;
+}
+
+// ---- WallInverseReferences -----------------------------------------------------------------------------
+
+// Every wall particle's reference is the kernel sum over the fluid a full tank would hold: checked by brute
+// force over the particles SampleFluid places in a block filling the tank (minus an obstacle), for one and
+// two sheets; the floor keeps sheets that see little fluid from a tiny reference.
+TEST(WallInverseReferencesTest, EqualBruteForceSumsOverAFullTank) {
+  for (int layers : {1, 2}) {
+    for (float factor : {2.0f, 2.5f}) {
+      SceneSetup scene;
+      scene.params.spacing = 0.01f;
+      scene.params.supportFactor = factor;
+      scene.tank = Aabb{{0.0f, 0.0f, 0.0f}, {0.12f, 0.08f, 0.06f}};
+      scene.boundaryLayers = layers;
+      scene.obstacles.push_back(Aabb{{0.05f, 0.0f, 0.02f}, {0.07f, 0.03f, 0.04f}});
+      scene.fluid.push_back(FluidBlock{});
+      scene.fluid.back().box = scene.tank;
+      std::vector<Vec4> fluid, boundary;
+      SampleFluid(scene, &fluid);
+      SampleBoundary(scene, &boundary);
+      const CubicSpline k = CubicSpline::Make(factor * scene.params.spacing);
+      const float floorFraction = 0.25f;
+      const std::vector<float> inv = WallInverseReferences(scene, k, boundary, floorFraction);
+      ASSERT_EQ(inv.size(), boundary.size());
+      const double flat = WallFluidSum(k, scene.params.spacing);
+      int flatSeen = 0;
+      for (size_t b = 0; b < boundary.size(); ++b) {
+        double sum = 0.0;
+        for (const Vec4& f : fluid) {
+          const float dx = f.x - boundary[b].x, dy = f.y - boundary[b].y, dz = f.z - boundary[b].z;
+          sum += k.W(std::sqrt(dx * dx + dy * dy + dz * dz));
+        }
+        const double expected = 1.0 / std::max(sum, floorFraction * flat);
+        ASSERT_NEAR(inv[b] / expected, 1.0, 1e-4) << "boundary particle " << b << " at " << boundary[b].x << ", "
+                                                  << boundary[b].y << ", " << boundary[b].z;
+        if (std::fabs(sum / flat - 1.0) < 1e-4) ++flatSeen;
+      }
+      // The middle of the floor is a flat wall: its first sheet sees exactly WallFluidSum.
+      EXPECT_GT(flatSeen, 0) << layers << " layer(s), support " << factor << " dx";
+    }
+  }
 }
 
 TEST(WallDensityCorrectionTest, GivesRestDensityNextToAFlatWall) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <ostream>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -14,9 +16,25 @@
 namespace sphxr {
 namespace {
 
-TEST(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
+// Bounds per wall model (sim::SceneSetup::WallPressure, docs/physics.md "Hydrostatics").
+struct WallCase {
+  const char* name;
+  sim::SceneSetup::WallPressure wall;
+  double settle;          // s before the observation window
+  float maxDrift;         // spacings, any particle over the 0.5 s window
+  float medianDrift;      // spacings
+  float pressureTolerance;  // relative, every layer of the lower 80 %
+};
+
+void PrintTo(const WallCase& c, std::ostream* os) { *os << c.name; }
+
+class Hydrostatic : public ::testing::TestWithParam<WallCase> {};
+
+TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
+  const WallCase c = GetParam();
   app::SceneFile scene;
   ASSERT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/tank_rest.json", &scene).ok());
+  scene.setup.wallPressure = c.wall;
   std::unique_ptr<sim::Solver> solver;
   ASSERT_TRUE(sim::Solver::Create(scene.setup, sim::SolverConfig{}, &solver).ok());
   const float dx = scene.setup.params.spacing;
@@ -24,7 +42,7 @@ TEST(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   const float g = -scene.setup.gravity.y;
 
   // Settle: the lattice starts at exactly rho0 (zero pressure) and compresses under its weight.
-  const double settle = 1.0, observe = 0.5;
+  const double settle = c.settle, observe = 0.5;
   while (solver->Time() < settle) ASSERT_TRUE(solver->Step().ok());
   sim::HostFluid before;
   solver->Download(&before);
@@ -42,12 +60,14 @@ TEST(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   solver->Download(&after);
   ASSERT_EQ(after.size(), before.size());
 
-  // Drift over the observation window. The issue asks for at most 0.1 spacing; this solver does not
-  // reach that (measured: median 0.34, maximum 1.8 spacings over 0.5 s): the mirrored wall pressure
-  // (p_b = p_i) is not the derivative of any energy and keeps a ~1 cm/s circulation going; an
-  // energy-consistent wall force lets it die away but holds only half the pressure (docs/physics.md,
-  // "Hydrostatics"). The bound below is loosened to what is met, so that a regression to real flow
-  // still fails.
+  // Drift over the observation window. The issue asks for at most 0.1 spacing.
+  // - wall_density (tank_rest's own setting): the water comes to rest (bench/rest.cpp: median drift per
+  //   0.5 s window 0.13, 0.18, 0.06, 0.02, 0.01, 0.008 spacings) but a few particles in disordered spots
+  //   of the floor layer keep rattling (maximum 0.3-0.5 spacing per window, not decaying). The median is
+  //   held to the issue's 0.1; the maximum is loosened to 1 spacing.
+  // - mirrored (the default elsewhere): the wall pressure p_b = p_i is not the derivative of any energy
+  //   and keeps a ~1 cm/s circulation going (median 0.34, maximum 1.8 spacings over 0.5 s). Loosened to
+  //   what is met, so that a regression to real flow still fails.
   std::vector<float> drift;
   for (size_t i = 0; i < after.size(); ++i) {
     const sim::Vec4 a = after.position[i], b = start.at(after.id[i]);
@@ -57,16 +77,17 @@ TEST(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   const float medianDrift = drift[drift.size() / 2], maxDrift = drift.back();
   RecordProperty("median_drift_spacings", std::to_string(medianDrift / dx));
   RecordProperty("max_drift_spacings", std::to_string(maxDrift / dx));
-  EXPECT_LT(maxDrift, 3.0f * dx) << "a particle moved " << maxDrift / dx << " spacings while the water should rest";
-  EXPECT_LT(medianDrift, 1.0f * dx) << "median drift " << medianDrift / dx << " spacings";
+  EXPECT_LT(maxDrift, c.maxDrift * dx) << "a particle moved " << maxDrift / dx << " spacings while the water should rest";
+  EXPECT_LT(medianDrift, c.medianDrift * dx) << "median drift " << medianDrift / dx << " spacings";
   EXPECT_LT(meanDensityError, 0.01f) << "mean compression over the observation window";
 
   // Hydrostatics: layer-averaged pressure (layers one spacing thick) against rho0 g depth over the lower
   // 80 % of the depth, depth measured from the free surface = the top particle's centre plus half a
-  // spacing (each particle fills a cube of side dx). The issue asks for 5 %; measured: the layers above
-  // the floor within -1.0 ... +3.0 %, the layer on the floor +5.8 % (the interior pressure rises ~4 %
-  // faster than rho0 g; not the lattice moment of the kernel, which is 1.02 at support 2 dx).
-  // Loosened to 8 %, see docs/physics.md, "Hydrostatics".
+  // spacing (each particle fills a cube of side dx). The issue asks for 5 %.
+  // - wall_density: measured -2.8 ... +2.7 % (the interior rises ~2 % faster than rho0 g); held to 5 %.
+  // - mirrored: the layers above the floor within -1.0 ... +3.0 %, the layer on the floor +5.8 %: the wall
+  //   gives no pressure of its own, so the floor layer compresses until p_i carries the weight. Loosened
+  //   to 8 %.
   float top = -1e30f;
   for (const sim::Vec4& p : after.position) top = std::max(top, p.y);
   const float surface = top + 0.5f * dx;
@@ -84,7 +105,7 @@ TEST(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
     if (depth < 0.2f * depthTotal || sum.second < 20) continue;
     const float pSim = static_cast<float>(sum.first / sum.second);
     const float pRef = rho0 * g * depth;
-    EXPECT_NEAR(pSim, pRef, 0.08f * pRef) << "layer at depth " << depth << " m (" << sum.second << " particles)";
+    EXPECT_NEAR(pSim, pRef, c.pressureTolerance * pRef) << "layer at depth " << depth << " m (" << sum.second << " particles)";
     slopeNum += static_cast<double>(pSim) * depth;
     slopeDen += static_cast<double>(depth) * depth;
     ++checked;
@@ -92,8 +113,14 @@ TEST(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   ASSERT_GE(checked, 10) << "too few layers compared";
   const double slope = slopeNum / slopeDen / (rho0 * g);
   RecordProperty("pressure_gradient_over_rho0_g", std::to_string(slope));
-  EXPECT_NEAR(slope, 1.0, 0.08) << "hydrostatic pressure gradient relative to rho0 g";
+  EXPECT_NEAR(slope, 1.0, c.pressureTolerance) << "hydrostatic pressure gradient relative to rho0 g";
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Walls, Hydrostatic,
+    ::testing::Values(WallCase{"wall_density", sim::SceneSetup::WallPressure::kWallDensity, 1.5, 1.0f, 0.1f, 0.05f},
+                      WallCase{"mirrored", sim::SceneSetup::WallPressure::kMirrored, 1.0, 3.0f, 1.0f, 0.08f}),
+    [](const ::testing::TestParamInfo<WallCase>& info) { return std::string(info.param.name); });
 
 }  // namespace
 }  // namespace sphxr

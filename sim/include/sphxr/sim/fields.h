@@ -40,6 +40,7 @@ struct HostFluid {
 struct HostBoundary {
   std::vector<Vec4> position;  // w = Psi (kg)
   std::vector<float> viscosity;  // artificial viscosity alpha of the wall this particle samples
+  std::vector<float> invReference;  // 1 / sum_f W_bf over the rest lattice filling the tank (0: no reference)
   size_t size() const { return position.size(); }
 };
 

@@ -85,6 +85,13 @@ struct SceneSetup {
   /// A dry floor drags on a spreading front much more than glass side walls drag on the column.
   float floorViscosity = -1.0f;
   int boundaryLayers = 1;        // layers of boundary particles behind each wall
+  /// How a wall particle's pressure is found (docs/physics.md, "Walls"). kMirrored: p_b = the fluid
+  /// particle's own pressure (at least its neighbours' Shepard average); matches Martin & Moyce, but
+  /// is not the derivative of an energy and keeps still water circulating at ~1 cm/s. kWallDensity:
+  /// each wall particle's own density from the fluid around it; energy-consistent, still water comes
+  /// to rest and meets hydrostatics within 3 %, but the dam break's column drains ~5 % slower.
+  enum class WallPressure { kMirrored, kWallDensity };
+  WallPressure wallPressure = WallPressure::kMirrored;
   std::vector<FluidBlock> fluid;
   std::vector<Aabb> obstacles;   // solid boxes inside the tank, surfaces sampled
   ReuseParams reuse;             // no "reuse" section in the scene: disabled
