@@ -10,10 +10,12 @@
 //   3. base       level 0 of the pyramid: the vertex count of each cell's marching-cubes case (and the
 //                 case), fused with level 1 (the 2x2x2 sums of the base) in one pass over the field
 //   4. reduce     level l node = sum of its 2x2x2 children in level l-1, up to the apex (the total)
-//   5. traverse   one thread per output vertex: walk down from the apex, at each level skipping the
-//                 children whose counts lie before the vertex's index, to its cell and the vertex's
-//                 slot there; the case table names the edge; the position is interpolated on it and the
-//                 normal is -grad phi (central differences), interpolated the same way.
+//   5. traverse   one work item per run of consecutive output vertices (one vertex on the GPU): the
+//                 first walks down from the apex, at each level skipping the children whose counts
+//                 lie before the vertex's index, to its cell and the vertex's slot there; the others
+//                 step to the next slot or the next cell with vertices (the in-order successor); the
+//                 case table names the edge; the position is interpolated on it and the normal is
+//                 -grad phi (central differences), interpolated the same way.
 // No per-cell output buffer of the worst-case size exists: the mesh has exactly apex vertices.
 #include <cstdint>
 
@@ -315,17 +317,32 @@ struct ReduceLevelStage {
   }
 };
 
-// ---- 5. traversal: one thread per output vertex ------------------------------------------------------
+// ---- 5. traversal: runs of consecutive output vertices ------------------------------------------------
+/// One work item per run of `run` consecutive vertices [run * item, run * item + run) (the last run
+/// ends at the apex). The first vertex walks down from the apex as in Dyken et al.: at each level the
+/// children are taken in a fixed order (x fastest), skipping those whose counts lie before the
+/// vertex's index, so the vertices of a cell are contiguous and in the order of its case's list. Each
+/// following vertex is the next slot of the same cell, or the first slot of the next cell in that
+/// order with a nonzero count: the in-order successor in the tree, found by going up from the cell
+/// until a node has a later child with a nonzero count and walking down its first such children. The
+/// path needs no stack: the node at level l above cell (x, y, z) is (x >> l, y >> l, z >> l) and its
+/// child on the path is bit l - 1 of each coordinate. So every vertex gets exactly the cell, the slot
+/// and the arithmetic of its own descent, for any run length; run = 1 is one descent per vertex (the
+/// GPU's many threads), longer runs replace most descents by a step within the cell (the CPU's few
+/// threads, where the ~7 dependent levels per vertex were most of the traversal's time).
 struct TraverseStage {
   FieldView field;
   PyramidView pyramid;
   const int8_t* edges;  // McTables::edges on this system, kMcMaxVertices per case
   float* positions;     // xyz per vertex
   float* normals;
+  int64_t vertices;     // the apex
+  int run;              // vertices per work item (>= 1)
 
   /// The child whose range of running sums holds key (the number of sums at or below it; sums are
   /// non-decreasing and the last is above key), and key made relative to that child. Branch-free, so
-  /// that consecutive vertices' descents overlap in the processor.
+  /// that consecutive vertices' descents overlap in the processor. With key = the running sum up to a
+  /// child, the result is its next sibling with a nonzero count (8: none).
   SPHXR_HD SPHXR_INLINE static int Select(const uint32_t sums[8], uint32_t* key) {
     const uint32_t k = *key;
     uint32_t p[8];
@@ -337,38 +354,41 @@ struct TraverseStage {
     return skip;
   }
 
-  SPHXR_HD void operator()(int64_t v) const {
-    // Walk down: at each level the children are taken in a fixed order (x fastest), so the vertices
-    // of a cell are contiguous and in the order of its case's list. Above level 1 the children's
-    // running sums are one brick: the child is the number of them at or below the key.
-    uint32_t key = static_cast<uint32_t>(v);
-    int x = 0, y = 0, z = 0;
-    for (int level = pyramid.levels - 1; level > 1; --level) {
-      const uint32_t* sums = pyramid.Brick(level - 1, x, y, z);
-      const int skip = Select(sums, &key);
-      x = 2 * x + (skip & 1);
-      y = 2 * y + ((skip >> 1) & 1);
-      z = 2 * z + (skip >> 2);
-    }
+  /// The running sums of the 8 cells under level-1 node (x, y, z) (a cell beyond the base's edge reads
+  /// the sentinel, 0).
+  SPHXR_HD SPHXR_INLINE void CellSums(int x, int y, int z, uint32_t sums[8]) const {
     const int* d = pyramid.dims[0];
-    {
-      // Level 1 -> the base: the 8 cells' counts, linear (a child beyond the edge reads the sentinel).
-      const int first = 2 * x + d[0] * (2 * y + d[1] * 2 * z);
-      const bool inX = 2 * x + 1 < d[0], inY = 2 * y + 1 < d[1], inZ = 2 * z + 1 < d[2];
-      uint32_t sums[8];
-      uint32_t sum = 0;
-      for (int k = 0; k < 8; ++k) {
-        const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
-        const bool inside = (!dx || inX) && (!dy || inY) && (!dz || inZ);
-        sum += pyramid.count[inside ? first + dx + d[0] * (dy + d[1] * dz) : pyramid.sentinel] & PyramidView::kCountMask;
-        sums[k] = sum;
-      }
-      const int skip = Select(sums, &key);
-      x = 2 * x + (skip & 1);
-      y = 2 * y + ((skip >> 1) & 1);
-      z = 2 * z + (skip >> 2);
+    const int first = 2 * x + d[0] * (2 * y + d[1] * 2 * z);
+    const bool inX = 2 * x + 1 < d[0], inY = 2 * y + 1 < d[1], inZ = 2 * z + 1 < d[2];
+    uint32_t sum = 0;
+    for (int k = 0; k < 8; ++k) {
+      const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
+      const bool inside = (!dx || inX) && (!dy || inY) && (!dz || inZ);
+      sum += pyramid.count[inside ? first + dx + d[0] * (dy + d[1] * dz) : pyramid.sentinel] & PyramidView::kCountMask;
+      sums[k] = sum;
     }
-    // (x, y, z) is the cell, key the vertex's slot in its case's list.
+  }
+
+  /// Walk down from node (x, y, z) of `level` (>= 1) to the cell holding vertex `key` of that node:
+  /// (x, y, z) becomes the cell, key its slot there, cellSums those of the cell's level-1 node.
+  SPHXR_HD SPHXR_INLINE void Descend(int level, int* x, int* y, int* z, uint32_t* key, uint32_t cellSums[8]) const {
+    for (; level > 1; --level) {
+      const int skip = Select(pyramid.Brick(level - 1, *x, *y, *z), key);
+      *x = 2 * *x + (skip & 1);
+      *y = 2 * *y + ((skip >> 1) & 1);
+      *z = 2 * *z + (skip >> 2);
+    }
+    CellSums(*x, *y, *z, cellSums);
+    const int skip = Select(cellSums, key);
+    *x = 2 * *x + (skip & 1);
+    *y = 2 * *y + ((skip >> 1) & 1);
+    *z = 2 * *z + (skip >> 2);
+  }
+
+  /// Vertex v: slot `key` of cell (x, y, z). The case table names the edge; the position is interpolated
+  /// on it and the normal is -grad phi (central differences), interpolated the same way.
+  SPHXR_HD SPHXR_INLINE void Emit(int64_t v, int x, int y, int z, uint32_t key) const {
+    const int* d = pyramid.dims[0];
     const int mcCase = static_cast<int>(pyramid.count[x + d[0] * (y + d[1] * z)] >> PyramidView::kCaseShift);
     const int edge = edges[mcCase * kMcMaxVertices + static_cast<int>(key)];
     const int axis = edge / 4, o = edge % 4;
@@ -399,6 +419,53 @@ struct TraverseStage {
     nn[0] = n.x;
     nn[1] = n.y;
     nn[2] = n.z;
+  }
+
+  SPHXR_HD void operator()(int64_t item) const {
+    const int64_t first = item * run;
+    const int64_t end = first + run < vertices ? first + run : vertices;
+    uint32_t key = static_cast<uint32_t>(first);
+    uint32_t cellSums[8];
+    int x = 0, y = 0, z = 0;
+    Descend(pyramid.levels - 1, &x, &y, &z, &key, cellSums);
+    int slot = (x & 1) | ((y & 1) << 1) | ((z & 1) << 2);  // the cell in its level-1 node
+    auto countOf = [&](int s) { return cellSums[s] - (s > 0 ? cellSums[s - 1] : 0u); };
+    uint32_t cellCount = countOf(slot);
+    for (int64_t v = first;;) {
+      Emit(v, x, y, z, key);
+      if (++v == end) break;
+      // The successor. Within the cell: its next slot.
+      if (++key < cellCount) continue;
+      // The next cell of the same level-1 node with vertices.
+      uint32_t sum = cellSums[slot];
+      int next = Select(cellSums, &sum);
+      key = 0;
+      if (next < 8) {
+        x = (x & ~1) | (next & 1);
+        y = (y & ~1) | ((next >> 1) & 1);
+        z = (z & ~1) | (next >> 2);
+        slot = next;
+        cellCount = countOf(slot);
+        continue;
+      }
+      // Up until a node has a later child with vertices (one has: v is below the apex's count), then
+      // down that child's first vertices.
+      int level = 2;
+      for (;; ++level) {
+        const int bit = level - 1;
+        const uint32_t* sums = pyramid.Brick(level - 1, x >> level, y >> level, z >> level);
+        const int child = ((x >> bit) & 1) | (((y >> bit) & 1) << 1) | (((z >> bit) & 1) << 2);
+        sum = sums[child];
+        next = Select(sums, &sum);
+        if (next < 8) break;
+      }
+      x = 2 * (x >> level) + (next & 1);
+      y = 2 * (y >> level) + ((next >> 1) & 1);
+      z = 2 * (z >> level) + (next >> 2);
+      Descend(level - 1, &x, &y, &z, &key, cellSums);
+      slot = (x & 1) | ((y & 1) << 1) | ((z & 1) << 2);
+      cellCount = countOf(slot);
+    }
   }
 };
 
