@@ -391,22 +391,22 @@ struct TraverseStage {
     const int* d = pyramid.dims[0];
     const int mcCase = static_cast<int>(pyramid.count[x + d[0] * (y + d[1] * z)] >> PyramidView::kCaseShift);
     const int edge = edges[mcCase * kMcMaxVertices + static_cast<int>(key)];
-    const int axis = edge / 4, o = edge % 4;
-    int a[3] = {x, y, z};
-    if (axis == 0) { a[1] += o & 1; a[2] += o >> 1; }
-    else if (axis == 1) { a[0] += o & 1; a[2] += o >> 1; }
-    else { a[0] += o & 1; a[1] += o >> 1; }
-    int b[3] = {a[0], a[1], a[2]};
-    b[axis] += 1;
+    // Edge 4 axis + o runs along `axis` from the cell's corner offset by (o & 1, o >> 1) on the other
+    // two axes in order. Scalars, not arrays indexed by the axis: a store to one element and a load of
+    // the whole stall the processor's store forwarding, per vertex.
+    const int axis = edge >> 2, o = edge & 3;
+    const int ax = x + (axis == 0 ? 0 : (o & 1)), ay = y + (axis == 0 ? (o & 1) : (axis == 1 ? 0 : (o >> 1)));
+    const int az = z + (axis == 2 ? 0 : (o >> 1));
+    const int bx = ax + (axis == 0 ? 1 : 0), by = ay + (axis == 1 ? 1 : 0), bz = az + (axis == 2 ? 1 : 0);
     // From the lower corner to the upper one, so the cells sharing this edge agree bit for bit.
-    const float f0 = field.value[field.Index(a[0], a[1], a[2])];
-    const float f1 = field.value[field.Index(b[0], b[1], b[2])];
+    const float f0 = field.value[field.Index(ax, ay, az)];
+    const float f1 = field.value[field.Index(bx, by, bz)];
     const float t = (field.iso - f0) / (f1 - f0);  // f0 != f1: exactly one of them is above iso
-    const Vec3 p0 = field.Point(a[0], a[1], a[2]);
-    const Vec3 p1 = field.Point(b[0], b[1], b[2]);
+    const Vec3 p0 = field.Point(ax, ay, az);
+    const Vec3 p1 = field.Point(bx, by, bz);
     const Vec3 p = p0 + (p1 - p0) * t;
-    const Vec3 g0 = field.Gradient(a[0], a[1], a[2]);
-    const Vec3 g1 = field.Gradient(b[0], b[1], b[2]);
+    const Vec3 g0 = field.Gradient(ax, ay, az);
+    const Vec3 g1 = field.Gradient(bx, by, bz);
     const Vec3 g = g0 + (g1 - g0) * t;
     const float len = Length(g);
     // -grad phi points out of the water; a flat field (len 0) cannot say where, so take +y.
