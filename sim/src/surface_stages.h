@@ -329,7 +329,8 @@ struct ReduceLevelStage {
 /// child on the path is bit l - 1 of each coordinate. So every vertex gets exactly the cell, the slot
 /// and the arithmetic of its own descent, for any run length; run = 1 is one descent per vertex (the
 /// GPU's many threads), longer runs replace most descents by a step within the cell (the CPU's few
-/// threads, where the ~7 dependent levels per vertex were most of the traversal's time).
+/// threads, where the ~7 dependent levels per vertex were most of the traversal's time), and a run
+/// copies a vertex it computed already on the same edge instead of interpolating it again (EdgeCache).
 struct TraverseStage {
   FieldView field;
   PyramidView pyramid;
@@ -387,7 +388,26 @@ struct TraverseStage {
 
   /// Vertex v: slot `key` of cell (x, y, z). The case table names the edge; the position is interpolated
   /// on it and the normal is -grad phi (central differences), interpolated the same way.
-  SPHXR_HD SPHXR_INLINE void Emit(int64_t v, int x, int y, int z, uint32_t key) const {
+  /// The vertices a run computed last, by edge (direct-mapped on a hash of the edge's id): a vertex
+  /// lies on an edge shared by up to 4 cells and by several triangles of each, and the run's cells
+  /// are neighbours in the pyramid's order, so most vertices are copies of one computed a few
+  /// vertices before. A copy is bitwise the value computed (every cell interpolates an edge the same
+  /// way). Only runs longer than one vertex use it (the CPU's).
+  struct EdgeCache {
+#ifdef __CUDA_ARCH__
+    static constexpr int kSize = 1;  // the GPU's runs are one vertex: no local memory for a cache
+#else
+    static constexpr int kSize = 64;
+#endif
+    static constexpr uint32_t kNone = 0xffffffffu;  // above every id (3 samples + 2 < 2^32)
+    uint32_t id[kSize];
+    float value[kSize][6];  // position, normal
+    SPHXR_HD SPHXR_INLINE static int Slot(uint32_t id) {
+      return static_cast<int>((id * 2654435761u) >> 26) & (kSize - 1);  // Knuth's multiplicative hash
+    }
+  };
+
+  SPHXR_HD SPHXR_INLINE void Emit(int64_t v, int x, int y, int z, uint32_t key, EdgeCache* cache) const {
     const int* d = pyramid.dims[0];
     const int mcCase = static_cast<int>(pyramid.count[x + d[0] * (y + d[1] * z)] >> PyramidView::kCaseShift);
     const int edge = edges[mcCase * kMcMaxVertices + static_cast<int>(key)];
@@ -398,8 +418,25 @@ struct TraverseStage {
     const int ax = x + (axis == 0 ? 0 : (o & 1)), ay = y + (axis == 0 ? (o & 1) : (axis == 1 ? 0 : (o >> 1)));
     const int az = z + (axis == 2 ? 0 : (o >> 1));
     const int bx = ax + (axis == 0 ? 1 : 0), by = ay + (axis == 1 ? 1 : 0), bz = az + (axis == 2 ? 1 : 0);
+    const int a = field.Index(ax, ay, az);
+    const uint32_t id = 3u * static_cast<uint32_t>(a) + static_cast<uint32_t>(axis);
+    float* pp = positions + 3 * v;
+    float* nn = normals + 3 * v;
+    float* hit = nullptr;
+    if (cache) {
+      const int c = EdgeCache::Slot(id);
+      hit = cache->value[c];
+      if (cache->id[c] == id) {
+        for (int i = 0; i < 3; ++i) {
+          pp[i] = hit[i];
+          nn[i] = hit[3 + i];
+        }
+        return;
+      }
+      cache->id[c] = id;
+    }
     // From the lower corner to the upper one, so the cells sharing this edge agree bit for bit.
-    const float f0 = field.value[field.Index(ax, ay, az)];
+    const float f0 = field.value[a];
     const float f1 = field.value[field.Index(bx, by, bz)];
     const float t = (field.iso - f0) / (f1 - f0);  // f0 != f1: exactly one of them is above iso
     const Vec3 p0 = field.Point(ax, ay, az);
@@ -411,14 +448,20 @@ struct TraverseStage {
     const float len = Length(g);
     // -grad phi points out of the water; a flat field (len 0) cannot say where, so take +y.
     const Vec3 n = len > 0.0f ? g * (-1.0f / len) : Vec3{0.0f, 1.0f, 0.0f};
-    float* pp = positions + 3 * v;
-    float* nn = normals + 3 * v;
     pp[0] = p.x;
     pp[1] = p.y;
     pp[2] = p.z;
     nn[0] = n.x;
     nn[1] = n.y;
     nn[2] = n.z;
+    if (hit) {
+      hit[0] = p.x;
+      hit[1] = p.y;
+      hit[2] = p.z;
+      hit[3] = n.x;
+      hit[4] = n.y;
+      hit[5] = n.z;
+    }
   }
 
   SPHXR_HD void operator()(int64_t item) const {
@@ -431,8 +474,13 @@ struct TraverseStage {
     int slot = (x & 1) | ((y & 1) << 1) | ((z & 1) << 2);  // the cell in its level-1 node
     auto countOf = [&](int s) { return cellSums[s] - (s > 0 ? cellSums[s - 1] : 0u); };
     uint32_t cellCount = countOf(slot);
+    EdgeCache cache;
+    EdgeCache* cached = end - first > 1 ? &cache : nullptr;
+    if (cached) {
+      for (int i = 0; i < EdgeCache::kSize; ++i) cache.id[i] = EdgeCache::kNone;
+    }
     for (int64_t v = first;;) {
-      Emit(v, x, y, z, key);
+      Emit(v, x, y, z, key, cached);
       if (++v == end) break;
       // The successor. Within the cell: its next slot.
       if (++key < cellCount) continue;

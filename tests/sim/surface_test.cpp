@@ -570,7 +570,7 @@ TEST(Surface, RunsOfVerticesGiveBitwiseTheMeshOfOneDescentPerVertex) {
     ExpectSameTriangles(SurfaceMesh{{pos1.begin(), pos1.end() - kGuard}, {nor1.begin(), nor1.end() - kGuard}},
                         ReferenceMarchingCubes(c.grid, c.field, c.iso));
     const int big = static_cast<int>(n);
-    for (int run : {2, 3, 5, 8, 13, 64, 255, big - 1, big, big + 7}) {
+    for (int run : {2, 3, 5, 8, 13, 64, 255, 256, big - 1, big, big + 7}) {
       SCOPED_TRACE(::testing::Message() << "run " << run << " of " << n << " vertices");
       std::vector<float> pos, nor;
       write(run, &pos, &nor);
