@@ -5,7 +5,7 @@
 // in one process: the median time of a simulation step (20 steps), and for each surface cell size
 // (spacing and spacing/2) the median over --repeat extractions of the three phases (field: re-grid,
 // bounding box, field gather; pyramid: base level and reductions; traversal: a descent per run of
-// --run vertices, 64 by default), and the median of 3 runs of the plain serial marching cubes of
+// --run vertices, 256 by default), and the median of 3 runs of the plain serial marching cubes of
 // tests/sim/reference_mc.h on the same field (positions and normals, as the traversal writes). Memory:
 // the pyramid against its base level. Prints a markdown table; --csv appends one row per cell size.
 // --compare-runs then traverses the last pyramid of each cell size again with each run length in
@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -45,11 +46,19 @@ const char* kUsage =
     "  --threads N  CPU backend threads (default 2)\n"
     "  --time S     simulated time before measuring (default 0.5 s, mid-collapse)\n"
     "  --repeat N   extractions per cell size (default 15)\n"
-    "  --run K      traversal vertices per work item (default 0: the backend's, 64)\n"
-    "  --compare-runs K,K,...  then the traversal alone at each run length, alternating (K = 1: a\n"
-    "               descent per vertex)\n"
+    "  --run K      traversal vertices per work item (default 0: the backend's, 256)\n"
+    "  --compare-runs K,K,...  then the traversal alone at each run length, 10 x --repeat\n"
+    "               rounds alternating (K = 1: a descent per vertex)\n"
     "  --csv FILE   append one row per cell size\n"
     "  --scene FILE (default " SPHXR_SCENES_DIR "/dam_break_1m.json)\n";
+
+double ProcessCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+constexpr int kCompareRounds = 10;  // --compare-runs rounds per --repeat: a traversal alone is short
 
 int Run(int argc, char** argv) {
   int threads = 2, repeat = 15, run = 0;
@@ -130,7 +139,7 @@ int Run(int argc, char** argv) {
     float cell;
     sim::SurfaceStats stats;
     double field, pyramid, traversal, reference;
-    std::vector<double> runTraversal;  // per --compare-runs entry
+    std::vector<double> runTraversal, runTraversalMin, runTraversalCpu;  // per --compare-runs entry
     bool runsAgree = true;
   };
   std::vector<Row> rows;
@@ -164,21 +173,23 @@ int Run(int argc, char** argv) {
       std::fprintf(stderr, "warning: the reference has %lld vertices, HPMC %lld\n",
                    static_cast<long long>(referenceVertices), static_cast<long long>(stats.vertices));
     }
-    Row row{params.cellSize, stats, Median(field), Median(pyramid), Median(traversal), Median(reference), {}, true};
+    Row row{params.cellSize, stats, Median(field), Median(pyramid), Median(traversal), Median(reference), {}, {}, {}, true};
     if (!compareRuns.empty()) {
       // The last pyramid again, each run length in turn per round; the meshes against the first one's.
-      std::vector<std::vector<double>> ms(compareRuns.size());
+      std::vector<std::vector<double>> ms(compareRuns.size()), cpuMs(compareRuns.size());
       sim::SurfaceMesh first, other;
-      for (int r = 0; r < repeat; ++r) {
+      for (int r = 0; r < kCompareRounds * repeat; ++r) {
         for (size_t i = 0; i < compareRuns.size(); ++i) {
           surface->SetTraversalRun(compareRuns[i]);
           sim::SurfaceMeshView view;
           sim::SurfaceStats runStats;
+          const double cpu0 = ProcessCpuMs();
           if (Status s = surface->WriteOwned(&view, &runStats); !s) {
             std::fprintf(stderr, "%s\n", s.message().c_str());
             return 1;
           }
           ms[i].push_back(1e3 * runStats.traversalSeconds);
+          cpuMs[i].push_back(ProcessCpuMs() - cpu0);
           if (r > 0) continue;
           surface->DownloadMesh(i == 0 ? &first : &other);
           if (i > 0) {
@@ -189,7 +200,11 @@ int Run(int argc, char** argv) {
         }
       }
       surface->SetTraversalRun(run);
-      for (const auto& m : ms) row.runTraversal.push_back(Median(m));
+      for (size_t i = 0; i < ms.size(); ++i) {
+        row.runTraversal.push_back(Median(ms[i]));
+        row.runTraversalMin.push_back(*std::min_element(ms[i].begin(), ms[i].end()));
+        row.runTraversalCpu.push_back(Median(cpuMs[i]));
+      }
     }
     rows.push_back(row);
   }
@@ -220,12 +235,16 @@ int Run(int argc, char** argv) {
     }
   }
   if (!compareRuns.empty()) {
-    std::printf("\nThe traversal alone by run length (vertices per work item), median of %d alternating rounds:\n\n",
-                repeat);
-    std::printf("| cell size | run | traversal ms | (pyramid + traversal) speed-up | mesh |\n|---|---:|---:|---:|---|\n");
+    std::printf("\nThe traversal alone by run length (vertices per work item), %d alternating rounds (the minimum: the "
+                "time least disturbed by other processes; CPU ms: the process's CPU time, all threads, spinning included\n"
+                "unless OMP_WAIT_POLICY=passive):\n\n",
+                kCompareRounds * repeat);
+    std::printf("| cell size | run | traversal ms median | min | CPU ms | (pyramid + traversal) speed-up | mesh |\n"
+                "|---|---:|---:|---:|---:|---:|---|\n");
     for (const Row& r : rows) {
       for (size_t i = 0; i < compareRuns.size(); ++i) {
-        std::printf("| %.4g m | %d | %.2f | %.2fx | %s |\n", r.cell, compareRuns[i], r.runTraversal[i],
+        std::printf("| %.4g m | %d | %.2f | %.2f | %.2f | %.2fx | %s |\n", r.cell, compareRuns[i],
+                    r.runTraversal[i], r.runTraversalMin[i], r.runTraversalCpu[i],
                     r.reference / (r.pyramid + r.runTraversal[i]),
                     i == 0 ? "" : (r.runsAgree ? "bitwise as the first" : "**DIFFERS**"));
       }
