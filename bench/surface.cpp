@@ -4,17 +4,24 @@
 // Runs the scene to --time (default 0.5 s: the column has landed and is collapsing), then, side by side
 // in one process: the median time of a simulation step (20 steps), and for each surface cell size
 // (spacing and spacing/2) the median over --repeat extractions of the three phases (field: re-grid,
-// bounding box, near flags, field gather; pyramid: base level and reductions; traversal: one thread per
-// vertex), and the median of 3 runs of the plain serial marching cubes of tests/sim/reference_mc.h on
-// the same field (positions and normals, as the traversal writes). Memory: the pyramid against its base
-// level. Prints a markdown table; --csv appends one row per cell size. Reports, never asserts.
+// bounding box, field gather; pyramid: base level and reductions; traversal: a descent per run of
+// --run vertices, 256 by default), and the median of 3 runs of the plain serial marching cubes of
+// tests/sim/reference_mc.h on the same field (positions and normals, as the traversal writes). Memory:
+// the pyramid against its base level. Prints a markdown table; --csv appends one row per cell size.
+// --compare-runs then traverses the last pyramid of each cell size again with each run length in
+// turn (rounds alternate, so a load that varies hits them alike) and checks that their meshes are
+// bitwise the same. Reports, never asserts.
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -34,15 +41,28 @@ namespace sphxr::bench {
 namespace {
 
 const char* kUsage =
-    "usage: sphxr_bench_surface [--threads N] [--time S] [--repeat N] [--csv FILE] [--scene FILE]\n"
+    "usage: sphxr_bench_surface [--threads N] [--time S] [--repeat N] [--run K] [--compare-runs K,K,...]\n"
+    "                           [--csv FILE] [--scene FILE]\n"
     "  --threads N  CPU backend threads (default 2)\n"
     "  --time S     simulated time before measuring (default 0.5 s, mid-collapse)\n"
     "  --repeat N   extractions per cell size (default 15)\n"
+    "  --run K      traversal vertices per work item (default 0: the backend's, 256)\n"
+    "  --compare-runs K,K,...  then the traversal alone at each run length, 10 x --repeat\n"
+    "               rounds alternating (K = 1: a descent per vertex)\n"
     "  --csv FILE   append one row per cell size\n"
     "  --scene FILE (default " SPHXR_SCENES_DIR "/dam_break_1m.json)\n";
 
+double ProcessCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+constexpr int kCompareRounds = 10;  // --compare-runs rounds per --repeat: a traversal alone is short
+
 int Run(int argc, char** argv) {
-  int threads = 2, repeat = 15;
+  int threads = 2, repeat = 15, run = 0;
+  std::vector<int> compareRuns;
   double time = 0.5;
   std::string csv, scenePath = SPHXR_SCENES_DIR "/dam_break_1m.json";
   for (int i = 1; i < argc; ++i) {
@@ -51,15 +71,24 @@ int Run(int argc, char** argv) {
     if (a == "--threads" && hasValue) threads = std::atoi(argv[++i]);
     else if (a == "--time" && hasValue) time = std::atof(argv[++i]);
     else if (a == "--repeat" && hasValue) repeat = std::atoi(argv[++i]);
-    else if (a == "--csv" && hasValue) csv = argv[++i];
+    else if (a == "--run" && hasValue) run = std::atoi(argv[++i]);
+    else if (a == "--compare-runs" && hasValue) {
+      for (std::stringstream list(argv[++i]); list.good();) {
+        std::string k;
+        std::getline(list, k, ',');
+        compareRuns.push_back(std::atoi(k.c_str()));
+      }
+    } else if (a == "--csv" && hasValue) csv = argv[++i];
     else if (a == "--scene" && hasValue) scenePath = argv[++i];
     else {
       std::fprintf(stderr, "%s", kUsage);
       return a == "--help" ? 0 : 2;
     }
   }
-  if (threads < 1 || repeat < 1 || !(time >= 0.0)) {
-    std::fprintf(stderr, "--threads and --repeat must be at least 1, --time not negative\n%s", kUsage);
+  const bool runsValid = std::all_of(compareRuns.begin(), compareRuns.end(), [](int k) { return k >= 1; });
+  if (threads < 1 || repeat < 1 || !(time >= 0.0) || run < 0 || !runsValid) {
+    std::fprintf(stderr, "--threads, --repeat and --compare-runs must be at least 1, --time and --run not negative\n%s",
+                 kUsage);
     return 2;
   }
   app::SceneFile scene;
@@ -93,6 +122,8 @@ int Run(int argc, char** argv) {
   }
   const double step = Median(stepMs);
   const float spacing = scene.setup.params.spacing;
+  sim::SurfaceExtractor* surface = solver->BackendForTests()->Surface();
+  surface->SetTraversalRun(run);
 
   std::ofstream out;
   if (!csv.empty() &&
@@ -108,6 +139,8 @@ int Run(int argc, char** argv) {
     float cell;
     sim::SurfaceStats stats;
     double field, pyramid, traversal, reference;
+    std::vector<double> runTraversal, runTraversalMin, runTraversalCpu;  // per --compare-runs entry
+    bool runsAgree = true;
   };
   std::vector<Row> rows;
   for (float factor : {1.0f, 0.5f}) {
@@ -127,7 +160,7 @@ int Run(int argc, char** argv) {
     }
     sim::SurfaceGrid grid;
     std::vector<float> values;
-    solver->BackendForTests()->Surface()->DownloadField(&grid, &values);
+    surface->DownloadField(&grid, &values);
     std::vector<double> reference;
     int64_t referenceVertices = 0;
     for (int r = 0; r < 3; ++r) {
@@ -140,7 +173,40 @@ int Run(int argc, char** argv) {
       std::fprintf(stderr, "warning: the reference has %lld vertices, HPMC %lld\n",
                    static_cast<long long>(referenceVertices), static_cast<long long>(stats.vertices));
     }
-    rows.push_back({params.cellSize, stats, Median(field), Median(pyramid), Median(traversal), Median(reference)});
+    Row row{params.cellSize, stats, Median(field), Median(pyramid), Median(traversal), Median(reference), {}, {}, {}, true};
+    if (!compareRuns.empty()) {
+      // The last pyramid again, each run length in turn per round; the meshes against the first one's.
+      std::vector<std::vector<double>> ms(compareRuns.size()), cpuMs(compareRuns.size());
+      sim::SurfaceMesh first, other;
+      for (int r = 0; r < kCompareRounds * repeat; ++r) {
+        for (size_t i = 0; i < compareRuns.size(); ++i) {
+          surface->SetTraversalRun(compareRuns[i]);
+          sim::SurfaceMeshView view;
+          sim::SurfaceStats runStats;
+          const double cpu0 = ProcessCpuMs();
+          if (Status s = surface->WriteOwned(&view, &runStats); !s) {
+            std::fprintf(stderr, "%s\n", s.message().c_str());
+            return 1;
+          }
+          ms[i].push_back(1e3 * runStats.traversalSeconds);
+          cpuMs[i].push_back(ProcessCpuMs() - cpu0);
+          if (r > 0) continue;
+          surface->DownloadMesh(i == 0 ? &first : &other);
+          if (i > 0) {
+            row.runsAgree = row.runsAgree && other.positions.size() == first.positions.size() &&
+                            std::memcmp(other.positions.data(), first.positions.data(), 4 * first.positions.size()) == 0 &&
+                            std::memcmp(other.normals.data(), first.normals.data(), 4 * first.normals.size()) == 0;
+          }
+        }
+      }
+      surface->SetTraversalRun(run);
+      for (size_t i = 0; i < ms.size(); ++i) {
+        row.runTraversal.push_back(Median(ms[i]));
+        row.runTraversalMin.push_back(*std::min_element(ms[i].begin(), ms[i].end()));
+        row.runTraversalCpu.push_back(Median(cpuMs[i]));
+      }
+    }
+    rows.push_back(row);
   }
   const double loadAfter = LoadAverage();
 
@@ -166,6 +232,22 @@ int Run(int argc, char** argv) {
           << ',' << r.pyramid << ',' << r.traversal << ',' << total << ',' << step << ',' << r.reference << ','
           << static_cast<double>(r.stats.pyramidBytes) / static_cast<double>(r.stats.baseBytes) << ','
           << r.stats.baseBytes << ',' << r.stats.pyramidBytes << ',' << r.stats.fieldBytes << '\n';
+    }
+  }
+  if (!compareRuns.empty()) {
+    std::printf("\nThe traversal alone by run length (vertices per work item), %d alternating rounds (the minimum: the "
+                "time least disturbed by other processes; CPU ms: the process's CPU time, all threads, spinning included\n"
+                "unless OMP_WAIT_POLICY=passive):\n\n",
+                kCompareRounds * repeat);
+    std::printf("| cell size | run | traversal ms median | min | CPU ms | (pyramid + traversal) speed-up | mesh |\n"
+                "|---|---:|---:|---:|---:|---:|---|\n");
+    for (const Row& r : rows) {
+      for (size_t i = 0; i < compareRuns.size(); ++i) {
+        std::printf("| %.4g m | %d | %.2f | %.2f | %.2f | %.2fx | %s |\n", r.cell, compareRuns[i],
+                    r.runTraversal[i], r.runTraversalMin[i], r.runTraversalCpu[i],
+                    r.reference / (r.pyramid + r.runTraversal[i]),
+                    i == 0 ? "" : (r.runsAgree ? "bitwise as the first" : "**DIFFERS**"));
+      }
     }
   }
   return 0;

@@ -15,6 +15,7 @@ struct OmpTraits {
   static void Sync() {}
   static constexpr const char* kName = "cpu";
   static constexpr bool kOnDevice = false;  // where the surface mesh lives
+  static constexpr int kTraversalRun = 256;  // a descent per run of vertices: few threads, each stepping along the mesh
 };
 
 }  // namespace

@@ -15,6 +15,7 @@ struct CudaTraits {
   static void Sync() { cudaDeviceSynchronize(); }
   static constexpr const char* kName = "cuda";
   static constexpr bool kOnDevice = true;  // where the surface mesh lives
+  static constexpr int kTraversalRun = 1;  // one descent per vertex: a thread each
 };
 
 }  // namespace

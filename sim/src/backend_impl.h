@@ -22,7 +22,8 @@
 namespace sphxr::sim {
 
 /// Traits: `template <class T> using Vector`, `static auto Policy()`, `static void Sync()`,
-/// `static const char* kName`.
+/// `static const char* kName`, `static bool kOnDevice` (where the surface mesh lives), `static int
+/// kTraversalRun` (the surface traversal's vertices per work item).
 template <class Traits>
 class BackendImpl final : public Backend {
   template <class T>

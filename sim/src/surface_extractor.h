@@ -31,6 +31,9 @@ class SurfaceExtractor {
                                 SurfaceStats* stats) = 0;
   /// Vertices of the last build (the apex).
   virtual int64_t VertexCount() const = 0;
+  /// Vertices per traversal work item (TraverseStage::run); 0 = this backend's default. The mesh is the
+  /// same for every value (tests, benchmarks).
+  virtual void SetTraversalRun(int vertices) = 0;
   /// Traversal into caller memory of this backend's memory space; an error when capacity is too small.
   virtual Status WriteTo(const SurfaceTarget& target, SurfaceStats* stats) = 0;
   /// Traversal into the extractor's own buffer, grown (and logged) when the mesh does not fit.

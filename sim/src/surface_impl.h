@@ -124,6 +124,8 @@ class SurfaceImpl final : public SurfaceExtractor {
 
   int64_t VertexCount() const override { return m_vertices; }
 
+  void SetTraversalRun(int vertices) override { m_traversalRun = vertices > 0 ? vertices : Traits::kTraversalRun; }
+
   Status WriteTo(const SurfaceTarget& target, SurfaceStats* stats) override {
     if (target.capacity < m_vertices) {
       return Status::Error(Format("surface: the mesh has %lld vertices, the target holds %lld: grow it and write again",
@@ -239,8 +241,10 @@ class SurfaceImpl final : public SurfaceExtractor {
   void Traverse(float* positions, float* normals, SurfaceStats* stats) {
     const auto begin = Clock::now();
     if (m_vertices > 0) {
-      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int64_t>(0), m_vertices,
-                         TraverseStage{Field(m_grid, m_iso), m_pyramid, Raw(m_edges), positions, normals});
+      const int64_t items = (m_vertices + m_traversalRun - 1) / m_traversalRun;
+      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int64_t>(0), items,
+                         TraverseStage{Field(m_grid, m_iso), m_pyramid, Raw(m_edges), positions, normals, m_vertices,
+                                       m_traversalRun});
     }
     Traits::Sync();
     stats->traversalSeconds = std::chrono::duration<double>(Clock::now() - begin).count();
@@ -257,6 +261,7 @@ class SurfaceImpl final : public SurfaceExtractor {
   int64_t m_vertices = 0;         // apex of the last build
   int64_t m_written = 0;          // vertices in the own buffer
   int64_t m_capacity = 0;         // vertices the own buffer holds
+  int m_traversalRun = Traits::kTraversalRun;  // vertices per traversal work item
   Vector<float> m_positions, m_normals;
 };
 

@@ -10,10 +10,12 @@
 //   3. base       level 0 of the pyramid: the vertex count of each cell's marching-cubes case (and the
 //                 case), fused with level 1 (the 2x2x2 sums of the base) in one pass over the field
 //   4. reduce     level l node = sum of its 2x2x2 children in level l-1, up to the apex (the total)
-//   5. traverse   one thread per output vertex: walk down from the apex, at each level skipping the
-//                 children whose counts lie before the vertex's index, to its cell and the vertex's
-//                 slot there; the case table names the edge; the position is interpolated on it and the
-//                 normal is -grad phi (central differences), interpolated the same way.
+//   5. traverse   one work item per run of consecutive output vertices (one vertex on the GPU): the
+//                 first walks down from the apex, at each level skipping the children whose counts
+//                 lie before the vertex's index, to its cell and the vertex's slot there; the others
+//                 step to the next slot or the next cell with vertices (the in-order successor); the
+//                 case table names the edge; the position is interpolated on it and the normal is
+//                 -grad phi (central differences), interpolated the same way.
 // No per-cell output buffer of the worst-case size exists: the mesh has exactly apex vertices.
 #include <cstdint>
 
@@ -315,17 +317,33 @@ struct ReduceLevelStage {
   }
 };
 
-// ---- 5. traversal: one thread per output vertex ------------------------------------------------------
+// ---- 5. traversal: runs of consecutive output vertices ------------------------------------------------
+/// One work item per run of `run` consecutive vertices [run * item, run * item + run) (the last run
+/// ends at the apex). The first vertex walks down from the apex as in Dyken et al.: at each level the
+/// children are taken in a fixed order (x fastest), skipping those whose counts lie before the
+/// vertex's index, so the vertices of a cell are contiguous and in the order of its case's list. Each
+/// following vertex is the next slot of the same cell, or the first slot of the next cell in that
+/// order with a nonzero count: the in-order successor in the tree, found by going up from the cell
+/// until a node has a later child with a nonzero count and walking down its first such children. The
+/// path needs no stack: the node at level l above cell (x, y, z) is (x >> l, y >> l, z >> l) and its
+/// child on the path is bit l - 1 of each coordinate. So every vertex gets exactly the cell, the slot
+/// and the arithmetic of its own descent, for any run length; run = 1 is one descent per vertex (the
+/// GPU's many threads), longer runs replace most descents by a step within the cell (the CPU's few
+/// threads, where the ~7 dependent levels per vertex were most of the traversal's time), and a run
+/// copies a vertex it computed already on the same edge instead of interpolating it again (EdgeCache).
 struct TraverseStage {
   FieldView field;
   PyramidView pyramid;
   const int8_t* edges;  // McTables::edges on this system, kMcMaxVertices per case
   float* positions;     // xyz per vertex
   float* normals;
+  int64_t vertices;     // the apex
+  int run;              // vertices per work item (>= 1)
 
   /// The child whose range of running sums holds key (the number of sums at or below it; sums are
   /// non-decreasing and the last is above key), and key made relative to that child. Branch-free, so
-  /// that consecutive vertices' descents overlap in the processor.
+  /// that consecutive vertices' descents overlap in the processor. With key = the running sum up to a
+  /// child, the result is its next sibling with a nonzero count (8: none).
   SPHXR_HD SPHXR_INLINE static int Select(const uint32_t sums[8], uint32_t* key) {
     const uint32_t k = *key;
     uint32_t p[8];
@@ -337,68 +355,165 @@ struct TraverseStage {
     return skip;
   }
 
-  SPHXR_HD void operator()(int64_t v) const {
-    // Walk down: at each level the children are taken in a fixed order (x fastest), so the vertices
-    // of a cell are contiguous and in the order of its case's list. Above level 1 the children's
-    // running sums are one brick: the child is the number of them at or below the key.
-    uint32_t key = static_cast<uint32_t>(v);
-    int x = 0, y = 0, z = 0;
-    for (int level = pyramid.levels - 1; level > 1; --level) {
-      const uint32_t* sums = pyramid.Brick(level - 1, x, y, z);
-      const int skip = Select(sums, &key);
-      x = 2 * x + (skip & 1);
-      y = 2 * y + ((skip >> 1) & 1);
-      z = 2 * z + (skip >> 2);
-    }
+  /// The running sums of the 8 cells under level-1 node (x, y, z) (a cell beyond the base's edge reads
+  /// the sentinel, 0).
+  SPHXR_HD SPHXR_INLINE void CellSums(int x, int y, int z, uint32_t sums[8]) const {
     const int* d = pyramid.dims[0];
-    {
-      // Level 1 -> the base: the 8 cells' counts, linear (a child beyond the edge reads the sentinel).
-      const int first = 2 * x + d[0] * (2 * y + d[1] * 2 * z);
-      const bool inX = 2 * x + 1 < d[0], inY = 2 * y + 1 < d[1], inZ = 2 * z + 1 < d[2];
-      uint32_t sums[8];
-      uint32_t sum = 0;
-      for (int k = 0; k < 8; ++k) {
-        const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
-        const bool inside = (!dx || inX) && (!dy || inY) && (!dz || inZ);
-        sum += pyramid.count[inside ? first + dx + d[0] * (dy + d[1] * dz) : pyramid.sentinel] & PyramidView::kCountMask;
-        sums[k] = sum;
-      }
-      const int skip = Select(sums, &key);
-      x = 2 * x + (skip & 1);
-      y = 2 * y + ((skip >> 1) & 1);
-      z = 2 * z + (skip >> 2);
+    const int first = 2 * x + d[0] * (2 * y + d[1] * 2 * z);
+    const bool inX = 2 * x + 1 < d[0], inY = 2 * y + 1 < d[1], inZ = 2 * z + 1 < d[2];
+    uint32_t sum = 0;
+    for (int k = 0; k < 8; ++k) {
+      const int dx = k & 1, dy = (k >> 1) & 1, dz = k >> 2;
+      const bool inside = (!dx || inX) && (!dy || inY) && (!dz || inZ);
+      sum += pyramid.count[inside ? first + dx + d[0] * (dy + d[1] * dz) : pyramid.sentinel] & PyramidView::kCountMask;
+      sums[k] = sum;
     }
-    // (x, y, z) is the cell, key the vertex's slot in its case's list.
+  }
+
+  /// Walk down from node (x, y, z) of `level` (>= 1) to the cell holding vertex `key` of that node:
+  /// (x, y, z) becomes the cell, key its slot there, cellSums those of the cell's level-1 node.
+  SPHXR_HD SPHXR_INLINE void Descend(int level, int* x, int* y, int* z, uint32_t* key, uint32_t cellSums[8]) const {
+    for (; level > 1; --level) {
+      const int skip = Select(pyramid.Brick(level - 1, *x, *y, *z), key);
+      *x = 2 * *x + (skip & 1);
+      *y = 2 * *y + ((skip >> 1) & 1);
+      *z = 2 * *z + (skip >> 2);
+    }
+    CellSums(*x, *y, *z, cellSums);
+    const int skip = Select(cellSums, key);
+    *x = 2 * *x + (skip & 1);
+    *y = 2 * *y + ((skip >> 1) & 1);
+    *z = 2 * *z + (skip >> 2);
+  }
+
+  /// Vertex v: slot `key` of cell (x, y, z). The case table names the edge; the position is interpolated
+  /// on it and the normal is -grad phi (central differences), interpolated the same way.
+  /// The vertices a run computed last, by edge (direct-mapped on a hash of the edge's id): a vertex
+  /// lies on an edge shared by up to 4 cells and by several triangles of each, and the run's cells
+  /// are neighbours in the pyramid's order, so most vertices are copies of one computed a few
+  /// vertices before. A copy is bitwise the value computed (every cell interpolates an edge the same
+  /// way). Only runs longer than one vertex use it (the CPU's).
+  struct EdgeCache {
+#ifdef __CUDA_ARCH__
+    static constexpr int kSize = 1;  // the GPU's runs are one vertex: no local memory for a cache
+#else
+    static constexpr int kSize = 64;
+#endif
+    static constexpr uint32_t kNone = 0xffffffffu;  // above every id (3 samples + 2 < 2^32)
+    uint32_t id[kSize];
+    float value[kSize][6];  // position, normal
+    SPHXR_HD SPHXR_INLINE static int Slot(uint32_t id) {
+      return static_cast<int>((id * 2654435761u) >> 26) & (kSize - 1);  // Knuth's multiplicative hash
+    }
+  };
+
+  SPHXR_HD SPHXR_INLINE void Emit(int64_t v, int x, int y, int z, uint32_t key, EdgeCache* cache) const {
+    const int* d = pyramid.dims[0];
     const int mcCase = static_cast<int>(pyramid.count[x + d[0] * (y + d[1] * z)] >> PyramidView::kCaseShift);
     const int edge = edges[mcCase * kMcMaxVertices + static_cast<int>(key)];
-    const int axis = edge / 4, o = edge % 4;
-    int a[3] = {x, y, z};
-    if (axis == 0) { a[1] += o & 1; a[2] += o >> 1; }
-    else if (axis == 1) { a[0] += o & 1; a[2] += o >> 1; }
-    else { a[0] += o & 1; a[1] += o >> 1; }
-    int b[3] = {a[0], a[1], a[2]};
-    b[axis] += 1;
+    // Edge 4 axis + o runs along `axis` from the cell's corner offset by (o & 1, o >> 1) on the other
+    // two axes in order. Scalars, not arrays indexed by the axis: a store to one element and a load of
+    // the whole stall the processor's store forwarding, per vertex.
+    const int axis = edge >> 2, o = edge & 3;
+    const int ax = x + (axis == 0 ? 0 : (o & 1)), ay = y + (axis == 0 ? (o & 1) : (axis == 1 ? 0 : (o >> 1)));
+    const int az = z + (axis == 2 ? 0 : (o >> 1));
+    const int bx = ax + (axis == 0 ? 1 : 0), by = ay + (axis == 1 ? 1 : 0), bz = az + (axis == 2 ? 1 : 0);
+    const int a = field.Index(ax, ay, az);
+    const uint32_t id = 3u * static_cast<uint32_t>(a) + static_cast<uint32_t>(axis);
+    float* pp = positions + 3 * v;
+    float* nn = normals + 3 * v;
+    float* hit = nullptr;
+    if (cache) {
+      const int c = EdgeCache::Slot(id);
+      hit = cache->value[c];
+      if (cache->id[c] == id) {
+        for (int i = 0; i < 3; ++i) {
+          pp[i] = hit[i];
+          nn[i] = hit[3 + i];
+        }
+        return;
+      }
+      cache->id[c] = id;
+    }
     // From the lower corner to the upper one, so the cells sharing this edge agree bit for bit.
-    const float f0 = field.value[field.Index(a[0], a[1], a[2])];
-    const float f1 = field.value[field.Index(b[0], b[1], b[2])];
+    const float f0 = field.value[a];
+    const float f1 = field.value[field.Index(bx, by, bz)];
     const float t = (field.iso - f0) / (f1 - f0);  // f0 != f1: exactly one of them is above iso
-    const Vec3 p0 = field.Point(a[0], a[1], a[2]);
-    const Vec3 p1 = field.Point(b[0], b[1], b[2]);
+    const Vec3 p0 = field.Point(ax, ay, az);
+    const Vec3 p1 = field.Point(bx, by, bz);
     const Vec3 p = p0 + (p1 - p0) * t;
-    const Vec3 g0 = field.Gradient(a[0], a[1], a[2]);
-    const Vec3 g1 = field.Gradient(b[0], b[1], b[2]);
+    const Vec3 g0 = field.Gradient(ax, ay, az);
+    const Vec3 g1 = field.Gradient(bx, by, bz);
     const Vec3 g = g0 + (g1 - g0) * t;
     const float len = Length(g);
     // -grad phi points out of the water; a flat field (len 0) cannot say where, so take +y.
     const Vec3 n = len > 0.0f ? g * (-1.0f / len) : Vec3{0.0f, 1.0f, 0.0f};
-    float* pp = positions + 3 * v;
-    float* nn = normals + 3 * v;
     pp[0] = p.x;
     pp[1] = p.y;
     pp[2] = p.z;
     nn[0] = n.x;
     nn[1] = n.y;
     nn[2] = n.z;
+    if (hit) {
+      hit[0] = p.x;
+      hit[1] = p.y;
+      hit[2] = p.z;
+      hit[3] = n.x;
+      hit[4] = n.y;
+      hit[5] = n.z;
+    }
+  }
+
+  SPHXR_HD void operator()(int64_t item) const {
+    const int64_t first = item * run;
+    const int64_t end = first + run < vertices ? first + run : vertices;
+    uint32_t key = static_cast<uint32_t>(first);
+    uint32_t cellSums[8];
+    int x = 0, y = 0, z = 0;
+    Descend(pyramid.levels - 1, &x, &y, &z, &key, cellSums);
+    int slot = (x & 1) | ((y & 1) << 1) | ((z & 1) << 2);  // the cell in its level-1 node
+    auto countOf = [&](int s) { return cellSums[s] - (s > 0 ? cellSums[s - 1] : 0u); };
+    uint32_t cellCount = countOf(slot);
+    EdgeCache cache;
+    EdgeCache* cached = end - first > 1 ? &cache : nullptr;
+    if (cached) {
+      for (int i = 0; i < EdgeCache::kSize; ++i) cache.id[i] = EdgeCache::kNone;
+    }
+    for (int64_t v = first;;) {
+      Emit(v, x, y, z, key, cached);
+      if (++v == end) break;
+      // The successor. Within the cell: its next slot.
+      if (++key < cellCount) continue;
+      // The next cell of the same level-1 node with vertices.
+      uint32_t sum = cellSums[slot];
+      int next = Select(cellSums, &sum);
+      key = 0;
+      if (next < 8) {
+        x = (x & ~1) | (next & 1);
+        y = (y & ~1) | ((next >> 1) & 1);
+        z = (z & ~1) | (next >> 2);
+        slot = next;
+        cellCount = countOf(slot);
+        continue;
+      }
+      // Up until a node has a later child with vertices (one has: v is below the apex's count), then
+      // down that child's first vertices.
+      int level = 2;
+      for (;; ++level) {
+        const int bit = level - 1;
+        const uint32_t* sums = pyramid.Brick(level - 1, x >> level, y >> level, z >> level);
+        const int child = ((x >> bit) & 1) | (((y >> bit) & 1) << 1) | (((z >> bit) & 1) << 2);
+        sum = sums[child];
+        next = Select(sums, &sum);
+        if (next < 8) break;
+      }
+      x = 2 * (x >> level) + (next & 1);
+      y = 2 * (y >> level) + ((next >> 1) & 1);
+      z = 2 * (z >> level) + (next >> 2);
+      Descend(level - 1, &x, &y, &z, &key, cellSums);
+      slot = (x & 1) | ((y & 1) << 1) | ((z & 1) << 2);
+      cellCount = countOf(slot);
+    }
   }
 };
 

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <map>
+#include <random>
 #include <unordered_map>
 
 #include "backend.h"
@@ -501,6 +503,89 @@ TEST(Surface, BufferGrowsOnlyWhenTheMeshDoesNotFitAndWriteToRefusesASmallTarget)
   s->DownloadMesh(&own);
   EXPECT_EQ(own.positions, pos);
   EXPECT_EQ(own.normals, nor);
+}
+
+TEST(Surface, RunsOfVerticesGiveBitwiseTheMeshOfOneDescentPerVertex) {
+  // The traversal steps from a run's first vertex to the next ones (the next slot of the cell, the next
+  // cell with vertices in the pyramid's order); every vertex must get the cell, slot and arithmetic of
+  // its own descent (run 1). Fields: isolated inside samples (8 cells of one triangle each around each,
+  // far apart: the step climbs many levels over empty bricks), a random field (every cell busy: steps
+  // within cells and bricks), and a sphere cut by the lattice's border on a lattice of odd, uneven sizes
+  // (padding at the pyramid's edges). Runs: short and odd ones, and ones that end at or past the
+  // mesh's last vertex. Caller memory pre-filled with NaN, and a guard after it: a vertex a run skips
+  // stays NaN, a run writing past the mesh changes the guard.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  struct Case {
+    const char* name;
+    SurfaceGrid grid;
+    std::vector<float> field;
+    float iso;
+  };
+  std::vector<Case> cases;
+  {
+    SurfaceGrid g = CubeGrid(45, 0.0f, 1.0f);
+    g.ny = 38;
+    g.nz = 27;
+    std::vector<float> f(static_cast<size_t>(g.Samples()), 0.0f);
+    std::uniform_int_distribution<int> pick(0, static_cast<int>(f.size()) - 1);
+    for (int n = 0; n < 40; ++n) f[static_cast<size_t>(pick(rng))] = 1.0f;
+    cases.push_back({"isolated samples", g, f, 0.5f});
+  }
+  {
+    SurfaceGrid g = CubeGrid(13, 0.0f, 1.0f);
+    g.ny = 9;
+    g.nz = 11;
+    std::vector<float> f(static_cast<size_t>(g.Samples()));
+    for (float& v : f) v = u(rng);
+    cases.push_back({"random field", g, f, 0.5f});
+  }
+  {
+    SurfaceGrid g = CubeGrid(35, 0.0f, 1.0f);
+    g.ny = 29;
+    g.nz = 19;
+    const auto f = Sample(g, [](double x, double y, double z) {
+      return 0.45 - std::sqrt((x - 0.3) * (x - 0.3) + (y - 0.2) * (y - 0.2) + (z - 0.1) * (z - 0.1));
+    });
+    cases.push_back({"sphere on the border", g, f, 0.0f});
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  constexpr int kGuard = 3 * 64;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    auto backend = sim::MakeCpuBackend(2);
+    sim::SurfaceExtractor* s = backend->Surface();
+    SurfaceStats stats;
+    ASSERT_TRUE(s->BuildFromField(c.grid, c.field, c.iso, &stats).ok());
+    const int64_t n = stats.vertices;
+    ASSERT_GT(n, 30);
+    auto write = [&](int run, std::vector<float>* pos, std::vector<float>* nor) {
+      pos->assign(static_cast<size_t>(3 * n + kGuard), nan);
+      nor->assign(pos->size(), nan);
+      s->SetTraversalRun(run);
+      EXPECT_TRUE(s->WriteTo(sim::SurfaceTarget{pos->data(), nor->data(), n}, &stats).ok());
+    };
+    std::vector<float> pos1, nor1;
+    write(1, &pos1, &nor1);
+    ExpectSameTriangles(SurfaceMesh{{pos1.begin(), pos1.end() - kGuard}, {nor1.begin(), nor1.end() - kGuard}},
+                        ReferenceMarchingCubes(c.grid, c.field, c.iso));
+    const int big = static_cast<int>(n);
+    for (int run : {2, 3, 5, 8, 13, 64, 255, 256, big - 1, big, big + 7}) {
+      SCOPED_TRACE(::testing::Message() << "run " << run << " of " << n << " vertices");
+      std::vector<float> pos, nor;
+      write(run, &pos, &nor);
+      int64_t firstDiff = -1;
+      for (int64_t v = 0; v < n && firstDiff < 0; ++v) {
+        if (std::memcmp(&pos[3 * v], &pos1[3 * v], 12) != 0 || std::memcmp(&nor[3 * v], &nor1[3 * v], 12) != 0) {
+          firstDiff = v;
+        }
+      }
+      EXPECT_EQ(firstDiff, -1) << "the first vertex that differs from its own descent's";
+      int guardWritten = 0;
+      for (size_t i = static_cast<size_t>(3 * n); i < pos.size(); ++i) guardWritten += std::isnan(pos[i]) && std::isnan(nor[i]) ? 0 : 1;
+      EXPECT_EQ(guardWritten, 0);
+    }
+  }
 }
 
 // ---- from particles --------------------------------------------------------------------------------------
