@@ -89,7 +89,8 @@ struct SceneSetup {
   /// particle's own pressure (at least its neighbours' Shepard average); matches Martin & Moyce, but
   /// is not the derivative of an energy and keeps still water circulating at ~1 cm/s. kWallDensity:
   /// each wall particle's own density from the fluid around it; energy-consistent, still water comes
-  /// to rest and meets hydrostatics within 3 %, but the dam break's column drains ~5 % slower.
+  /// to rest and meets hydrostatics within 3 %, but the dam break's column height at the back wall is
+  /// +14 % against Martin & Moyce (mirrored: +8.8 %, through a dip at the wall; physics.md).
   enum class WallPressure { kMirrored, kWallDensity };
   WallPressure wallPressure = WallPressure::kMirrored;
   std::vector<FluidBlock> fluid;
