@@ -20,7 +20,8 @@ namespace {
 
 // Multiples of sqrt(2 g H), the free-fall speed from the column top. Measured (1 s each): base 2.2,
 // stiffness x0.1 1.4, x100 4.85 (a few particles shot out where the jet hits the far wall at c = 150 m/s),
-// viscosity 0 2.5, x100 0.58, spacing x0.5 2.45, x2 1.7.
+// viscosity 0 2.5, x100 0.58, spacing x0.5 2.45, x2 1.7; with walls of their own density (the walls'
+// pressure from the fluid beside them, docs/physics.md "Walls") base 1.34, viscosity 0 1.45.
 constexpr float kSpeedBound = 5.0f;
 
 struct Extreme {
@@ -29,6 +30,7 @@ struct Extreme {
   float viscosityScale = 1.0f;
   float spacingScale = 1.0f;      // of the base (twice the scene's spacing)
   const char* startupWarning = nullptr;  // expected in the log at start-up, if the setting is unusable
+  bool wallDensity = false;       // tank.wall_pressure = "wall_density" instead of the scene's mirrored walls
 };
 
 // ctest and gtest name the case by its setting instead of by the bytes of the struct.
@@ -44,6 +46,7 @@ TEST_P(Stability, OneSecondOfDamBreak) {
   p.spacing *= 2.0f * e.spacingScale;
   p.stiffness *= e.stiffnessScale;
   p.viscosity *= e.viscosityScale;
+  if (e.wallDensity) scene.setup.wallPressure = sim::SceneSetup::WallPressure::kWallDensity;
   const float columnHeight = 2.0f * scene.damBreak->columnWidth;
   const float vRef = std::sqrt(2.0f * 9.81f * columnHeight);
 
@@ -91,7 +94,9 @@ INSTANTIATE_TEST_SUITE_P(
                       Extreme{"viscosity_0", 1.0f, 0.0f},
                       Extreme{"viscosity_x100", 1.0f, 100.0f},
                       Extreme{"spacing_x0_5", 1.0f, 1.0f, 0.5f},
-                      Extreme{"spacing_x2", 1.0f, 1.0f, 2.0f, "too coarse"}),
+                      Extreme{"spacing_x2", 1.0f, 1.0f, 2.0f, "too coarse"},
+                      Extreme{"wall_density", 1.0f, 1.0f, 1.0f, nullptr, true},
+                      Extreme{"wall_density_viscosity_0", 1.0f, 0.0f, 1.0f, nullptr, true}),
     [](const ::testing::TestParamInfo<Extreme>& info) { return std::string(info.param.name); });
 
 }  // namespace
