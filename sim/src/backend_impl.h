@@ -14,6 +14,7 @@
 #include <thrust/transform_reduce.h>
 
 #include <chrono>
+#include <vector>
 #include <type_traits>
 
 #include "backend.h"
@@ -70,6 +71,14 @@ class BackendImpl final : public Backend {
       g = View();
       thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
                          BoundaryVolumeStage{g, Raw(sorted), Raw(m_boundary), physics.boundaryGamma * physics.restDensity, physics.kernel});
+    }
+    // The cells that hold boundary particles (the walls' own pressure runs over them).
+    {
+      std::vector<uint32_t> starts(cells), wallCells;
+      thrust::copy(m_boundaryStart.begin(), m_boundaryStart.end(), starts.begin());
+      for (size_t c = 0; c < cells; ++c)
+        if (starts[c] != kEmptyCell) wallCells.push_back(static_cast<uint32_t>(c));
+      m_wallCells.assign(wallCells.begin(), wallCells.end());
     }
     // Which cells have boundary particles in their 27-cell neighbourhood (the walls never move).
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), static_cast<int>(cells),
@@ -138,8 +147,8 @@ class BackendImpl final : public Backend {
     // 3c. the walls' own pressure
     if (physics.wallDensity) {
       if (m_boundaryPressureTerm.size() != m_boundary.size()) m_boundaryPressureTerm.resize(m_boundary.size());
-      thrust::for_each_n(policy, first, static_cast<int>(m_boundary.size()),
-                         WallPressureStage{View(), fv, physics, Raw(m_boundaryPressureTerm)});
+      thrust::for_each_n(policy, first, static_cast<int>(m_wallCells.size()),
+                         WallPressureStage{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)});
     }
     // 4. density and pressure
     overComputing(DensityStage{View(), fv, Neighbours(physics), physics});
@@ -416,6 +425,7 @@ class BackendImpl final : public Backend {
   Vector<float> m_boundaryAlpha;
   mutable Vector<float> m_boundaryPressureTerm;
   Vector<float> m_boundaryInvReference;
+  Vector<uint32_t> m_wallCells;  // linear indices of the cells holding boundary particles
   // Moving boundaries (body_stages.h): canonical body-frame particles, their sorted world copies.
   Vector<Vec4> m_bodyLocal;        // body frame, w = Psi_b
   Vector<uint32_t> m_bodyOfLocal;  // body index of each canonical particle

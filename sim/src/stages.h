@@ -238,12 +238,32 @@ struct BoundaryNearStage {
 /// energy (the fluid's and the walls' own, each a function of the particle positions only), so still
 /// water comes to rest. Mirroring (p_b = p_i) is not such a derivative and pumps a ~1 cm/s circulation
 /// (docs/physics.md, "Hydrostatics").
+/// One work item per grid cell holding wall particles (`cells`): a cell with no fluid in its 27 cells
+/// (most of a tank's walls) writes 0 for its particles after 27 look-ups, instead of every particle
+/// scanning its own 27 cells.
 struct WallPressureStage {
   GridView grid;
   FluidView fluid;
   Physics ph;
+  const uint32_t* cells;  // linear indices of the cells that hold wall particles
   float* out;  // p_b / rho_b^2
-  SPHXR_HD void operator()(int b) const {
+  SPHXR_HD void operator()(int k) const {
+    const uint32_t c = cells[k];
+    const int cx = static_cast<int>(c % static_cast<uint32_t>(grid.nx));
+    const int cy = static_cast<int>((c / static_cast<uint32_t>(grid.nx)) % static_cast<uint32_t>(grid.ny));
+    const int cz = static_cast<int>(c / static_cast<uint32_t>(grid.nx * grid.ny));
+    bool fluidNear = false;
+    for (int z = cz - 1; z <= cz + 1; ++z)
+      for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x) {
+          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
+          if (grid.fluidStart[grid.Linear(x, y, z)] != kEmptyCell) fluidNear = true;
+        }
+    for (uint32_t b = grid.boundaryStart[c]; b < grid.boundaryEnd[c]; ++b) {
+      out[b] = fluidNear ? Particle(static_cast<int>(b)) : 0.0f;
+    }
+  }
+  SPHXR_HD SPHXR_INLINE float Particle(int b) const {
     const Vec3 xb = Xyz(grid.boundary[b]);
     const CubicSpline k = ph.kernel;
     float sum = 0.0f;
@@ -253,7 +273,7 @@ struct WallPressureStage {
     });
     const float rho = ph.restDensity * sum * grid.boundaryInvReference[b];
     const float p = TaitPressure(ph, rho);
-    out[b] = p > 0.0f ? p / (rho * rho) : 0.0f;
+    return p > 0.0f ? p / (rho * rho) : 0.0f;
   }
 };
 
