@@ -14,7 +14,6 @@
 #include <thrust/transform_reduce.h>
 
 #include <chrono>
-#include <vector>
 #include <type_traits>
 
 #include "backend.h"
@@ -51,7 +50,9 @@ class BackendImpl final : public Backend {
     Vector<float> unsortedReference(boundary.invReference.begin(), boundary.invReference.end());
     m_boundary.resize(nb);
     m_boundaryAlpha.resize(nb);
-    m_boundaryInvReference.resize(nb);
+    const bool wallDensity = unsortedReference.size() == static_cast<size_t>(nb) && physics.wallDensity;
+    m_boundaryInvReference.resize(wallDensity ? nb : 0);
+    m_boundaryPressureTerm.resize(wallDensity ? nb : 0);
     Vector<uint32_t> keys(nb), order(nb);
     thrust::fill(Traits::Policy(), m_boundaryStart.begin(), m_boundaryStart.end(), kEmptyCell);
     thrust::fill(Traits::Policy(), m_boundaryEnd.begin(), m_boundaryEnd.end(), kEmptyCell);
@@ -63,7 +64,7 @@ class BackendImpl final : public Backend {
       Vector<Vec4> sorted(nb);
       thrust::gather(Traits::Policy(), order.begin(), order.end(), unsorted.begin(), sorted.begin());
       thrust::gather(Traits::Policy(), order.begin(), order.end(), unsortedAlpha.begin(), m_boundaryAlpha.begin());
-      if (unsortedReference.size() == static_cast<size_t>(nb)) {  // walls with their own density only
+      if (wallDensity) {
         thrust::gather(Traits::Policy(), order.begin(), order.end(), unsortedReference.begin(), m_boundaryInvReference.begin());
       }
       thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
@@ -72,13 +73,14 @@ class BackendImpl final : public Backend {
       thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), nb,
                          BoundaryVolumeStage{g, Raw(sorted), Raw(m_boundary), physics.boundaryGamma * physics.restDensity, physics.kernel});
     }
-    // The cells that hold boundary particles (the walls' own pressure runs over them).
-    {
-      std::vector<uint32_t> starts(cells), wallCells;
-      thrust::copy(m_boundaryStart.begin(), m_boundaryStart.end(), starts.begin());
-      for (size_t c = 0; c < cells; ++c)
-        if (starts[c] != kEmptyCell) wallCells.push_back(static_cast<uint32_t>(c));
-      m_wallCells.assign(wallCells.begin(), wallCells.end());
+    // The cells that hold boundary particles: the walls' own pressure runs over them.
+    m_wallCells.clear();
+    if (wallDensity) {
+      m_wallCells.resize(cells);
+      const thrust::counting_iterator<uint32_t> cell(0);
+      auto end = thrust::copy_if(Traits::Policy(), cell, cell + cells, m_boundaryStart.begin(), m_wallCells.begin(),
+                                 NonEmptyCell{});
+      m_wallCells.resize(end - m_wallCells.begin());
     }
     // Which cells have boundary particles in their 27-cell neighbourhood (the walls never move).
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), static_cast<int>(cells),
@@ -145,8 +147,7 @@ class BackendImpl final : public Backend {
     };
 
     // 3c. the walls' own pressure
-    if (physics.wallDensity) {
-      if (m_boundaryPressureTerm.size() != m_boundary.size()) m_boundaryPressureTerm.resize(m_boundary.size());
+    if (physics.wallDensity && !m_wallCells.empty()) {
       thrust::for_each_n(policy, first, static_cast<int>(m_wallCells.size()),
                          WallPressureStage{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)});
     }
@@ -423,7 +424,7 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step  // per-step scratch (stages.h NeighbourList)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
-  mutable Vector<float> m_boundaryPressureTerm;
+  Vector<float> m_boundaryPressureTerm;  // per boundary particle, walls with their own density only
   Vector<float> m_boundaryInvReference;
   Vector<uint32_t> m_wallCells;  // linear indices of the cells holding boundary particles
   // Moving boundaries (body_stages.h): canonical body-frame particles, their sorted world copies.

@@ -215,20 +215,28 @@ struct CellRangeStage {
 };
 
 // ---- cells near the boundary (once): any boundary particle in the 27 cells around cell c ------------
+/// Whether any of the 27 cells around linear cell c (within the grid) is non-empty in `start`.
+SPHXR_HD SPHXR_INLINE bool AnyInNeighbourCells(const GridView& grid, const uint32_t* start, int c) {
+  const int cx = c % grid.nx, cy = (c / grid.nx) % grid.ny, cz = c / (grid.nx * grid.ny);
+  bool any = false;
+  for (int z = cz - 1; z <= cz + 1; ++z)
+    for (int y = cy - 1; y <= cy + 1; ++y)
+      for (int x = cx - 1; x <= cx + 1; ++x) {
+        if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
+        if (start[grid.Linear(x, y, z)] != kEmptyCell) any = true;
+      }
+  return any;
+}
+
+/// Predicate for compacting cell indices: the cell's start is not kEmptyCell.
+struct NonEmptyCell {
+  SPHXR_HD bool operator()(uint32_t start) const { return start != kEmptyCell; }
+};
+
 struct BoundaryNearStage {
   GridView grid;
   uint8_t* out;
-  SPHXR_HD void operator()(int c) const {
-    const int cx = c % grid.nx, cy = (c / grid.nx) % grid.ny, cz = c / (grid.nx * grid.ny);
-    uint8_t near = 0;
-    for (int z = cz - 1; z <= cz + 1; ++z)
-      for (int y = cy - 1; y <= cy + 1; ++y)
-        for (int x = cx - 1; x <= cx + 1; ++x) {
-          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
-          if (grid.boundaryStart[grid.Linear(x, y, z)] != kEmptyCell) near = 1;
-        }
-    out[c] = near;
-  }
+  SPHXR_HD void operator()(int c) const { out[c] = AnyInNeighbourCells(grid, grid.boundaryStart, c) ? 1 : 0; }
 };
 
 // ---- wall pressure (every step): each wall particle's own density from the fluid around it -----------
@@ -249,16 +257,7 @@ struct WallPressureStage {
   float* out;  // p_b / rho_b^2
   SPHXR_HD void operator()(int k) const {
     const uint32_t c = cells[k];
-    const int cx = static_cast<int>(c % static_cast<uint32_t>(grid.nx));
-    const int cy = static_cast<int>((c / static_cast<uint32_t>(grid.nx)) % static_cast<uint32_t>(grid.ny));
-    const int cz = static_cast<int>(c / static_cast<uint32_t>(grid.nx * grid.ny));
-    bool fluidNear = false;
-    for (int z = cz - 1; z <= cz + 1; ++z)
-      for (int y = cy - 1; y <= cy + 1; ++y)
-        for (int x = cx - 1; x <= cx + 1; ++x) {
-          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
-          if (grid.fluidStart[grid.Linear(x, y, z)] != kEmptyCell) fluidNear = true;
-        }
+    const bool fluidNear = AnyInNeighbourCells(grid, grid.fluidStart, static_cast<int>(c));
     for (uint32_t b = grid.boundaryStart[c]; b < grid.boundaryEnd[c]; ++b) {
       out[b] = fluidNear ? Particle(static_cast<int>(b)) : 0.0f;
     }
@@ -451,6 +450,8 @@ struct ForceStage {
     Vec3 a{0.0f, 0.0f, 0.0f};
     // Shepard average of the pressure around i (self included), for the wall term below.
     const bool nearWall = fluid.position[i].w != 0.0f;
+    // The Shepard average feeds the mirrored wall pressure (and the bodies', which are always mirrored).
+    const bool shepard = nearWall && (!ph.wallDensity || grid.MovingNear(xi));
     float pAverage = fluid.pressure[i] * k.W(0.0f) / rhoi;
     float weight = k.W(0.0f) / rhoi;
     auto fluidNeighbour = [&](uint32_t j, Vec3 d) {
@@ -458,7 +459,7 @@ struct ForceStage {
       if (r2 >= k.H2 || r2 == 0.0f) return;  // r2 == 0: self, or a coincident particle (no direction)
       const float rhoj = fluid.density[j];
       const float r = sqrtf(r2);
-      if (nearWall) {
+      if (shepard) {
         const float wj = k.W(r) / rhoj;
         pAverage += fluid.pressure[j] * wj;
         weight += wj;

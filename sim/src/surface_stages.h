@@ -448,19 +448,13 @@ struct TraverseStage {
     const float len = Length(g);
     // -grad phi points out of the water; a flat field (len 0) cannot say where, so take +y.
     const Vec3 n = len > 0.0f ? g * (-1.0f / len) : Vec3{0.0f, 1.0f, 0.0f};
-    pp[0] = p.x;
-    pp[1] = p.y;
-    pp[2] = p.z;
-    nn[0] = n.x;
-    nn[1] = n.y;
-    nn[2] = n.z;
+    const float value[6] = {p.x, p.y, p.z, n.x, n.y, n.z};
+    for (int i = 0; i < 3; ++i) {
+      pp[i] = value[i];
+      nn[i] = value[3 + i];
+    }
     if (hit) {
-      hit[0] = p.x;
-      hit[1] = p.y;
-      hit[2] = p.z;
-      hit[3] = n.x;
-      hit[4] = n.y;
-      hit[5] = n.z;
+      for (int i = 0; i < 6; ++i) hit[i] = value[i];
     }
   }
 
