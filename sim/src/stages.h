@@ -143,7 +143,7 @@ struct Physics {
   float restDensity;
   float invRestDensity;
   float boundaryGamma;  // Psi_b = gamma rho0 V_b: flat-wall rest-density correction (sampling.h)
-  float boundaryGradScale;
+  float boundaryGradScale;  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
   int maxNeighbours;    // neighbour-list slots per particle (NeighbourList)
   // Activity-based reuse (Huang et al. 2013, section 3.3); used only when the reuse stage runs.
   bool reuseEnabled;
@@ -157,7 +157,7 @@ struct Physics {
   int reuseCooldown;            // steps a particle so flagged stays active before it is classified again
   bool wallDensity;             // walls with their own density (WallPressureStage), else mirrored pressure
   float bodyGradScale;          // as boundaryGradScale, for the one-sheet shells of moving bodies
-  float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle  // gamma_grad / gamma: flat-wall pressure-gradient consistency (sampling.h)
+  float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle
   float stiffness;      // Tait B
   float exponent;       // Tait gamma
   float soundSpeed;     // sqrt(B gamma / rho0)
