@@ -6,9 +6,12 @@
 // IDLE, the acceleration tolerance), all from the same initial state, on the CPU backend, to the same simulated time with the
 // scenes' fixed time step, so the steps of all runs fall at the same simulated times. Per run:
 //   - step_ms: median wall time of Solver::Step over the run (the whole step, every stage);
-//   - speedup: the reference's median step time divided by the run's. The reference is run twice,
-//     first and last, and the mean of its two medians is used (the machine is shared; both are in
-//     the CSV so the drift is visible);
+//   - speedup: the reference's median step time divided by the run's. By default every run is paired
+//     with a reference (reuse off) solver stepped in lock-step with it, one step of each in turn
+//     (which goes first alternates), so a change of the machine's speed during the run hits both
+//     alike: the ratio is measured side by side. --unpaired runs each setting alone and divides the
+//     mean of the two reference runs (first and last) instead; the shared VM's speed drifts by 30 %
+//     over a sweep, so that ratio is noise. Both reference runs are in the CSV either way;
 //   - active: mean over the steps of the fraction of particles that computed density and forces;
 //   - mean_density_error: time average of the per-step mean compression, mean of max(0, rho/rho0 - 1);
 //     peak_density_error: the largest per-step mean compression in the run;
@@ -58,16 +61,22 @@ struct Args {
   std::string csv;
   std::string only;  // "deep_tank" or "dam_break_1m": one scene only
   double time = 0.0; // 0: the default per scene
+  bool unpaired = false;
+  bool presetsOnly = false;
   bool help = false;
 };
 
 const char* kUsage =
     "usage: sphxr_bench_reuse [--quick] [--threads N] [--csv FILE] [--scene deep_tank|dam_break_1m] [--time T]\n"
+    "                          [--presets] [--unpaired]\n"
     "  --quick         off, the three presets and 2 more settings, to t = 0.1 s (a smoke run)\n"
     "  --threads N     CPU backend threads (default 0 = all cores)\n"
     "  --csv FILE      write one row per run to FILE (overwritten)\n"
     "  --scene NAME    one of the two scenes only\n"
-    "  --time T        simulated seconds per run (default 0.3 deep_tank, 0.5 dam_break_1m)\n";
+    "  --time T        simulated seconds per run (default 0.3 deep_tank, 0.5 dam_break_1m)\n"
+    "  --presets       off and the three presets only (no sweep)\n"
+    "  --unpaired      no lock-step reference: half the time, but the speed-up is then against reference runs\n"
+    "                  made minutes apart (noise on a shared machine)\n";
 
 bool ParseArgs(int argc, char** argv, Args* out) {
   for (int i = 1; i < argc; ++i) {
@@ -90,6 +99,10 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     } else if (a == "--time" && next(&v)) {
       out->time = std::atof(v.c_str());
       if (!(out->time > 0.0)) return false;
+    } else if (a == "--presets") {
+      out->presetsOnly = true;
+    } else if (a == "--unpaired") {
+      out->unpaired = true;
     } else if (a == "--help" || a == "-h") {
       out->help = true;
     } else {
@@ -121,9 +134,10 @@ Setting Preset(const char* name) {
 
 /// The sweep: one factor at a time around (delta1 0.25, delta2 1, T 1.3, IDLE 3, tolerance 1 g), the
 /// guard off once (to show why it exists), then the presets.
-std::vector<Setting> Settings(bool quick) {
+std::vector<Setting> Settings(bool quick, bool presetsOnly) {
   std::vector<Setting> s;
-  if (quick) {
+  if (presetsOnly) {
+  } else if (quick) {
     s = {Sweep(1, 1, 1.2f, 1, 0.0f), Sweep(0.25f, 1, 1.3f, 3, 1.0f)};
   } else {
     s.push_back(Sweep(1, 1, 1.2f, 1, 0.0f));
@@ -189,6 +203,7 @@ struct Result {
   std::vector<Sample> samples;
   double surfaceRms = 0, frontDev = 0;
   double loadStart = 0, loadEnd = 0;
+  double pairedRefMs = std::nan("");  // median step of the lock-step reference (NaN: unpaired)
 };
 
 struct SceneCase {
@@ -199,65 +214,121 @@ struct SceneCase {
   bool dam;
 };
 
-bool Run(const SceneCase& sc, const Setting& setting, int threads, Result* r) {
-  r->setting = setting;
-  app::SceneFile scene;
-  if (Status s = app::LoadScene(sc.path, &scene); !s) {
-    std::fprintf(stderr, "%s\n", s.message().c_str());
-    return false;
-  }
-  scene.setup.reuse.enabled = setting.enabled;
-  scene.setup.reuse.delta1 = setting.delta1;
-  scene.setup.reuse.delta2 = setting.delta2;
-  scene.setup.reuse.threshold = setting.threshold;
-  scene.setup.reuse.idle = setting.idle;
-  scene.setup.reuse.accelTolerance = setting.tolerance;
-  sim::SolverConfig config;
-  config.device = sim::Device::kCpu;
-  config.threads = threads;
-  std::unique_ptr<sim::Solver> solver;
-  if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) {
-    std::fprintf(stderr, "%s\n", s.message().c_str());
-    return false;
-  }
-  r->fluid = solver->FluidCount();
-  const float dx = scene.setup.params.spacing;
-  const int minPerBin = std::max(1, static_cast<int>(0.1f * (scene.setup.tank.max.z - scene.setup.tank.min.z) / dx));
-  r->loadStart = LoadAverage();
-  std::vector<double> stepMs;
-  double errTime = 0.0, errSum = 0.0, activeSum = 0.0;
-  size_t nextSample = 0;
-  sim::HostFluid host;
-  while (solver->Time() < sc.time - 1e-9) {
-    const auto t0 = std::chrono::steady_clock::now();
-    if (Status s = solver->Step(); !s) {
+/// One solver of a run: created from the scene with the setting's reuse parameters, stepped one step
+/// at a time (so that two can run in lock-step), its statistics gathered into a Result.
+class Runner {
+ public:
+  bool Init(const SceneCase& sc, const Setting& setting, int threads, Result* r) {
+    m_sc = &sc;
+    m_r = r;
+    r->setting = setting;
+    if (Status s = app::LoadScene(sc.path, &m_scene); !s) {
       std::fprintf(stderr, "%s\n", s.message().c_str());
       return false;
     }
-    stepMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    const sim::StepInfo& info = solver->LastStep();
-    if (!std::isfinite(info.maxSpeed) || !std::isfinite(info.meanDensityError)) r->finite = false;
-    errSum += info.meanDensityError * info.dt;
-    errTime += info.dt;
-    activeSum += info.activeFraction;
-    r->peakErr = std::max<double>(r->peakErr, info.meanDensityError);
-    r->maxSpeed = std::max<double>(r->maxSpeed, info.maxSpeed);
-    r->clamped += info.clamped;
-    if (nextSample < sc.sampleTimes.size() && solver->Time() >= sc.sampleTimes[nextSample] - 1e-7) {
-      solver->Download(&host);
+    m_scene.setup.reuse.enabled = setting.enabled;
+    m_scene.setup.reuse.delta1 = setting.delta1;
+    m_scene.setup.reuse.delta2 = setting.delta2;
+    m_scene.setup.reuse.threshold = setting.threshold;
+    m_scene.setup.reuse.idle = setting.idle;
+    m_scene.setup.reuse.accelTolerance = setting.tolerance;
+    sim::SolverConfig config;
+    config.device = sim::Device::kCpu;
+    config.threads = threads;
+    if (Status s = sim::Solver::Create(m_scene.setup, config, &m_solver); !s) {
+      std::fprintf(stderr, "%s\n", s.message().c_str());
+      return false;
+    }
+    r->fluid = m_solver->FluidCount();
+    m_dx = m_scene.setup.params.spacing;
+    m_minPerBin =
+        std::max(1, static_cast<int>(0.1f * (m_scene.setup.tank.max.z - m_scene.setup.tank.min.z) / m_dx));
+    return true;
+  }
+  double Time() const { return m_solver->Time(); }
+  bool Done() const { return m_solver->Time() >= m_sc->time - 1e-9; }
+  /// One step, timed; the statistics and, at the sample times, the surface and front.
+  bool Step() {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (Status s = m_solver->Step(); !s) {
+      std::fprintf(stderr, "%s\n", s.message().c_str());
+      return false;
+    }
+    m_stepMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    const sim::StepInfo& info = m_solver->LastStep();
+    if (!std::isfinite(info.maxSpeed) || !std::isfinite(info.meanDensityError)) m_r->finite = false;
+    m_errSum += info.meanDensityError * info.dt;
+    m_errTime += info.dt;
+    m_activeSum += info.activeFraction;
+    m_r->peakErr = std::max<double>(m_r->peakErr, info.meanDensityError);
+    m_r->maxSpeed = std::max<double>(m_r->maxSpeed, info.maxSpeed);
+    m_r->clamped += info.clamped;
+    if (m_nextSample < m_sc->sampleTimes.size() && m_solver->Time() >= m_sc->sampleTimes[m_nextSample] - 1e-7) {
+      m_solver->Download(&m_host);
       Sample smp;
-      smp.time = solver->Time();
-      smp.heights = Heights(host, scene.setup);
-      smp.front = sim::SurgeFront(host, scene.setup.tank.min.x, dx, minPerBin);
-      r->samples.push_back(std::move(smp));
-      ++nextSample;
+      smp.time = m_solver->Time();
+      smp.heights = Heights(m_host, m_scene.setup);
+      smp.front = sim::SurgeFront(m_host, m_scene.setup.tank.min.x, m_dx, m_minPerBin);
+      m_r->samples.push_back(std::move(smp));
+      ++m_nextSample;
+    }
+    return true;
+  }
+  void Finish() {
+    m_r->steps = static_cast<int64_t>(m_stepMs.size());
+    m_r->stepMs = Median(m_stepMs);
+    m_r->active = m_stepMs.empty() ? 1.0 : m_activeSum / static_cast<double>(m_stepMs.size());
+    m_r->meanErr = m_errTime > 0 ? m_errSum / m_errTime : 0.0;
+  }
+
+ private:
+  const SceneCase* m_sc = nullptr;
+  Result* m_r = nullptr;
+  app::SceneFile m_scene;
+  std::unique_ptr<sim::Solver> m_solver;
+  float m_dx = 0.0f;
+  int m_minPerBin = 1;
+  std::vector<double> m_stepMs;
+  double m_errTime = 0.0, m_errSum = 0.0, m_activeSum = 0.0;
+  size_t m_nextSample = 0;
+  sim::HostFluid m_host;
+};
+
+/// Runs `setting` to the scene's end time. With `paired`, a reference solver (reuse off) runs in
+/// lock-step: one step of each in turn, the one behind in simulated time first (ties alternate), so
+/// both see the same machine; its median step time goes to r->pairedRefMs.
+bool Run(const SceneCase& sc, const Setting& setting, int threads, bool paired, Result* r) {
+  Runner run;
+  if (!run.Init(sc, setting, threads, r)) return false;
+  Result refResult;
+  Runner ref;
+  Setting off;
+  off.name = "off";
+  if (paired && !ref.Init(sc, off, threads, &refResult)) return false;
+  r->loadStart = LoadAverage();
+  bool refFirst = false;
+  while (!run.Done() || (paired && !ref.Done())) {
+    if (!paired) {
+      if (!run.Step()) return false;
+      continue;
+    }
+    refFirst = !refFirst;
+    const bool stepRef = !ref.Done() && (run.Done() || ref.Time() < run.Time() - 1e-9 ||
+                                          (std::fabs(ref.Time() - run.Time()) <= 1e-9 && refFirst));
+    if (stepRef) {
+      if (!ref.Step()) return false;
+      if (!run.Done() && !run.Step()) return false;
+    } else {
+      if (!run.Step()) return false;
+      if (!ref.Done() && !ref.Step()) return false;
     }
   }
   r->loadEnd = LoadAverage();
-  r->steps = static_cast<int64_t>(stepMs.size());
-  r->stepMs = Median(stepMs);
-  r->active = stepMs.empty() ? 1.0 : activeSum / static_cast<double>(stepMs.size());
-  r->meanErr = errTime > 0 ? errSum / errTime : 0.0;
+  run.Finish();
+  if (paired) {
+    ref.Finish();
+    r->pairedRefMs = refResult.stepMs;
+  }
   return true;
 }
 
@@ -301,7 +372,7 @@ int main(int argc, char** argv) {
   if (!args.csv.empty() &&
       !OpenCsv(args.csv,
                "timestamp_utc,cpu_model,nproc,threads,scene,fluid,setting,enabled,delta1,delta2,threshold,idle,accel_tolerance,"
-               "sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,speedup,active_fraction,"
+               "sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,paired_ref_step_ms,speedup,active_fraction,"
                "mean_density_error,peak_density_error,surface_rms_spacings,front_deviation,max_speed,clamped,"
                "finite,load_avg_start,load_avg_end",
                false, &csv)) {
@@ -317,40 +388,44 @@ int main(int argc, char** argv) {
     off.name = "off";
     Result ref, refLast;
     std::fprintf(stderr, "%s: reference (reuse off) to t = %g s ...\n", sc.name.c_str(), sc.time);
-    if (!Run(sc, off, args.threads, &ref)) return 1;
+    if (!Run(sc, off, args.threads, false, &ref)) return 1;
     std::vector<Result> results;
-    for (const Setting& s : Settings(args.quick)) {
+    for (const Setting& s : Settings(args.quick, args.presetsOnly)) {
       std::fprintf(stderr, "%s: %s delta1 %g delta2 %g T %g IDLE %d tolerance %g ...\n", sc.name.c_str(),
                    s.name.c_str(), s.delta1, s.delta2, s.threshold, s.idle, s.tolerance);
       Result r;
-      if (!Run(sc, s, args.threads, &r)) return 1;
+      if (!Run(sc, s, args.threads, !args.unpaired, &r)) return 1;
       results.push_back(std::move(r));
     }
     std::fprintf(stderr, "%s: reference again (timing drift) ...\n", sc.name.c_str());
-    if (!Run(sc, off, args.threads, &refLast)) return 1;
+    if (!Run(sc, off, args.threads, false, &refLast)) return 1;
     const double refMs = 0.5 * (ref.stepMs + refLast.stepMs);
     app::SceneFile scene;
     if (Status s = app::LoadScene(sc.path, &scene); !s) return 1;
     const float dx = scene.setup.params.spacing;
     std::printf("\n## %s: %d particles, %.2f s simulated, reference %.2f / %.2f ms per step (first / last run)\n",
                 sc.name.c_str(), ref.fluid, sc.time, ref.stepMs, refLast.stepMs);
-    std::printf("%-9s %6s %6s %6s %5s %5s %8s %7s %7s %9s %9s %8s %8s %6s\n", "setting", "delta1", "delta2", "T", "IDLE", "tol",
-                "step_ms", "speedup", "active", "mean_err%", "peak_err%", "surf_rms", "front%", "vmax");
+    std::printf("%s\n", args.unpaired ? "speed-up against the mean of the two reference runs"
+                                       : "speed-up against a reference stepped in lock-step with each run (ref_ms)");
+    std::printf("%-9s %6s %6s %6s %5s %5s %8s %8s %7s %7s %9s %9s %8s %8s %6s\n", "setting", "delta1", "delta2", "T", "IDLE", "tol",
+                "step_ms", "ref_ms", "speedup", "active", "mean_err%", "peak_err%", "surf_rms", "front%", "vmax");
     results.insert(results.begin(), ref);
     for (Result& r : results) {
       Compare(ref, &r, dx);
-      const double speedup = r.stepMs > 0 ? refMs / r.stepMs : 0.0;
-      std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %8.2f %7.2f %7.3f %9.3f %9.3f %8.3f %8.2f %6.2f%s\n",
+      const bool paired = std::isfinite(r.pairedRefMs);
+      const double speedup = r.stepMs > 0 ? (paired ? r.pairedRefMs : refMs) / r.stepMs : 0.0;
+      std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %8.2f %8.2f %7.2f %7.3f %9.3f %9.3f %8.3f %8.2f %6.2f%s\n",
                   r.setting.name.c_str(), r.setting.delta1, r.setting.delta2, r.setting.threshold, r.setting.idle,
                   r.setting.tolerance,
-                  r.stepMs, speedup, r.active, 100 * r.meanErr, 100 * r.peakErr, r.surfaceRms, 100 * r.frontDev,
+                  r.stepMs, paired ? r.pairedRefMs : refMs, speedup, r.active, 100 * r.meanErr, 100 * r.peakErr, r.surfaceRms, 100 * r.frontDev,
                   r.maxSpeed, r.finite ? "" : "  NaN!");
       if (csv) {
         csv << when << ',' << CsvField(cpu) << ',' << CpuCount() << ',' << threads << ',' << sc.name << ',' << r.fluid
             << ',' << r.setting.name << ',' << (r.setting.enabled ? 1 : 0) << ',' << r.setting.delta1 << ','
             << r.setting.delta2 << ',' << r.setting.threshold << ',' << r.setting.idle << ',' << r.setting.tolerance << ','
             << sc.time << ','
-            << r.steps << ',' << r.stepMs << ',' << ref.stepMs << ',' << refLast.stepMs << ',' << speedup << ','
+            << r.steps << ',' << r.stepMs << ',' << ref.stepMs << ',' << refLast.stepMs << ',' << r.pairedRefMs << ','
+            << speedup << ','
             << r.active << ',' << r.meanErr << ',' << r.peakErr << ',' << r.surfaceRms << ','
             << (sc.dam ? r.frontDev : std::nan("")) << ',' << r.maxSpeed << ',' << r.clamped << ','
             << (r.finite ? 1 : 0) << ',' << r.loadStart << ',' << r.loadEnd << '\n';
