@@ -45,7 +45,7 @@ def main():
         for h, l in zip(handles, labels):
             seen.setdefault(l, h)
         ax.legend(seen.values(), seen.keys(), fontsize=8, loc="best")
-    fig.suptitle("Activity-based reuse: measured speed-up (loaded machine, +-30 %%) and work bound against accuracy (%s)"
+    fig.suptitle("Activity-based reuse: speed-up against a reuse-off solver in lock-step, and the work bound, against accuracy (%s)"
                  % rows[0]["cpu_model"], fontsize=10)
     fig.tight_layout()
     fig.savefig(dst, dpi=110)
