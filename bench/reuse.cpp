@@ -136,10 +136,9 @@ Setting Preset(const char* name) {
 /// guard off once (to show why it exists), then the presets.
 std::vector<Setting> Settings(bool quick, bool presetsOnly) {
   std::vector<Setting> s;
-  if (presetsOnly) {
-  } else if (quick) {
+  if (quick && !presetsOnly) {
     s = {Sweep(1, 1, 1.2f, 1, 0.0f), Sweep(0.25f, 1, 1.3f, 3, 1.0f)};
-  } else {
+  } else if (!presetsOnly) {
     s.push_back(Sweep(1, 1, 1.2f, 1, 0.0f));
     for (float tol : {0.1f, 0.3f, 1.0f, 2.0f, 5.0f}) s.push_back(Sweep(0.25f, 1, 1.3f, 3, tol));
     for (int idle : {1, 2, 5, 8}) s.push_back(Sweep(0.25f, 1, 1.3f, idle, 1.0f));

@@ -34,6 +34,12 @@ class BackendImpl final : public Backend {
 
   Status Init(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
               const HostBoundary& boundary) override {
+    // The force stage reads every wall particle's p_b/rho_b^2 under wall_density: without a reference
+    // per boundary particle there would be nothing to compute it from.
+    if (physics.wallDensity && boundary.invReference.size() != boundary.size()) {
+      return Status::Error("walls with their own density need one reference per boundary particle "
+                           "(sampling.h WallInverseReferences)");
+    }
     m_shape = grid;
     const size_t cells = static_cast<size_t>(grid.Cells());
     m_fluidStart.resize(cells);
@@ -47,10 +53,10 @@ class BackendImpl final : public Backend {
     const int nb = static_cast<int>(boundary.size());
     Vector<Vec4> unsorted(boundary.position.begin(), boundary.position.end());
     Vector<float> unsortedAlpha(boundary.viscosity.begin(), boundary.viscosity.end());
+    const bool wallDensity = physics.wallDensity;
     Vector<float> unsortedReference(boundary.invReference.begin(), boundary.invReference.end());
     m_boundary.resize(nb);
     m_boundaryAlpha.resize(nb);
-    const bool wallDensity = unsortedReference.size() == static_cast<size_t>(nb) && physics.wallDensity;
     m_boundaryInvReference.resize(wallDensity ? nb : 0);
     m_boundaryPressureTerm.resize(wallDensity ? nb : 0);
     Vector<uint32_t> keys(nb), order(nb);

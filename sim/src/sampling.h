@@ -39,7 +39,7 @@ float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers);
 float WallFluidSum(const CubicSpline& kernel, float dx);
 
 /// For each boundary particle, 1 / sum_f W_bf over the fluid's rest lattice filling the whole tank
-/// (minus obstacles): the reference its own density is measured against (BoundaryPressureStage). Edges
+/// (minus obstacles): the reference its own density is measured against (WallPressureStage). Edges
 /// and corners see a quarter and an eighth of the fluid a flat wall sees, and get a reference to match.
 /// The reference is floored at `floorFraction` of the flat wall's, so that a particle behind the first
 /// sheet, which sees almost no fluid at rest, does not turn one stray neighbour into a huge pressure.

@@ -61,7 +61,7 @@ struct GridView {
   const Vec4* boundary;  // xyz position, w = Psi_b (kg)
   const float* boundaryAlpha;  // artificial viscosity alpha of each boundary particle's wall
   const float* boundaryInvReference;  // per boundary particle: 1 / its rest-lattice fluid sum
-  const float* boundaryPressureTerm;  // per boundary particle, this step: p_b / rho_b^2 (BoundaryPressureStage)
+  const float* boundaryPressureTerm;  // per boundary particle, this step: p_b / rho_b^2 (WallPressureStage)
   const uint8_t* boundaryNear; // per cell: 1 when a boundary particle lies in its 27 cells
   // Moving boundaries (paddles, body_stages.h): particles re-sorted every step with their own ranges.
   int bodyCount;                  // 0: no moving boundary; the pointers below are then unused
