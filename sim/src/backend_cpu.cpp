@@ -4,6 +4,7 @@
 #include <thrust/system/omp/vector.h>
 
 #include "backend_impl.h"
+#include "cpu_stages.h"  // before the traits below name its stages
 
 namespace sphxr::sim {
 namespace {
@@ -16,6 +17,10 @@ struct OmpTraits {
   static constexpr const char* kName = "cpu";
   static constexpr bool kOnDevice = false;  // where the surface mesh lives
   static constexpr int kTraversalRun = 256;  // a descent per run of vertices: few threads, each stepping along the mesh
+  static constexpr bool kSimdStages = true;  // density and forces in SIMD (cpu_stages.h)
+  using DensityBlockStart = sim::DensityBlockStart;
+  using DensityBlockStage = sim::DensityBlockStage;
+  using ForceListStage = sim::ForceListStage;
 };
 
 }  // namespace

@@ -16,6 +16,7 @@ struct CudaTraits {
   static constexpr const char* kName = "cuda";
   static constexpr bool kOnDevice = true;  // where the surface mesh lives
   static constexpr int kTraversalRun = 1;  // one descent per vertex: a thread each
+  static constexpr bool kSimdStages = false;  // a thread per particle (DensityStage, ForceStage)
 };
 
 }  // namespace

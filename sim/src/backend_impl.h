@@ -157,13 +157,31 @@ class BackendImpl final : public Backend {
       thrust::for_each_n(policy, first, static_cast<int>(m_wallCells.size()),
                          WallPressureStage{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)});
     }
-    // 4. density and pressure
-    overComputing(DensityStage{View(), fv, Neighbours(physics), physics});
+    // 4. density and pressure. The CPU runs it in cell blocks (cpu_stages.h), with reuse masking the
+    // lanes that reuse; CUDA a thread per particle (over the compacted list with reuse).
+    const DensityStage density{View(), fv, Neighbours(physics), physics};
+    if constexpr (Traits::kSimdStages) {
+      m_blockStart.resize(n);
+      auto end = thrust::copy_if(policy, first, first + n, m_blockStart.begin(),
+                                 typename Traits::DensityBlockStart{View(), Raw(m_fluid.position)});
+      const int blocks = static_cast<int>(end - m_blockStart.begin());
+      thrust::for_each_n(policy, first, blocks,
+                         typename Traits::DensityBlockStage{density, Raw(m_blockStart),
+                                                            physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr,
+                                                            physics.reuseIdle});
+    } else {
+      overComputing(density);
+    }
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // 5. forces
     if (bodies && m_bodyPressureTerm.size() != static_cast<size_t>(n)) m_bodyPressureTerm.resize(n);
-    overComputing(ForceStage{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr});
+    const ForceStage forces{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr};
+    if constexpr (Traits::kSimdStages) {
+      overComputing(typename Traits::ForceListStage{forces});  // SIMD over each neighbour list (cpu_stages.h)
+    } else {
+      overComputing(forces);
+    }
     if (Status s = lap(Stage::kForces); !s) return s;
 
     // 5b. the fluid's force on each body particle (the reaction)
@@ -427,7 +445,8 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_fluidStart, m_fluidEnd, m_boundaryStart, m_boundaryEnd;
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
-  Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step  // per-step scratch (stages.h NeighbourList)
+  Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
+  Vector<uint32_t> m_blockStart;   // CPU density blocks: first particle of each (cpu_stages.h)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
   Vector<float> m_boundaryPressureTerm;  // per boundary particle, walls with their own density only

@@ -359,6 +359,9 @@ struct OverList {
 };
 
 // ---- stage 4: density and pressure ---------------------------------------------------------------
+/// One work item per particle (both backends). The CPU backend runs the same pieces, Candidate and
+/// Finish, from DensityBlockStage (cpu_stages.h), which tests one candidate against a cell's
+/// particles at once; the two give bit-identical results (tests/sim/cpu_stages_test.cpp).
 struct DensityStage {
   GridView grid;
   FluidView fluid;
@@ -366,22 +369,34 @@ struct DensityStage {
   Physics ph;
   SPHXR_HD void operator()(int i) const {
     const Vec3 xi = Xyz(fluid.position[i]);
-    const CubicSpline k = ph.kernel;
     float sumFluid = 0.0f;
     uint32_t found = 0;
-    uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+    uint32_t* slots = Slots(i);
     const uint32_t self = static_cast<uint32_t>(i);
-    const uint32_t capacity = static_cast<uint32_t>(list.maxNeighbours);
     ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t j, Vec3 d) {
-      const float r2 = Dot(d, d);
-      if (r2 < k.H2) {
-        sumFluid += k.W(sqrtf(r2));
-        if (j != self) {
-          if (found < capacity) slots[found] = j;
-          ++found;
-        }
-      }
+      Candidate(self, j, d, &sumFluid, &found, slots);
     });
+    Finish(i, xi, sumFluid, found);
+  }
+  SPHXR_HD SPHXR_INLINE uint32_t* Slots(int i) const {
+    return list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+  }
+  /// Fluid particle j at d = x_self - x_j: within the support it adds W to the sum and, unless it is
+  /// self, takes the next neighbour-list slot (counted past the capacity: the force stage then scans).
+  SPHXR_HD SPHXR_INLINE void Candidate(uint32_t self, uint32_t j, Vec3 d, float* sumFluid, uint32_t* found,
+                                       uint32_t* slots) const {
+    const float r2 = Dot(d, d);
+    if (r2 < ph.kernel.H2) {
+      *sumFluid += ph.kernel.W(sqrtf(r2));
+      if (j != self) {
+        if (*found < static_cast<uint32_t>(list.maxNeighbours)) slots[*found] = j;
+        ++*found;
+      }
+    }
+  }
+  /// The walls' and bodies' sums, then density, pressure and p/rho^2 of particle i.
+  SPHXR_HD SPHXR_INLINE void Finish(int i, Vec3 xi, float sumFluid, uint32_t found) const {
+    const CubicSpline k = ph.kernel;
     list.count[i] = found;
     float sumBoundary = 0.0f;
     int cx, cy, cz;
@@ -432,6 +447,17 @@ SPHXR_HD SPHXR_INLINE Vec3 BodyAcceleration(const GridView& grid, const Physics&
 }
 
 // ---- stage 5: pressure, viscosity and gravity ----------------------------------------------------
+/// What the force stage knows of particle i before its neighbours (ForceStage::Begin).
+struct ForceParticle {
+  Vec3 xi, vi;
+  float rhoi, pTermI;
+  bool nearWall;  // a wall within the support (the density stage's flag)
+  bool shepard;   // the Shepard pressure average is needed (mirrored walls or a moving body near)
+  float pAverage, weight;  // Shepard sums, self included
+};
+
+/// One work item per particle (both backends). The CPU backend runs the same Begin and End around a
+/// SIMD sum over the neighbour list (ForceListStage, cpu_stages.h).
 struct ForceStage {
   GridView grid;
   FluidView fluid;
@@ -439,30 +465,23 @@ struct ForceStage {
   Physics ph;
   float* bodyPressureTerm = nullptr;  // per particle near a moving body: p_i/rho_i^2 + p_b/rho_i^2 (for its reaction)
   SPHXR_HD void operator()(int i) const {
-    const Vec3 xi = Xyz(fluid.position[i]);
-    const Vec3 vi = Xyz(fluid.velocity[i]);
-    const float rhoi = fluid.density[i];
-    const float pTermI = fluid.pressureTerm[i];
+    ForceParticle P = Begin(i);
+    const Vec3 xi = P.xi, vi = P.vi;
+    const float rhoi = P.rhoi, pTermI = P.pTermI;
     const CubicSpline k = ph.kernel;
     const float h = ph.smoothing;
     const float eps = 0.01f * h * h;
     const float viscFluid = 2.0f * ph.alpha * ph.soundSpeed * h;
     Vec3 a{0.0f, 0.0f, 0.0f};
-    // Shepard average of the pressure around i (self included), for the wall term below.
-    const bool nearWall = fluid.position[i].w != 0.0f;
-    // The Shepard average feeds the mirrored wall pressure (and the bodies', which are always mirrored).
-    const bool shepard = nearWall && (!ph.wallDensity || grid.MovingNear(xi));
-    float pAverage = fluid.pressure[i] * k.W(0.0f) / rhoi;
-    float weight = k.W(0.0f) / rhoi;
     auto fluidNeighbour = [&](uint32_t j, Vec3 d) {
       const float r2 = Dot(d, d);
       if (r2 >= k.H2 || r2 == 0.0f) return;  // r2 == 0: self, or a coincident particle (no direction)
       const float rhoj = fluid.density[j];
       const float r = sqrtf(r2);
-      if (shepard) {
+      if (P.shepard) {
         const float wj = k.W(r) / rhoj;
-        pAverage += fluid.pressure[j] * wj;
-        weight += wj;
+        P.pAverage += fluid.pressure[j] * wj;
+        P.weight += wj;
       }
       float term = pTermI + fluid.pressureTerm[j];
       const Vec3 vij = vi - Xyz(fluid.velocity[j]);
@@ -481,14 +500,39 @@ struct ForceStage {
     } else {
       ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, fluidNeighbour);
     }
+    End(i, P, a);
+  }
+
+  SPHXR_HD SPHXR_INLINE ForceParticle Begin(int i) const {
+    ForceParticle P;
+    P.xi = Xyz(fluid.position[i]);
+    P.vi = Xyz(fluid.velocity[i]);
+    P.rhoi = fluid.density[i];
+    P.pTermI = fluid.pressureTerm[i];
+    P.nearWall = fluid.position[i].w != 0.0f;
+    // The Shepard average feeds the mirrored wall pressure (and the bodies', which are always mirrored).
+    P.shepard = P.nearWall && (!ph.wallDensity || grid.MovingNear(P.xi));
+    P.pAverage = fluid.pressure[i] * ph.kernel.W(0.0f) / P.rhoi;
+    P.weight = ph.kernel.W(0.0f) / P.rhoi;
+    return P;
+  }
+
+  /// Given the fluid neighbours' acceleration `a` (and P's Shepard sums): the walls, the moving bodies,
+  /// gravity, the reuse guard, and the store.
+  SPHXR_HD SPHXR_INLINE void End(int i, const ForceParticle& P, Vec3 a) const {
+    const Vec3 xi = P.xi, vi = P.vi;
+    const float rhoi = P.rhoi, pTermI = P.pTermI;
+    const CubicSpline k = ph.kernel;
+    const float h = ph.smoothing;
+    const float eps = 0.01f * h * h;
     // Wall pressure. Mirrored (the default): p_b = p_i (Akinci et al. 2012), but never below the average
     // pressure of i's fluid neighbours (the extrapolation of Adami et al. 2012, taken at i). Near the free
     // surface p_i is clamped to 0 while the particles below it push it with their own p_j > 0; mirroring
     // alone then gives the wall no strength and the particle sinks into it. Wall density (tank
     // "wall_pressure": "wall_density"): p_b/rho_b^2 of each wall particle from WallPressureStage.
     // Moving bodies always use the mirrored pressure.
-    if (nearWall) {
-      const float pWall = fmaxf(fluid.pressure[i], pAverage / weight);
+    if (P.nearWall) {
+      const float pWall = fmaxf(fluid.pressure[i], P.pAverage / P.weight);
       const float wallPressureTerm = ph.boundaryGradScale * (pTermI + pWall / (rhoi * rhoi));
       const float viscWall = ph.soundSpeed * h / (2.0f * rhoi);
       ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {

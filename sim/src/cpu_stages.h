@@ -1,0 +1,334 @@
+#pragma once
+// The CPU backend's SIMD traversals of the density and force stages (host-only; the CUDA backend runs
+// stages.h's DensityStage and ForceStage, a thread per particle). The physics is stages.h's: these
+// only arrange the same sums for 16-wide vector units.
+//
+// Density (DensityBlockStage): one work item per block of up to 16 particles of a pair of grid cells
+// along x (particles are sorted by Morton code, so a pair is a contiguous run). Each candidate j of the cells around
+// the block is loaded once and evaluated for all the block's particles at once: the distance, the hit
+// mask, sqrt and the kernel (both pieces, selected per lane); only the neighbour-list appends are
+// scalar, one per hit. The per-particle DensityStage does the same one candidate and one particle at a
+// time, with a branch per candidate and per kernel piece. Same cells, same candidate order: each
+// particle's sum adds the same terms in the same order and its neighbour list is the same list; a
+// kernel value may differ in the last bit where the compiler fuses a multiply-add differently.
+//
+// Forces (ForceListStage): per particle, its neighbour list 16 at a time, the neighbours' fields
+// gathered into vectors, the pair terms of ForceStage in every lane, the lanes summed at the end. The
+// sum's order differs from ForceStage's serial one (rounding only); the walls, bodies, gravity and
+// the reuse guard are ForceStage::End itself.
+//
+// Both are deterministic for any thread count (a particle's sums never depend on the schedule), and
+// the CPU runs them for every density and force evaluation, with reuse too (DensityBlockStage masks
+// the lanes that reuse and skips blocks without one), so reuse off and reuse with IDLE = 0 stay
+// bit-identical. tests/sim/cpu_stages_test.cpp compares both with the per-particle stages and with
+// brute force.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#if defined(__AVX512F__) || defined(__AVX__) || defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+#include "stages.h"
+
+// Each instruction-set tier gets its own inline namespace: a translation unit built for another tier
+// (a test without -march=native) then cannot lend its copies of these inline functions to the backend's.
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+#define SPHXR_CPU_TIER cpu_avx512
+#elif defined(__AVX__)
+#define SPHXR_CPU_TIER cpu_avx
+#elif defined(__SSE2__)
+#define SPHXR_CPU_TIER cpu_sse2
+#else
+#define SPHXR_CPU_TIER cpu_scalar
+#endif
+
+namespace sphxr::sim {
+inline namespace SPHXR_CPU_TIER {
+
+inline constexpr int kLanes = 16;
+
+/// 16 floats in one SIMD value (GCC/Clang vector extension: AVX-512 one register, AVX two, SSE four).
+typedef float Lanes16 __attribute__((vector_size(64), aligned(64)));
+typedef int32_t LaneInts16 __attribute__((vector_size(64), aligned(64)));
+
+inline Lanes16 Splat16(float v) { return Lanes16{} + v; }
+
+inline Lanes16 Sqrt16(Lanes16 a) {
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+  // (Zero-masked with all lanes on: GCC 12's _mm512_sqrt_ps passes an undefined merge source that
+  // -Wmaybe-uninitialized reports at every use.)
+  return reinterpret_cast<Lanes16>(_mm512_maskz_sqrt_ps(static_cast<__mmask16>(0xffff), reinterpret_cast<__m512>(a)));
+#elif defined(__AVX__)
+  __m256 h[2];
+  std::memcpy(h, &a, sizeof a);
+  h[0] = _mm256_sqrt_ps(h[0]);
+  h[1] = _mm256_sqrt_ps(h[1]);
+  std::memcpy(&a, h, sizeof a);
+  return a;
+#elif defined(__SSE2__)
+  __m128 h[4];
+  std::memcpy(h, &a, sizeof a);
+  for (int k = 0; k < 4; ++k) h[k] = _mm_sqrt_ps(h[k]);
+  std::memcpy(&a, h, sizeof a);
+  return a;
+#else
+  for (int l = 0; l < kLanes; ++l) a[l] = std::sqrt(a[l]);
+  return a;
+#endif
+}
+
+/// Bit l set where the comparison result (all ones / zero per lane) is true.
+inline uint32_t Bits16(LaneInts16 c) {
+#if defined(__AVX512DQ__)
+  return static_cast<uint32_t>(_mm512_movepi32_mask(reinterpret_cast<__m512i>(c)));
+#elif defined(__AVX__)
+  __m256 h[2];
+  std::memcpy(h, &c, sizeof c);
+  return static_cast<uint32_t>(_mm256_movemask_ps(h[0])) | (static_cast<uint32_t>(_mm256_movemask_ps(h[1])) << 8);
+#elif defined(__SSE2__)
+  __m128 h[4];
+  std::memcpy(h, &c, sizeof c);
+  uint32_t m = 0;
+  for (int k = 0; k < 4; ++k) m |= static_cast<uint32_t>(_mm_movemask_ps(h[k])) << (4 * k);
+  return m;
+#else
+  uint32_t m = 0;
+  for (int l = 0; l < kLanes; ++l) m |= (c[l] != 0 ? 1u : 0u) << l;
+  return m;
+#endif
+}
+
+/// Gathers base[index[l]] into lane l (AVX2 and AVX-512 have a gather instruction).
+inline Lanes16 Gather16(const float* base, LaneInts16 index) {
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+  // (The masked form with a zero source: GCC 12's _mm512_i32gather_ps trips -Wmaybe-uninitialized.)
+  return reinterpret_cast<Lanes16>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), static_cast<__mmask16>(0xffff),
+                                                            reinterpret_cast<__m512i>(index), base, 4));
+#elif defined(__AVX2__)
+  __m256i h[2];
+  std::memcpy(h, &index, sizeof index);
+  __m256 r[2] = {_mm256_i32gather_ps(base, h[0], 4), _mm256_i32gather_ps(base, h[1], 4)};
+  Lanes16 out;
+  std::memcpy(&out, r, sizeof out);
+  return out;
+#else
+  Lanes16 out;
+  for (int l = 0; l < kLanes; ++l) out[l] = base[index[l]];
+  return out;
+#endif
+}
+
+/// The sum of the 16 lanes, in lane order.
+inline float Sum16(Lanes16 v) {
+  float s = 0.0f;
+  for (int l = 0; l < kLanes; ++l) s += v[l];
+  return s;
+}
+
+/// The pair of cells along x that a density block is drawn from: cells 2m and 2m + 1 of a row, whose
+/// Morton codes differ in the lowest bit only, so their particles are one contiguous run (`first`,
+/// `end`). A block of up to 16 particles from the pair fills the vector better than one cell's ~8, and
+/// the pair's 4 x 3 x 3 cells around it are 36 instead of twice 27.
+struct CellPair {
+  int x0, x1;  // the pair's cells along x (x1 == x0 when the grid ends)
+  uint32_t first, end;
+};
+
+SPHXR_INLINE CellPair PairOf(const GridView& g, int cx, int cy, int cz) {
+  CellPair p;
+  p.x0 = cx & ~1;
+  p.x1 = p.x0 + 1 < g.nx ? p.x0 + 1 : p.x0;
+  const uint32_t c0 = g.Linear(p.x0, cy, cz), c1 = g.Linear(p.x1, cy, cz);
+  p.first = g.fluidStart[c0] != kEmptyCell ? g.fluidStart[c0] : g.fluidStart[c1];
+  p.end = g.fluidStart[c1] != kEmptyCell ? g.fluidEnd[c1] : g.fluidEnd[c0];
+  return p;
+}
+
+/// Whether particle i starts a block: it is the first of its cell pair, or 16, 32, ... after the first.
+struct DensityBlockStart {
+  GridView grid;
+  const Vec4* position;  // sorted
+  bool operator()(int i) const {
+    int cx, cy, cz;
+    grid.CellOf(Xyz(position[i]), &cx, &cy, &cz);
+    return (static_cast<uint32_t>(i) - PairOf(grid, cx, cy, cz).first) % kLanes == 0;
+  }
+};
+
+/// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to 16
+/// particles or the end of its cell pair). With reuse (`idle` set), only the lanes that compute this
+/// step (ComputesThisStep) are written; a block without one costs nothing.
+struct DensityBlockStage {
+  DensityStage stage;
+  const uint32_t* blockStart;
+  const int32_t* idle = nullptr;  // reuse: the idle counts; nullptr: every particle computes
+  int32_t idleSteps = 0;
+
+  void operator()(int b) const {
+    const GridView& g = stage.grid;
+    const Vec4* position = stage.fluid.position;
+    const uint32_t first = blockStart[b];
+    int cx, cy, cz;
+    g.CellOf(Xyz(position[first]), &cx, &cy, &cz);
+    const CellPair pair = PairOf(g, cx, cy, cz);
+    const int lanes = static_cast<int>(pair.end - first < static_cast<uint32_t>(kLanes) ? pair.end - first : kLanes);
+    uint32_t computing = 0;
+    const ComputesThisStep computes{idle, idleSteps};
+    for (int l = 0; l < lanes; ++l) {
+      if (idle == nullptr || computes(static_cast<int>(first) + l)) computing |= 1u << l;
+    }
+    if (computing == 0) return;
+
+    Lanes16 px = Splat16(1e30f), py = px, pz = px;
+    uint32_t found[kLanes] = {};
+    // The block's extent inside its cell pair per axis (local coordinates clamped to the pair's box,
+    // as ForEachInCells clamps to the cell), for culling the cells around it that no lane can reach.
+    const float cs = g.cellSize;
+    const int base[3] = {pair.x0, cy, cz};
+    const float extent[3] = {static_cast<float>(pair.x1 - pair.x0 + 1) * cs, cs, cs};
+    const float origin[3] = {g.origin.x + static_cast<float>(pair.x0) * cs, g.origin.y + static_cast<float>(cy) * cs,
+                             g.origin.z + static_cast<float>(cz) * cs};
+    float lo[3] = {extent[0], cs, cs}, hi[3] = {0.0f, 0.0f, 0.0f};
+    for (int l = 0; l < kLanes; ++l) {
+      if (computing & (1u << l)) {
+        const Vec4 p = position[first + l];
+        px[l] = p.x;
+        py[l] = p.y;
+        pz[l] = p.z;
+        const float local[3] = {p.x - origin[0], p.y - origin[1], p.z - origin[2]};
+        for (int a = 0; a < 3; ++a) {
+          const float t = fminf(fmaxf(local[a], 0.0f), extent[a]);
+          lo[a] = fminf(lo[a], t);
+          hi[a] = fmaxf(hi[a], t);
+        }
+      }  // other lanes stay far away, never a hit (their squared distance overflows to +inf)
+    }
+    // Squared distance along `axis` from the block's extent to cell c.
+    auto gap = [&](int axis, int c) {
+      const float cellLo = static_cast<float>(c - base[axis]) * cs, cellHi = cellLo + cs;
+      const float d = fmaxf(0.0f, fmaxf(cellLo - hi[axis], lo[axis] - cellHi));
+      return d * d;
+    };
+    const CubicSpline k = stage.ph.kernel;
+    const Lanes16 h2 = Splat16(k.H2), invH = Splat16(k.invH), one = Splat16(1.0f), half = Splat16(0.5f);
+    const Lanes16 zero = Splat16(0.0f), six = Splat16(6.0f), sigma = Splat16(k.sigma), sigma2 = Splat16(k.sigma * 2.0f);
+    Lanes16 sum = zero;
+    const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
+    const float reach2 = cs * cs;  // a cell this far from every lane holds no neighbour (cell size >= support)
+    const int z0 = cz > 0 ? cz - 1 : 0, z1 = cz < g.nz - 1 ? cz + 1 : cz;
+    const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy < g.ny - 1 ? cy + 1 : cy;
+    const int x0 = pair.x0 > 0 ? pair.x0 - 1 : 0, x1 = pair.x1 < g.nx - 1 ? pair.x1 + 1 : pair.x1;
+    for (int z = z0; z <= z1; ++z) {
+      const float dz2 = gap(2, z);
+      for (int y = y0; y <= y1; ++y) {
+        const float dyz2 = dz2 + gap(1, y);
+        if (dyz2 >= reach2) continue;
+        const uint32_t row = g.Linear(0, y, z);
+        for (int x = x0; x <= x1; ++x) {
+          if (dyz2 + gap(0, x) >= reach2) continue;
+          const uint32_t s = g.fluidStart[row + x];
+          if (s == kEmptyCell) continue;
+          const uint32_t e = g.fluidEnd[row + x];
+          for (uint32_t j = s; j < e; ++j) {
+            const Vec4 pj = position[j];
+            const Lanes16 dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
+            const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
+            const LaneInts16 within = r2 < h2;
+            uint32_t hits = Bits16(within);
+            if (hits == 0) continue;
+            // The cubic spline (kernel.h) in every lane, both pieces, then the lane's piece.
+            const Lanes16 q = Sqrt16(r2) * invH;
+            const Lanes16 inner = sigma * (six * (q * q * q - q * q) + one);
+            const Lanes16 t = one - q;
+            const Lanes16 outer = sigma2 * t * t * t;
+            const Lanes16 w = q <= half ? inner : outer;
+            sum += (within & (q < one)) ? w : zero;
+            while (hits != 0) {  // the neighbour lists: every hit but the particle itself
+              const int l = __builtin_ctz(hits);
+              hits &= hits - 1u;
+              const uint32_t i = first + static_cast<uint32_t>(l);
+              if (j == i) continue;
+              if (found[l] < capacity) stage.Slots(static_cast<int>(i))[found[l]] = j;
+              ++found[l];
+            }
+          }
+        }
+      }
+    }
+    for (int l = 0; l < lanes; ++l) {
+      if (computing & (1u << l)) stage.Finish(static_cast<int>(first) + l, Vec3{px[l], py[l], pz[l]}, sum[l], found[l]);
+    }
+  }
+};
+
+/// ForceStage for particle i with its fluid neighbours summed 16 at a time from the neighbour list
+/// (a list that overflowed falls back to ForceStage's own cell scan).
+struct ForceListStage {
+  ForceStage stage;
+
+  void operator()(int i) const {
+    const uint32_t found = stage.list.count[i];
+    const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
+    if (found > capacity) {
+      stage(i);
+      return;
+    }
+    ForceParticle P = stage.Begin(i);
+    const FluidView& f = stage.fluid;
+    const Physics& ph = stage.ph;
+    const CubicSpline k = ph.kernel;
+    const float h = ph.smoothing;
+    const float eps = 0.01f * h * h;
+    const float viscFluid = 2.0f * ph.alpha * ph.soundSpeed * h;
+    const float* position = reinterpret_cast<const float*>(f.position);  // Vec4: x y z w
+    const float* velocity = reinterpret_cast<const float*>(f.velocity);
+    const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(capacity);
+    const Lanes16 zero = Splat16(0.0f);
+    Lanes16 ax = zero, ay = zero, az = zero, pSum = zero, wSum = zero;
+    for (uint32_t base = 0; base < found; base += kLanes) {
+      LaneInts16 index;
+      for (int l = 0; l < kLanes; ++l) {
+        // Lanes past the list read particle i itself: r2 = 0, which the pair test excludes.
+        index[l] = static_cast<int32_t>(base + static_cast<uint32_t>(l) < found ? slots[base + l] : static_cast<uint32_t>(i));
+      }
+      const LaneInts16 at = index * 4;
+      const Lanes16 dx = P.xi.x - Gather16(position, at), dy = P.xi.y - Gather16(position + 1, at),
+                    dz = P.xi.z - Gather16(position + 2, at);
+      const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
+      const LaneInts16 pair = (r2 < k.H2) & (r2 != 0.0f);
+      if (Bits16(pair) == 0) continue;
+      const Lanes16 rhoj = Gather16(f.density, index);
+      const Lanes16 r = Sqrt16(r2);
+      const Lanes16 q = r * k.invH;
+      const Lanes16 t = 1.0f - q;
+      // CubicSpline::GradFactor in every lane (r > 0 where it is used).
+      const Lanes16 grad = (pair & (q < 1.0f)) ? (q <= 0.5f ? k.gradA * (3.0f * q - 2.0f) : -k.gradB * t * t / r) : zero;
+      if (P.shepard) {  // CubicSpline::W / rho_j
+        const Lanes16 w = (pair & (q < 1.0f)) ? (q <= 0.5f ? k.sigma * (6.0f * (q * q * q - q * q) + 1.0f)
+                                                           : k.sigma * 2.0f * t * t * t)
+                                              : zero;
+        const Lanes16 wj = w / rhoj;
+        pSum += Gather16(f.pressure, index) * wj;
+        wSum += wj;
+      }
+      Lanes16 term = P.pTermI + Gather16(f.pressureTerm, index);
+      const Lanes16 vx = (P.vi.x - Gather16(velocity, at)) * dx + (P.vi.y - Gather16(velocity + 1, at)) * dy +
+                         (P.vi.z - Gather16(velocity + 2, at)) * dz;
+      term = vx < 0.0f ? term - viscFluid * vx / ((r2 + eps) * (P.rhoi + rhoj)) : term;
+      const Lanes16 s = ph.mass * term * grad;
+      ax -= dx * s;
+      ay -= dy * s;
+      az -= dz * s;
+    }
+    if (P.shepard) {
+      P.pAverage += Sum16(pSum);
+      P.weight += Sum16(wSum);
+    }
+    stage.End(i, P, Vec3{Sum16(ax), Sum16(ay), Sum16(az)});
+  }
+};
+
+}  // namespace SPHXR_CPU_TIER
+}  // namespace sphxr::sim

@@ -1,0 +1,373 @@
+// The CPU backend's blocked density traversal (sim/src/cpu_stages.h) against the per-particle
+// DensityStage (the CUDA backend's) and against a brute-force O(n^2) sum in double: the same neighbour
+// lists in the same order, the same densities to float rounding, on random, clustered, cell-border and
+// over-full sets (more than 16 particles in a cell, more neighbours than list slots), with and without
+// reuse masking some particles out.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cpu_stages.h"
+#include "morton.h"
+
+namespace sphxr::sim {
+namespace {
+
+constexpr float kSpacing = 0.01f;
+constexpr float kSupport = 2.0f * kSpacing;
+
+/// Particles sorted by cell (Morton order, as the backend sorts them) with their grid, fields and
+/// neighbour lists in host vectors; Run*() evaluates one traversal into them.
+struct Setup {
+  Physics ph{};
+  int nx = 0, ny = 0, nz = 0;
+  Vec3 origin{0.0f, 0.0f, 0.0f};
+  std::vector<Vec4> position, velocity, acceleration;
+  std::vector<float> density, pressure, pressureTerm;
+  std::vector<int32_t> idle;
+  std::vector<uint32_t> start, end, index, count;
+  std::vector<uint8_t> boundaryNear;
+  std::vector<Vec4> boundary;  // sorted by cell, w = Psi_b
+  std::vector<float> boundaryAlpha;
+  std::vector<uint32_t> boundaryStart, boundaryEnd;
+
+  Setup(std::vector<Vec3> points, int maxNeighbours, std::vector<Vec3> walls = {}) {
+    ph.kernel = CubicSpline::Make(kSupport);
+    ph.mass = 1000.0f * kSpacing * kSpacing * kSpacing;
+    ph.restDensity = 1000.0f;
+    ph.invRestDensity = 1.0f / 1000.0f;
+    ph.stiffness = 50000.0f;
+    ph.exponent = 7.0f;
+    ph.maxNeighbours = maxNeighbours;
+    ph.smoothing = 0.5f * kSupport;
+    ph.alpha = 0.3f;
+    ph.soundSpeed = std::sqrt(50000.0f * 7.0f / 1000.0f);
+    ph.gravity = Vec3{0.0f, 0.0f, 0.0f};
+    ph.boundaryGradScale = 1.0f;
+    ph.wallDensity = false;  // mirrored walls: the force stage needs the Shepard pressure average
+    nx = 9;  // 0.18 x 0.16 x 0.16 m of 0.02 m cells: an odd row, whose last cell has no pair
+    ny = nz = 8;
+    GridView g = Grid();
+    std::vector<std::pair<uint32_t, Vec3>> keyed;
+    for (const Vec3& p : points) {
+      int cx, cy, cz;
+      g.CellOf(p, &cx, &cy, &cz);
+      keyed.push_back({MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz)), p});
+    }
+    std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const size_t n = keyed.size();
+    for (const auto& k : keyed) position.push_back(Vec4{k.second.x, k.second.y, k.second.z, 0.0f});
+    std::mt19937 rng(17);  // velocities of about 1 m/s in every direction: both signs of v_ij . x_ij
+    std::uniform_real_distribution<float> uv(-1.0f, 1.0f);
+    for (size_t i = 0; i < n; ++i) velocity.push_back(Vec4{uv(rng), uv(rng), uv(rng), 0.0f});
+    acceleration.assign(n, Vec4{0.0f, 0.0f, 0.0f, 0.0f});
+    density.assign(n, -1.0f);
+    pressure.assign(n, -1.0f);
+    pressureTerm.assign(n, -1.0f);
+    idle.assign(n, -1);
+    index.assign(n * static_cast<size_t>(maxNeighbours), 0xdeadbeefu);
+    count.assign(n, 0xdeadbeefu);
+    const size_t cells = static_cast<size_t>(nx) * ny * nz;
+    start.assign(cells, kEmptyCell);
+    end.assign(cells, kEmptyCell);
+    boundaryNear.assign(cells, 0);
+    boundaryStart.assign(cells, kEmptyCell);
+    boundaryEnd.assign(cells, kEmptyCell);
+    g = Grid();
+    std::vector<std::pair<uint32_t, Vec3>> keyedWalls;
+    for (const Vec3& p : walls) {
+      int cx, cy, cz;
+      g.CellOf(p, &cx, &cy, &cz);
+      keyedWalls.push_back({MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz)), p});
+    }
+    std::stable_sort(keyedWalls.begin(), keyedWalls.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const float psi = 0.7f * 1000.0f * kSpacing * kSpacing * kSpacing;
+    for (size_t b = 0; b < keyedWalls.size(); ++b) {
+      const Vec3 p = keyedWalls[b].second;
+      boundary.push_back(Vec4{p.x, p.y, p.z, psi});
+      boundaryAlpha.push_back(0.3f);
+      int cx, cy, cz;
+      g.CellOf(p, &cx, &cy, &cz);
+      const uint32_t c = g.Linear(cx, cy, cz);
+      if (boundaryStart[c] == kEmptyCell) boundaryStart[c] = static_cast<uint32_t>(b);
+      boundaryEnd[c] = static_cast<uint32_t>(b + 1);
+    }
+    g = Grid();
+    for (size_t c = 0; c < cells; ++c) boundaryNear[c] = AnyInNeighbourCells(g, boundaryStart.data(), static_cast<int>(c)) ? 1 : 0;
+    for (size_t i = 0; i < n; ++i) {
+      int cx, cy, cz;
+      g.CellOf(Xyz(position[i]), &cx, &cy, &cz);
+      const uint32_t c = g.Linear(cx, cy, cz);
+      if (start[c] == kEmptyCell) start[c] = static_cast<uint32_t>(i);
+      end[c] = static_cast<uint32_t>(i + 1);
+    }
+  }
+
+  GridView Grid() {
+    GridView g{};
+    g.origin = origin;
+    g.cellSize = kSupport;
+    g.invCellSize = 1.0f / kSupport;
+    g.nx = nx;
+    g.ny = ny;
+    g.nz = nz;
+    g.fluidStart = start.data();
+    g.fluidEnd = end.data();
+    g.boundaryNear = boundaryNear.data();
+    g.boundaryStart = boundaryStart.data();
+    g.boundaryEnd = boundaryEnd.data();
+    g.boundary = boundary.data();
+    g.boundaryAlpha = boundaryAlpha.data();
+    g.bodyCount = 0;
+    return g;
+  }
+
+  DensityStage Stage() {
+    FluidView f{};
+    f.position = position.data();
+    f.velocity = velocity.data();
+    f.acceleration = acceleration.data();
+    f.density = density.data();
+    f.pressure = pressure.data();
+    f.pressureTerm = pressureTerm.data();
+    f.idle = idle.data();
+    f.count = static_cast<int>(position.size());
+    return DensityStage{Grid(), f, NeighbourList{index.data(), count.data(), ph.maxNeighbours}, ph};
+  }
+
+  ForceStage Forces() {
+    const DensityStage d = Stage();
+    return ForceStage{d.grid, d.fluid, d.list, ph, nullptr};
+  }
+
+  void RunPerParticle(bool reuse, int idleSteps) {
+    const DensityStage s = Stage();
+    const ComputesThisStep computes{idle.data(), idleSteps};
+    for (int i = 0; i < static_cast<int>(position.size()); ++i) {
+      if (!reuse || computes(i)) s(i);
+    }
+  }
+
+  void RunBlocked(bool reuse, int idleSteps) {
+    const int n = static_cast<int>(position.size());
+    const DensityBlockStart isStart{Grid(), position.data()};
+    std::vector<uint32_t> blocks;
+    for (int i = 0; i < n; ++i) {
+      if (isStart(i)) blocks.push_back(static_cast<uint32_t>(i));
+    }
+    const DensityBlockStage s{Stage(), blocks.data(), reuse ? idle.data() : nullptr, idleSteps};
+    for (int b = 0; b < static_cast<int>(blocks.size()); ++b) s(b);
+  }
+};
+
+/// Runs both traversals on copies of one set and compares them with each other and with brute force.
+void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what, bool reuse = false) {
+  SCOPED_TRACE(what);
+  Setup perParticle(points, maxNeighbours), blocked(points, maxNeighbours);
+  const size_t n = perParticle.position.size();
+  constexpr int kIdle = 3;
+  if (reuse) {  // every third particle reuses this step (IC = 1), every fifth computes at IC = IDLE
+    for (size_t i = 0; i < n; ++i) {
+      const int32_t ic = i % 3 == 0 ? 1 : (i % 5 == 0 ? kIdle : -1);
+      perParticle.idle[i] = blocked.idle[i] = ic;
+    }
+  }
+  perParticle.RunPerParticle(reuse, kIdle);
+  blocked.RunBlocked(reuse, kIdle);
+  const CubicSpline k = perParticle.ph.kernel;
+  size_t overflowed = 0, checked = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const bool computes = !reuse || perParticle.idle[i] < 0 || perParticle.idle[i] == kIdle;
+    if (!computes) {  // untouched by both
+      EXPECT_EQ(blocked.density[i], -1.0f) << "particle " << i;
+      EXPECT_EQ(blocked.count[i], 0xdeadbeefu) << "particle " << i;
+      continue;
+    }
+    ++checked;
+    // The same neighbour list, in the same order.
+    ASSERT_EQ(blocked.count[i], perParticle.count[i]) << "particle " << i;
+    const size_t stored = std::min<size_t>(blocked.count[i], static_cast<size_t>(maxNeighbours));
+    if (blocked.count[i] > static_cast<uint32_t>(maxNeighbours)) ++overflowed;
+    for (size_t s = 0; s < stored; ++s) {
+      ASSERT_EQ(blocked.index[i * maxNeighbours + s], perParticle.index[i * maxNeighbours + s])
+          << "particle " << i << " slot " << s;
+    }
+    // Brute force: every particle within the support (self included), in double.
+    const Vec3 xi = Xyz(blocked.position[i]);
+    double sum = 0.0;
+    uint32_t neighbours = 0;
+    bool borderline = false;  // a pair within float rounding of the support: its count is the float test's
+    for (size_t j = 0; j < n; ++j) {
+      const Vec3 d = xi - Xyz(blocked.position[j]);
+      const double r = std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.y) * d.y +
+                                 static_cast<double>(d.z) * d.z);
+      if (std::abs(r - k.H) < 1e-5 * k.H) borderline = true;
+      if (r < k.H) {
+        const double q = r / k.H;
+        sum += q <= 0.5 ? k.sigma * (6.0 * (q * q * q - q * q) + 1.0) : k.sigma * 2.0 * std::pow(1.0 - q, 3);
+        if (j != i) ++neighbours;
+      }
+    }
+    if (!borderline) {
+      EXPECT_EQ(blocked.count[i], neighbours) << "particle " << i;
+    }
+    const double brute = perParticle.ph.mass * sum;
+    EXPECT_NEAR(blocked.density[i], brute, 1e-5 * brute) << "particle " << i;
+    // Each particle's sum adds the same terms in the same order; only a fused multiply-add in the
+    // kernel's polynomial may round one term differently.
+    EXPECT_NEAR(blocked.density[i], perParticle.density[i], 1e-6f * perParticle.density[i]) << "particle " << i;
+    EXPECT_NEAR(blocked.pressure[i], perParticle.pressure[i], 1e-4f * perParticle.pressure[i] + 1e-3f)
+        << "particle " << i;
+  }
+  EXPECT_GT(checked, n / 3);
+  if (maxNeighbours < 30) {
+    EXPECT_GT(overflowed, 0u) << "the over-full case must overflow the list";
+  }
+}
+
+std::vector<Vec3> Random(size_t n, float lo, float hi, unsigned seed, float hiX = 0.0f) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(lo, hi), ux(lo, hiX > 0.0f ? hiX : hi);
+  std::vector<Vec3> p(n);
+  for (Vec3& v : p) v = Vec3{ux(rng), u(rng), u(rng)};
+  return p;
+}
+
+/// ForceListStage against ForceStage and against the pair terms summed in double, on the densities
+/// and lists the blocked density stage left (no walls, no gravity: the fluid pair terms alone).
+void CompareForces(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what,
+                   const std::vector<Vec3>& walls = {}) {
+  SCOPED_TRACE(what);
+  Setup s(points, maxNeighbours, walls);
+  s.RunBlocked(false, 0);
+  const size_t n = s.position.size();
+  const ForceStage perParticle = s.Forces();
+  const ForceListStage simd{s.Forces()};
+  std::vector<Vec4> reference(n);
+  for (size_t i = 0; i < n; ++i) perParticle(static_cast<int>(i));
+  reference = s.acceleration;
+  std::fill(s.acceleration.begin(), s.acceleration.end(), Vec4{9.0f, 9.0f, 9.0f, 9.0f});
+  for (size_t i = 0; i < n; ++i) simd(static_cast<int>(i));
+  const Physics& ph = s.ph;
+  const CubicSpline k = ph.kernel;
+  const double h = ph.smoothing, eps = 0.01 * h * h, viscFluid = 2.0 * ph.alpha * ph.soundSpeed * h;
+  size_t overflowed = 0, nearWall = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (s.count[i] > static_cast<uint32_t>(maxNeighbours)) ++overflowed;
+    if (s.position[i].w != 0.0f) {  // walls in the support: the wall term (and its Shepard average) too
+      ++nearWall;
+      const double scale = std::abs(reference[i].x) + std::abs(reference[i].y) + std::abs(reference[i].z);
+      EXPECT_NEAR(s.acceleration[i].x, reference[i].x, 1e-5 * scale + 1e-6) << "particle " << i;
+      EXPECT_NEAR(s.acceleration[i].y, reference[i].y, 1e-5 * scale + 1e-6) << "particle " << i;
+      EXPECT_NEAR(s.acceleration[i].z, reference[i].z, 1e-5 * scale + 1e-6) << "particle " << i;
+      continue;
+    }
+    double a[3] = {0, 0, 0}, scale = 0.0;  // scale: the sum of the pair terms' magnitudes
+    for (size_t j = 0; j < n; ++j) {
+      const double d[3] = {static_cast<double>(s.position[i].x) - s.position[j].x,
+                           static_cast<double>(s.position[i].y) - s.position[j].y,
+                           static_cast<double>(s.position[i].z) - s.position[j].z};
+      const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      if (r >= k.H || r == 0.0) continue;
+      const double q = r / k.H;
+      const double grad = q <= 0.5 ? k.gradA * (3.0 * q - 2.0) : -k.gradB * (1.0 - q) * (1.0 - q) / r;
+      double term = static_cast<double>(s.pressureTerm[i]) + s.pressureTerm[j];
+      const double vx = (static_cast<double>(s.velocity[i].x) - s.velocity[j].x) * d[0] +
+                        (static_cast<double>(s.velocity[i].y) - s.velocity[j].y) * d[1] +
+                        (static_cast<double>(s.velocity[i].z) - s.velocity[j].z) * d[2];
+      if (vx < 0.0) term -= viscFluid * vx / ((r * r + eps) * (static_cast<double>(s.density[i]) + s.density[j]));
+      for (int c = 0; c < 3; ++c) a[c] -= d[c] * ph.mass * term * grad;
+      scale += std::abs(ph.mass * term * grad) * r;
+    }
+    const float got[3] = {s.acceleration[i].x, s.acceleration[i].y, s.acceleration[i].z};
+    const float ref[3] = {reference[i].x, reference[i].y, reference[i].z};
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(got[c], a[c], 1e-5 * scale + 1e-6) << "particle " << i << " axis " << c;
+      EXPECT_NEAR(got[c], ref[c], 1e-5 * scale + 1e-6) << "particle " << i << " axis " << c;
+    }
+  }
+  if (maxNeighbours < 30) {
+    EXPECT_GT(overflowed, 0u) << "the over-full case must overflow the list";
+  }
+  if (!walls.empty()) {
+    EXPECT_GT(nearWall, n / 10) << "the wall case must put particles near the wall";
+  }
+}
+
+TEST(CpuStages, ForcesNearMirroredWallsMatchPerParticle) {
+  // A floor of wall particles under water 6 spacings deep: the Shepard pressure average feeds the wall.
+  std::vector<Vec3> walls, water;
+  for (int z = 0; z < 16; ++z)
+    for (int x = 0; x < 18; ++x) {
+      walls.push_back(Vec3{(x + 0.5f) * kSpacing, 0.002f, (z + 0.5f) * kSpacing});
+      for (int y = 0; y < 6; ++y) water.push_back(Vec3{(x + 0.5f) * kSpacing, 0.0075f + y * 0.0098f, (z + 0.5f) * kSpacing});
+    }
+  CompareForces(water, 64, "mirrored floor", walls);
+}
+
+TEST(CpuStages, ForcesMatchPerParticleAndBruteForce) {
+  CompareForces(Random(3000, 0.0f, 0.16f, 6, 0.18f), 64, "random");
+}
+
+TEST(CpuStages, ForcesOfOverflowingListsMatch) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> nd(0.0f, 0.008f);
+  std::vector<Vec3> p;
+  for (int i = 0; i < 2000; ++i) {
+    p.push_back(Vec3{std::clamp(0.08f + nd(rng), 0.0f, 0.179f), std::clamp(0.08f + nd(rng), 0.0f, 0.159f),
+                     std::clamp(0.08f + nd(rng), 0.0f, 0.159f)});
+  }
+  CompareForces(p, 24, "clustered, lists overflowing");
+}
+
+TEST(CpuStages, DensityRandomSetMatchesPerParticleAndBruteForce) {
+  Compare(Random(3000, 0.0f, 0.16f, 1), 64, "random");
+}
+
+TEST(CpuStages, DensityClusteredSetWithOverFullCellsMatches) {
+  // Three dense clusters: cells with far more than 16 particles (several blocks per cell).
+  std::mt19937 rng(2);
+  std::normal_distribution<float> nd(0.0f, 0.006f);
+  std::vector<Vec3> p;
+  const Vec3 centres[] = {{0.05f, 0.05f, 0.05f}, {0.1f, 0.08f, 0.11f}, {0.13f, 0.14f, 0.03f}};
+  for (const Vec3& c : centres) {
+    for (int i = 0; i < 600; ++i) {
+      p.push_back(Vec3{std::clamp(c.x + nd(rng), 0.0f, 0.159f), std::clamp(c.y + nd(rng), 0.0f, 0.159f),
+                       std::clamp(c.z + nd(rng), 0.0f, 0.159f)});
+    }
+  }
+  Compare(p, 2000, "clustered");
+  Compare(p, 24, "clustered, lists overflowing");
+}
+
+TEST(CpuStages, DensityCellBorderLatticeMatches) {
+  // A lattice of pitch 0.4 cells: every fifth plane lies on a cell face, so many particles sit on
+  // faces, edges and corners (no pair is exactly a support apart: 2.5 pitches is not a lattice distance).
+  std::vector<Vec3> p;
+  const float pitch = 0.4f * kSupport;
+  for (int z = 0; z < 19; ++z)
+    for (int y = 0; y < 19; ++y)
+      for (int x = 0; x < 19; ++x) p.push_back(Vec3{x * pitch, y * pitch, z * pitch});
+  Compare(p, 64, "cell-border lattice");
+}
+
+TEST(CpuStages, DensityOddRowEndAndOutsideTheGridMatch) {
+  // x over the whole odd row (its last cell is a pair of one), and particles beyond the grid on every
+  // side, which CellOf clamps into the edge cells.
+  std::vector<Vec3> p = Random(3000, 0.0f, 0.16f, 4, 0.18f);
+  std::vector<Vec3> outside = Random(200, -0.01f, 0.17f, 5, 0.19f);
+  p.insert(p.end(), outside.begin(), outside.end());
+  Compare(p, 64, "odd row, outside");
+}
+
+TEST(CpuStages, DensityReuseMasksLanesThatDoNotCompute) {
+  Compare(Random(3000, 0.0f, 0.16f, 3), 64, "random, reuse", /*reuse=*/true);
+}
+
+}  // namespace
+}  // namespace sphxr::sim
