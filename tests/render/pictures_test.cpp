@@ -380,7 +380,9 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   EXPECT_GT(BladeCentre(snapshot()->paddles[0]).y, top) << "a hand-held paddle starts out of the water";
 
   // Press right of the panel and find, with the button held, the cursor rows that put the blade's centre
-  // 3 cm above the floor (under water) and the columns 6 cm apart along the drag.
+  // 3 cm above the floor (under water) and the columns 6 cm apart along the drag, the simulation paused.
+  desktop->OnKey(GLFW_KEY_SPACE);
+  ASSERT_TRUE(desktop->Paused());
   const double x0 = 420;
   desktop->OnCursor(x0, 250);
   desktop->OnMouseButton(GLFW_MOUSE_BUTTON_LEFT, true);
@@ -397,11 +399,21 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   // The paddle enters the water at the press point (re-entry at 1 m/s of simulated time).
   const auto start = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  // Frames at about 30 Hz (as with vsync, the window leaves the simulation thread its core).
+  // Each frame advances the simulation by the same 13 steps (N: one step while paused), about 3.3 ms of
+  // simulated time, as a frame of 30 ms wall time did on this machine when the test was written. Free-
+  // running frames made the stroke's speed in simulated time depend on how fast the solver is: after
+  // the CPU's SIMD stages a frame held 4.5 ms, the 20-frame stroke was slower, and the water ahead of
+  // the blade moved 0-4 mm instead of 4-9 mm. Stepped frames make the test the same on every machine.
+  constexpr int kStepsPerFrame = 13;
   auto frame = [&] {
-    const bool open = desktop->Frame();
-    std::this_thread::sleep_for(std::chrono::milliseconds(30));
-    return open;
+    if (!desktop->Frame()) return false;  // hands the newest cursor pose to the simulation
+    const int64_t target = snapshot()->steps + kStepsPerFrame;
+    for (int k = 0; k < kStepsPerFrame; ++k) desktop->OnKey(GLFW_KEY_N);
+    while (snapshot()->steps < target && wall() < 120.0) {
+      if (!desktop->Frame()) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return true;
   };
   while (wall() < 60.0 && glm::length(BladeCentre(snapshot()->paddles[0]) - target0) > 0.005f) ASSERT_TRUE(frame());
   ASSERT_LT(glm::length(BladeCentre(snapshot()->paddles[0]) - target0), 0.005f)
