@@ -21,6 +21,20 @@ namespace {
 constexpr float kSpacing = 0.01f;
 constexpr float kSupport = 2.0f * kSpacing;
 
+/// The points in Morton order of their cells, stably (as the backend sorts particles).
+std::vector<Vec3> SortedByCell(const GridView& g, const std::vector<Vec3>& points) {
+  std::vector<std::pair<uint32_t, Vec3>> keyed;
+  for (const Vec3& p : points) {
+    int cx, cy, cz;
+    g.CellOf(p, &cx, &cy, &cz);
+    keyed.push_back({MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz)), p});
+  }
+  std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Vec3> out;
+  for (const auto& k : keyed) out.push_back(k.second);
+  return out;
+}
+
 /// Particles sorted by cell (Morton order, as the backend sorts them) with their grid, fields and
 /// neighbour lists in host vectors; Run*() evaluates one traversal into them.
 struct Setup {
@@ -53,15 +67,8 @@ struct Setup {
     nx = 9;  // 0.18 x 0.16 x 0.16 m of 0.02 m cells: an odd row, whose last cell has no pair
     ny = nz = 8;
     GridView g = Grid();
-    std::vector<std::pair<uint32_t, Vec3>> keyed;
-    for (const Vec3& p : points) {
-      int cx, cy, cz;
-      g.CellOf(p, &cx, &cy, &cz);
-      keyed.push_back({MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz)), p});
-    }
-    std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    const size_t n = keyed.size();
-    for (const auto& k : keyed) position.push_back(Vec4{k.second.x, k.second.y, k.second.z, 0.0f});
+    for (const Vec3& p : SortedByCell(g, points)) position.push_back(Vec4{p.x, p.y, p.z, 0.0f});
+    const size_t n = position.size();
     std::mt19937 rng(17);  // velocities of about 1 m/s in every direction: both signs of v_ij . x_ij
     std::uniform_real_distribution<float> uv(-1.0f, 1.0f);
     for (size_t i = 0; i < n; ++i) velocity.push_back(Vec4{uv(rng), uv(rng), uv(rng), 0.0f});
@@ -79,16 +86,10 @@ struct Setup {
     boundaryStart.assign(cells, kEmptyCell);
     boundaryEnd.assign(cells, kEmptyCell);
     g = Grid();
-    std::vector<std::pair<uint32_t, Vec3>> keyedWalls;
-    for (const Vec3& p : walls) {
-      int cx, cy, cz;
-      g.CellOf(p, &cx, &cy, &cz);
-      keyedWalls.push_back({MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz)), p});
-    }
-    std::stable_sort(keyedWalls.begin(), keyedWalls.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const std::vector<Vec3> sortedWalls = SortedByCell(g, walls);
     const float psi = 0.7f * 1000.0f * kSpacing * kSpacing * kSpacing;
-    for (size_t b = 0; b < keyedWalls.size(); ++b) {
-      const Vec3 p = keyedWalls[b].second;
+    for (size_t b = 0; b < sortedWalls.size(); ++b) {
+      const Vec3 p = sortedWalls[b];
       boundary.push_back(Vec4{p.x, p.y, p.z, psi});
       boundaryAlpha.push_back(0.3f);
       int cx, cy, cz;
