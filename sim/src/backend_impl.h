@@ -163,7 +163,7 @@ class BackendImpl final : public Backend {
     if constexpr (Traits::kSimdStages) {
       m_blockStart.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_blockStart.begin(),
-                                 typename Traits::DensityBlockStart{View(), Raw(m_fluid.position)});
+                                 typename Traits::DensityBlockStart{View(), Raw(m_keys)});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
       thrust::for_each_n(policy, first, blocks,
                          typename Traits::DensityBlockStage{density, Raw(m_blockStart),

@@ -30,6 +30,7 @@
 #include <immintrin.h>
 #endif
 
+#include "morton.h"
 #include "stages.h"
 
 // Each instruction-set tier gets its own inline namespace: a translation unit built for another tier
@@ -127,6 +128,14 @@ inline float Sum16(Lanes16 v) {
   return s;
 }
 
+/// CubicSpline::W(r) (kernel.h) in every lane from q = r / H: both pieces, each lane's own, and 0 where
+/// `valid` is off or q >= 1.
+inline Lanes16 KernelW16(const CubicSpline& k, Lanes16 q, LaneInts16 valid) {
+  const Lanes16 t = 1.0f - q;
+  const Lanes16 w = q <= 0.5f ? k.sigma * (6.0f * (q * q * q - q * q) + 1.0f) : k.sigma * 2.0f * t * t * t;
+  return (valid & (q < 1.0f)) ? w : Splat16(0.0f);
+}
+
 /// The pair of cells along x that a density block is drawn from: cells 2m and 2m + 1 of a row, whose
 /// Morton codes differ in the lowest bit only, so their particles are one contiguous run (`first`,
 /// `end`). A block of up to 16 particles from the pair fills the vector better than one cell's ~8, and
@@ -147,13 +156,15 @@ SPHXR_INLINE CellPair PairOf(const GridView& g, int cx, int cy, int cz) {
 }
 
 /// Whether particle i starts a block: it is the first of its cell pair, or 16, 32, ... after the first.
+/// Its cell comes from the step's sorted Morton keys (CellCodeStage), not from its position again.
 struct DensityBlockStart {
   GridView grid;
-  const Vec4* position;  // sorted
+  const uint32_t* keys;  // sorted
   bool operator()(int i) const {
-    int cx, cy, cz;
-    grid.CellOf(Xyz(position[i]), &cx, &cy, &cz);
-    return (static_cast<uint32_t>(i) - PairOf(grid, cx, cy, cz).first) % kLanes == 0;
+    uint32_t cx, cy, cz;
+    MortonDecode(keys[i], &cx, &cy, &cz);
+    const CellPair pair = PairOf(grid, static_cast<int>(cx), static_cast<int>(cy), static_cast<int>(cz));
+    return (static_cast<uint32_t>(i) - pair.first) % kLanes == 0;
   }
 };
 
@@ -212,9 +223,7 @@ struct DensityBlockStage {
       return d * d;
     };
     const CubicSpline k = stage.ph.kernel;
-    const Lanes16 h2 = Splat16(k.H2), invH = Splat16(k.invH), one = Splat16(1.0f), half = Splat16(0.5f);
-    const Lanes16 zero = Splat16(0.0f), six = Splat16(6.0f), sigma = Splat16(k.sigma), sigma2 = Splat16(k.sigma * 2.0f);
-    Lanes16 sum = zero;
+    Lanes16 sum = Splat16(0.0f);
     const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
     const float reach2 = cs * cs;  // a cell this far from every lane holds no neighbour (cell size >= support)
     const int z0 = cz > 0 ? cz - 1 : 0, z1 = cz < g.nz - 1 ? cz + 1 : cz;
@@ -235,16 +244,10 @@ struct DensityBlockStage {
             const Vec4 pj = position[j];
             const Lanes16 dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
             const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
-            const LaneInts16 within = r2 < h2;
+            const LaneInts16 within = r2 < k.H2;
             uint32_t hits = Bits16(within);
             if (hits == 0) continue;
-            // The cubic spline (kernel.h) in every lane, both pieces, then the lane's piece.
-            const Lanes16 q = Sqrt16(r2) * invH;
-            const Lanes16 inner = sigma * (six * (q * q * q - q * q) + one);
-            const Lanes16 t = one - q;
-            const Lanes16 outer = sigma2 * t * t * t;
-            const Lanes16 w = q <= half ? inner : outer;
-            sum += (within & (q < one)) ? w : zero;
+            sum += KernelW16(k, Sqrt16(r2) * k.invH, within);
             while (hits != 0) {  // the neighbour lists: every hit but the particle itself
               const int l = __builtin_ctz(hits);
               hits &= hits - 1u;
@@ -306,10 +309,7 @@ struct ForceListStage {
       // CubicSpline::GradFactor in every lane (r > 0 where it is used).
       const Lanes16 grad = (pair & (q < 1.0f)) ? (q <= 0.5f ? k.gradA * (3.0f * q - 2.0f) : -k.gradB * t * t / r) : zero;
       if (P.shepard) {  // CubicSpline::W / rho_j
-        const Lanes16 w = (pair & (q < 1.0f)) ? (q <= 0.5f ? k.sigma * (6.0f * (q * q * q - q * q) + 1.0f)
-                                                           : k.sigma * 2.0f * t * t * t)
-                                              : zero;
-        const Lanes16 wj = w / rhoj;
+        const Lanes16 wj = KernelW16(k, q, pair) / rhoj;
         pSum += Gather16(f.pressure, index) * wj;
         wSum += wj;
       }

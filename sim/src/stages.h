@@ -359,9 +359,9 @@ struct OverList {
 };
 
 // ---- stage 4: density and pressure ---------------------------------------------------------------
-/// One work item per particle (both backends). The CPU backend runs the same pieces, Candidate and
-/// Finish, from DensityBlockStage (cpu_stages.h), which tests one candidate against a cell's
-/// particles at once; the two give bit-identical results (tests/sim/cpu_stages_test.cpp).
+/// One work item per particle (the CUDA backend). The CPU backend runs Finish (and the same sums, in
+/// SIMD) from DensityBlockStage (cpu_stages.h), which tests one candidate against up to 16 particles
+/// at once: the same neighbour lists, densities equal to rounding (tests/sim/cpu_stages_test.cpp).
 struct DensityStage {
   GridView grid;
   FluidView fluid;
@@ -373,26 +373,22 @@ struct DensityStage {
     uint32_t found = 0;
     uint32_t* slots = Slots(i);
     const uint32_t self = static_cast<uint32_t>(i);
+    const CubicSpline k = ph.kernel;
+    const uint32_t capacity = static_cast<uint32_t>(list.maxNeighbours);
     ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, [&](uint32_t j, Vec3 d) {
-      Candidate(self, j, d, &sumFluid, &found, slots);
+      const float r2 = Dot(d, d);
+      if (r2 < k.H2) {
+        sumFluid += k.W(sqrtf(r2));
+        if (j != self) {  // the neighbour list, counted past the capacity (the force stage then scans)
+          if (found < capacity) slots[found] = j;
+          ++found;
+        }
+      }
     });
     Finish(i, xi, sumFluid, found);
   }
   SPHXR_HD SPHXR_INLINE uint32_t* Slots(int i) const {
     return list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
-  }
-  /// Fluid particle j at d = x_self - x_j: within the support it adds W to the sum and, unless it is
-  /// self, takes the next neighbour-list slot (counted past the capacity: the force stage then scans).
-  SPHXR_HD SPHXR_INLINE void Candidate(uint32_t self, uint32_t j, Vec3 d, float* sumFluid, uint32_t* found,
-                                       uint32_t* slots) const {
-    const float r2 = Dot(d, d);
-    if (r2 < ph.kernel.H2) {
-      *sumFluid += ph.kernel.W(sqrtf(r2));
-      if (j != self) {
-        if (*found < static_cast<uint32_t>(list.maxNeighbours)) slots[*found] = j;
-        ++*found;
-      }
-    }
   }
   /// The walls' and bodies' sums, then density, pressure and p/rho^2 of particle i.
   SPHXR_HD SPHXR_INLINE void Finish(int i, Vec3 xi, float sumFluid, uint32_t found) const {

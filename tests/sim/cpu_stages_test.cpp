@@ -21,14 +21,17 @@ namespace {
 constexpr float kSpacing = 0.01f;
 constexpr float kSupport = 2.0f * kSpacing;
 
+/// The Morton key of p's cell, as CellCodeStage computes it.
+uint32_t CellKey(const GridView& g, Vec3 p) {
+  int cx, cy, cz;
+  g.CellOf(p, &cx, &cy, &cz);
+  return MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz));
+}
+
 /// The points in Morton order of their cells, stably (as the backend sorts particles).
 std::vector<Vec3> SortedByCell(const GridView& g, const std::vector<Vec3>& points) {
   std::vector<std::pair<uint32_t, Vec3>> keyed;
-  for (const Vec3& p : points) {
-    int cx, cy, cz;
-    g.CellOf(p, &cx, &cy, &cz);
-    keyed.push_back({MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz)), p});
-  }
+  for (const Vec3& p : points) keyed.push_back({CellKey(g, p), p});
   std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Vec3> out;
   for (const auto& k : keyed) out.push_back(k.second);
@@ -156,7 +159,10 @@ struct Setup {
 
   void RunBlocked(bool reuse, int idleSteps) {
     const int n = static_cast<int>(position.size());
-    const DensityBlockStart isStart{Grid(), position.data()};
+    std::vector<uint32_t> keys;  // the sorted Morton keys, as the backend's sort leaves them
+    const GridView g = Grid();
+    for (const Vec4& p : position) keys.push_back(CellKey(g, Xyz(p)));
+    const DensityBlockStart isStart{g, keys.data()};
     std::vector<uint32_t> blocks;
     for (int i = 0; i < n; ++i) {
       if (isStart(i)) blocks.push_back(static_cast<uint32_t>(i));
