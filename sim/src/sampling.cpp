@@ -87,17 +87,23 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
       continue;
     }
     // Hydrostatic start: the layer at depth d below the block's top sits where a column compressed to
-    // the Tait density rho(s) = rho0 (1 + rho0 g s / B)^(1/gamma) puts it: y = top - int_0^d rho0/rho ds
-    // (closed form). Only the vertical component of gravity compresses.
+    // the Tait density rho(s) = rho0 (1 + rho0 g s / B)^(1/gamma) puts it: depth
+    // D(d) = int_0^d rho0/rho ds (closed form) below the compressed top. Only the vertical component of
+    // gravity compresses. The column stands on the block's floor: the lowest layer stays half a spacing
+    // above it (where the uncompressed lattice has it, one spacing from the floor's boundary particles)
+    // and the surface comes down. Anchoring the top instead left a gap of the whole column's compression
+    // under the water (3.4 mm in deep_tank), which the column fell into and rang in its acoustic mode.
     const float top = block.box.min.y + static_cast<float>(ny) * dx;
     const double a = scene.params.restDensity * std::max(0.0, -static_cast<double>(scene.gravity.y)) /
                      scene.params.stiffness;
     const double e = 1.0 - 1.0 / scene.params.exponent;
+    auto compressedDepth = [&](double d) { return (std::pow(1.0 + a * d, e) - 1.0) / (a * e); };
+    const double bottom = block.box.min.y + 0.5 * dx;
+    const double bottomDepth = compressedDepth(top - bottom);
     auto layerY = [&](int64_t j) -> float {
       const float y = block.box.min.y + (static_cast<float>(j) + 0.5f) * dx;
       if (!block.hydrostatic || a <= 0.0) return y;
-      const double d = top - y;
-      return static_cast<float>(top - (std::pow(1.0 + a * d, e) - 1.0) / (a * e));
+      return static_cast<float>(bottom + bottomDepth - compressedDepth(top - y));
     };
     for (int64_t k = 0; k < nz; ++k) {
       for (int64_t j = 0; j < ny; ++j) {
