@@ -46,7 +46,8 @@ struct FluidBlock {
   Aabb box;
   Vec3 velocity;  // initial velocity, m/s
   /// Start in hydrostatic equilibrium: each layer is compressed to the Tait density of its depth below
-  /// the block's top, so a pool starts at rest instead of ringing from a zero-pressure lattice.
+  /// the block's top, the lowest layer staying where the plain lattice has it (the surface comes down),
+  /// so a pool starts at rest instead of ringing from a zero-pressure lattice.
   bool hydrostatic = false;
 };
 
