@@ -1,13 +1,16 @@
 #pragma once
-// Small helpers shared by the benchmarks: the machine, the process's memory, timestamps, CSV files.
+// Small helpers shared by the benchmarks: the machine, the process's memory, timestamps, CSV files,
+// command-line numbers.
 // Benchmarks report; they never assert a target.
 #include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <sstream>
@@ -15,6 +18,15 @@
 #include <vector>
 
 namespace sphxr::bench {
+
+/// A command-line number: the whole text one finite number (nothing after it).
+inline bool ParseNumber(const char* text, double* out) {
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
 
 /// "model name" of the first processor in /proc/cpuinfo ("unknown" when absent).
 inline std::string CpuModel() {

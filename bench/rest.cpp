@@ -16,6 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bench_util.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/sim/solver.h"
 
@@ -38,9 +39,8 @@ void Usage() {
 }
 
 bool ParsePositive(const char* text, double* out) {
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) return false;
+  double v = 0.0;
+  if (!sphxr::bench::ParseNumber(text, &v) || !(v > 0.0)) return false;
   *out = v;
   return true;
 }

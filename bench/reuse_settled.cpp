@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/sim/solver.h"
 
@@ -47,13 +48,6 @@ const char* kUsage =
     "  --report K            print a line every K steps (default 100)\n"
     "  --probe               print four interior particles' accelerations for 16 steps after settling, then stop\n";
 
-// A whole finite number, nothing after it.
-bool ParseNumber(const char* text, double* out) {
-  char* end = nullptr;
-  *out = std::strtod(text, &end);
-  return end != text && *end == '\0' && std::isfinite(*out);
-}
-
 bool Fail(const sphxr::Status& s) {
   if (s) return false;
   std::fprintf(stderr, "sphxr_bench_reuse_settled: %s\n", s.message().c_str());
@@ -70,7 +64,7 @@ int main(int argc, char** argv) {
   double threads = 0, report = 100;
   for (int a = 1; a < argc; ++a) {
     auto value = [&](double* out, bool positive) {
-      if (a + 1 >= argc || !ParseNumber(argv[a + 1], out) || (positive ? *out <= 0 : *out < 0)) {
+      if (a + 1 >= argc || !sphxr::bench::ParseNumber(argv[a + 1], out) || (positive ? *out <= 0 : *out < 0)) {
         std::fprintf(stderr, "sphxr_bench_reuse_settled: %s wants a %s number\n%s", argv[a],
                      positive ? "positive" : "non-negative", kUsage);
         std::exit(2);
@@ -143,26 +137,29 @@ int main(int argc, char** argv) {
     }
   }
 
+  if (probe) {  // reuse off from the settled state, four interior particles' accelerations
+    std::unique_ptr<Solver> solver;
+    if (Fail(Solver::Create(scene, config, &solver)) || Fail(solver->Upload(state))) return 1;
+    const uint32_t ids[4] = {10007, 20000, 30123, 40500};
+    for (int step = 0; step < 16; ++step) {
+      if (Fail(solver->Step())) return 1;
+      HostFluid h;
+      solver->Download(&h);
+      std::printf("step %2d:", step);
+      for (size_t i = 0; i < h.size(); ++i) {
+        for (uint32_t id : ids) {
+          if (h.id[i] == id) std::printf("  #%u a = (%.2f %.2f %.2f)", id, h.acceleration[i].x, h.acceleration[i].y, h.acceleration[i].z);
+        }
+      }
+      std::printf("  m/s^2\n");
+    }
+    return 0;
+  }
+
   double meanMs[2] = {0, 0};
   for (int mode = 0; mode < 2; ++mode) {
     std::unique_ptr<Solver> solver;
     if (Fail(Solver::Create(scene, config, &solver)) || Fail(solver->Upload(state))) return 1;
-    if (probe) {
-      const uint32_t ids[4] = {10007, 20000, 30123, 40500};
-      for (int step = 0; step < 16; ++step) {
-        if (Fail(solver->Step())) return 1;
-        HostFluid h;
-        solver->Download(&h);
-        std::printf("step %2d:", step);
-        for (size_t i = 0; i < h.size(); ++i) {
-          for (uint32_t id : ids) {
-            if (h.id[i] == id) std::printf("  #%u a = (%.2f %.2f %.2f)", id, h.acceleration[i].x, h.acceleration[i].y, h.acceleration[i].z);
-          }
-        }
-        std::printf("  m/s^2\n");
-      }
-      return 0;
-    }
     const char* name = mode ? preset.c_str() : "off";
     if (mode == 1 && Fail(solver->SetReuse(reuse))) return 1;
     const double t0 = solver->Time();

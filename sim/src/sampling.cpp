@@ -97,12 +97,13 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
     const double a = scene.params.restDensity * std::max(0.0, -static_cast<double>(scene.gravity.y)) /
                      scene.params.stiffness;
     const double e = 1.0 - 1.0 / scene.params.exponent;
+    const bool compress = block.hydrostatic && a > 0.0;
     auto compressedDepth = [&](double d) { return (std::pow(1.0 + a * d, e) - 1.0) / (a * e); };
     const double bottom = block.box.min.y + 0.5 * dx;
-    const double bottomDepth = compressedDepth(top - bottom);
+    const double bottomDepth = compress ? compressedDepth(top - bottom) : 0.0;
     auto layerY = [&](int64_t j) -> float {
       const float y = block.box.min.y + (static_cast<float>(j) + 0.5f) * dx;
-      if (!block.hydrostatic || a <= 0.0) return y;
+      if (!compress) return y;
       return static_cast<float>(bottom + bottomDepth - compressedDepth(top - y));
     };
     for (int64_t k = 0; k < nz; ++k) {
