@@ -1,0 +1,57 @@
+#!/usr/bin/env python3
+"""Why holding a particle's acceleration (activity-based reuse) is unstable: docs/reuse.md.
+
+One sound mode x'' = -w^2 x, integrated by the solver's symplectic Euler (v += a dt; x += v dt), with
+the acceleration computed once and held for k = IDLE + 1 steps. Prints, per w dt and k, the k-step
+map's determinant and its largest eigenvalue (per cycle and per step), and the steps a perturbation
+needs to grow ten-thousand-fold; and for the alternative hold (the k steps' impulse at once, then
+coasting: symplectic Euler at step k dt, stable only for k w dt < 2) its largest eigenvalue. Each map is checked against stepping the oscillator directly.
+
+    python3 bench/hold_stability.py
+"""
+import math
+
+import numpy as np
+
+
+def hold_map(wdt, k):
+    """The k-step map of (x, u = v dt) when a = -w^2 x0 is held for k steps."""
+    w2 = wdt * wdt
+    m = np.array([[1.0 - w2 * k * (k + 1) / 2.0, float(k)], [-k * w2, 1.0]])
+    for x0, u0 in ((1.0, 0.0), (0.0, 1.0)):  # check each column against stepping
+        x, u = x0, u0
+        a = -w2 * x0
+        for _ in range(k):
+            u += a
+            x += u
+        assert abs(x - (m[0, 0] * x0 + m[0, 1] * u0)) < 1e-12 and abs(u - (m[1, 0] * x0 + m[1, 1] * u0)) < 1e-12
+    return m
+
+
+def impulse_map(wdt, k):
+    """The alternative: the k steps' impulse k dt a applied at once, then k steps of coasting."""
+    w2 = wdt * wdt
+    m = np.array([[1.0 - k * k * w2, float(k)], [-k * w2, 1.0]])
+    for x0, u0 in ((1.0, 0.0), (0.0, 1.0)):
+        x, u = x0, u0 + k * (-w2 * x0)
+        for _ in range(k):
+            x += u
+        assert abs(x - (m[0, 0] * x0 + m[0, 1] * u0)) < 1e-12 and abs(u - (m[1, 0] * x0 + m[1, 1] * u0)) < 1e-12
+    return m
+
+
+def main():
+    print("| w dt | k = IDLE + 1 | determinant | max abs eigenvalue per cycle | per step | steps to grow x10^4 | impulse hold: max abs eigenvalue |")
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for wdt in (1.0, 0.5, 1.0 / 3.0, 0.1):
+        for k in (1, 2, 4):
+            m = hold_map(wdt, k)
+            ev = max(abs(np.linalg.eigvals(m)))
+            per_step = ev ** (1.0 / k)
+            grow = f"{math.log(1e4) / math.log(per_step):.0f}" if per_step > 1.0 + 1e-12 else "never"
+            imp = max(abs(np.linalg.eigvals(impulse_map(wdt, k))))
+            print(f"| {wdt:.3g} | {k} | {np.linalg.det(m):.4g} | {ev:.4g} | {per_step:.4g} | {grow} | {imp:.4g} |")
+
+
+if __name__ == "__main__":
+    main()
