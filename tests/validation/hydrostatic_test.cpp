@@ -62,9 +62,11 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
 
   // Drift over the observation window. The issue asks for at most 0.1 spacing.
   // - wall_density (tank_rest's own setting): the water comes to rest (bench/rest.cpp: median drift per
-  //   0.5 s window 0.13, 0.18, 0.06, 0.02, 0.01, 0.008 spacings) but a few particles in disordered spots
-  //   of the floor layer keep rattling (maximum 0.3-0.5 spacing per window, not decaying). The median is
-  //   held to the issue's 0.1; the maximum is loosened to 1 spacing.
+  //   0.5 s window 0.13, 0.18, 0.06, 0.05, 0.02, 0.01, 0.008, 0.006, 0.004 spacings) but a few particles
+  //   keep rattling: in disordered spots near the floor left by the first second's rearrangement, and at
+  //   the free surface. Their maximum per window falls to 0.11-0.22 spacing from 3.5 s on and then
+  //   levels off (measured to 8.5 s; docs/physics.md). So the window starts at 4 s; the median is held
+  //   to the issue's 0.1, the maximum loosened to 0.3 spacing (the issue's 0.1 is not met).
   // - mirrored (the default elsewhere): the wall pressure p_b = p_i is not the derivative of any energy
   //   and keeps a ~1 cm/s circulation going (median 0.34, maximum 1.8 spacings over 0.5 s). Loosened to
   //   what is met, so that a regression to real flow still fails.
@@ -118,7 +120,7 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
 
 INSTANTIATE_TEST_SUITE_P(
     Walls, Hydrostatic,
-    ::testing::Values(WallCase{"wall_density", sim::SceneSetup::WallPressure::kWallDensity, 1.5, 1.0f, 0.1f, 0.05f},
+    ::testing::Values(WallCase{"wall_density", sim::SceneSetup::WallPressure::kWallDensity, 4.0, 0.3f, 0.1f, 0.05f},
                       WallCase{"mirrored", sim::SceneSetup::WallPressure::kMirrored, 1.0, 3.0f, 1.0f, 0.08f}),
     [](const ::testing::TestParamInfo<WallCase>& info) { return std::string(info.param.name); });
 
