@@ -14,30 +14,37 @@ import math
 import numpy as np
 
 
+def checked(m, cycle):
+    """m, after checking each column against `cycle` (one reuse cycle stepped directly from (x0, u0))."""
+    for x0, u0 in ((1.0, 0.0), (0.0, 1.0)):
+        x, u = cycle(x0, u0)
+        assert abs(x - (m[0, 0] * x0 + m[0, 1] * u0)) < 1e-12 and abs(u - (m[1, 0] * x0 + m[1, 1] * u0)) < 1e-12
+    return m
+
+
 def hold_map(wdt, k):
     """The k-step map of (x, u = v dt) when a = -w^2 x0 is held for k steps."""
     w2 = wdt * wdt
-    m = np.array([[1.0 - w2 * k * (k + 1) / 2.0, float(k)], [-k * w2, 1.0]])
-    for x0, u0 in ((1.0, 0.0), (0.0, 1.0)):  # check each column against stepping
-        x, u = x0, u0
-        a = -w2 * x0
+
+    def cycle(x, u):
+        a = -w2 * x
         for _ in range(k):
             u += a
             x += u
-        assert abs(x - (m[0, 0] * x0 + m[0, 1] * u0)) < 1e-12 and abs(u - (m[1, 0] * x0 + m[1, 1] * u0)) < 1e-12
-    return m
+        return x, u
+
+    return checked(np.array([[1.0 - w2 * k * (k + 1) / 2.0, float(k)], [-k * w2, 1.0]]), cycle)
 
 
 def impulse_map(wdt, k):
     """The alternative: the k steps' impulse k dt a applied at once, then k steps of coasting."""
     w2 = wdt * wdt
-    m = np.array([[1.0 - k * k * w2, float(k)], [-k * w2, 1.0]])
-    for x0, u0 in ((1.0, 0.0), (0.0, 1.0)):
-        x, u = x0, u0 + k * (-w2 * x0)
-        for _ in range(k):
-            x += u
-        assert abs(x - (m[0, 0] * x0 + m[0, 1] * u0)) < 1e-12 and abs(u - (m[1, 0] * x0 + m[1, 1] * u0)) < 1e-12
-    return m
+
+    def cycle(x, u):
+        u += k * (-w2 * x)
+        return x + k * u, u
+
+    return checked(np.array([[1.0 - k * k * w2, float(k)], [-k * w2, 1.0]]), cycle)
 
 
 def main():
