@@ -96,9 +96,8 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       out->scene = v;
     } else if (a == "--spacing") {
       if (!next(&v)) return false;
-      char* end = nullptr;
-      const double h = std::strtod(v, &end);
-      if (!*v || *end || !(h > 0.0 && h < 1.0)) {
+      double h = 0.0;
+      if (!ParseNumber(v, &h) || !(h > 0.0 && h < 1.0)) {
         std::fprintf(stderr, "--spacing %s: must be a number between 0 and 1 (m)\n", v);
         return false;
       }
