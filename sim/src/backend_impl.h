@@ -230,6 +230,8 @@ class BackendImpl final : public Backend {
     thrust::copy(m_boundary.begin(), m_boundary.end(), out->position.begin());
     out->viscosity.resize(m_boundaryAlpha.size());
     thrust::copy(m_boundaryAlpha.begin(), m_boundaryAlpha.end(), out->viscosity.begin());
+    out->invReference.resize(m_boundaryInvReference.size());  // empty unless the walls have their own density
+    thrust::copy(m_boundaryInvReference.begin(), m_boundaryInvReference.end(), out->invReference.begin());
   }
 
   void Upload(const HostFluid& fluid) override {
