@@ -28,13 +28,18 @@ using sphxr::sim::Vec4;
 void Usage() {
   std::fprintf(stderr,
                "usage: sphxr_bench_rest [--scene FILE] [--windows N] [--window S] [--threads N] [--wall-pressure W] [--detail]\n"
+               "                        [--energy] [--damp FROM UNTIL RATE]\n"
                "  --scene FILE  scene (default %s/tank_rest.json)\n"
                "  --windows N   number of windows (default 6)\n"
                "  --window S    simulated seconds per window (default 0.5)\n"
                "  --threads N   CPU backend threads (default 0 = all cores)\n"
                "  --wall-pressure W  mirrored | wall_density: override the scene's tank.wall_pressure\n"
                "  --detail      the 12 largest drifts of the last window; per layer the mean height and the\n"
-               "                pressure and density of the particles 2.5 spacings or more from the side walls\n",
+               "                pressure and density of the particles 2.5 spacings or more from the side walls\n"
+               "  --energy      after each window the total energy (kinetic, gravity, fluid and wall internal;\n"
+               "                brute force over all pairs, for small scenes)\n"
+               "  --damp FROM UNTIL RATE  multiply every velocity by exp(-RATE dt) after each step between FROM and\n"
+               "                UNTIL seconds (a quench: does the motion come back once it is off?)\n",
                SPHXR_SCENES_DIR);
 }
 
@@ -45,12 +50,79 @@ bool ParsePositive(const char* text, double* out) {
   return true;
 }
 
+// The energy the solver's conservative forces derive from (docs/physics.md, "Why still water rattles"):
+// kinetic + gravity + the Tait internal energy sum_i m e(rho_i) of the fluid (e' = p / rho^2, zero below
+// rho0 where p is clamped) + the walls' own sum_b M_b e(rho_b) under tank.wall_pressure = "wall_density"
+// (M_b = m Psi_b R_b / rho0 makes the walls' forces its derivative; stages.h, WallPressureStage).
+// Densities are recomputed here in double precision, brute force over all pairs: O(N^2), meant for
+// tank_rest's 4,000 particles (a second per call), not for large scenes. With the viscosities at 0 it
+// stays constant up to the integrator's error; with them it can only fall.
+double Energy(const sphxr::sim::Solver& solver, const HostFluid& f, double* parts) {
+  const auto& sc = solver.Scene();
+  const double dx = sc.params.spacing, H = dx * sc.params.supportFactor, rho0 = sc.params.restDensity;
+  const double B = sc.params.stiffness, m = solver.ParticleMass(), g = -sc.gravity.y;
+  const double sigma = 8.0 / (M_PI * H * H * H);
+  auto W = [&](double r) {  // the cubic spline of kernel.h, in double
+    const double q = r / H;
+    if (q >= 1) return 0.0;
+    if (q <= 0.5) return sigma * (6 * (q * q * q - q * q) + 1);
+    const double t = 1 - q;
+    return sigma * 2 * t * t * t;
+  };
+  auto e = [&](double rho) {
+    if (rho <= rho0) return 0.0;
+    auto F = [&](double r) { return B * (std::pow(r, 6) / (6 * std::pow(rho0, 7)) + 1 / r); };
+    return F(rho) - F(rho0);
+  };
+  sphxr::sim::HostBoundary b;
+  solver.DownloadBoundary(&b);
+  double ke = 0, pe = 0, ef = 0, ew = 0;
+  const size_t n = f.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Vec4 v = f.velocity[i], x = f.position[i];
+    ke += 0.5 * m * (double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+    pe += m * g * x.y;
+    double rho = 0;
+    for (size_t j = 0; j < n; ++j) {
+      const Vec4 y = f.position[j];
+      const double dxx = double(x.x) - y.x, dy = double(x.y) - y.y, dz = double(x.z) - y.z;
+      const double r2 = dxx * dxx + dy * dy + dz * dz;
+      if (r2 < H * H) rho += m * W(std::sqrt(r2));
+    }
+    for (size_t k = 0; k < b.size(); ++k) {
+      const Vec4 y = b.position[k];
+      const double dxx = double(x.x) - y.x, dy = double(x.y) - y.y, dz = double(x.z) - y.z;
+      const double r2 = dxx * dxx + dy * dy + dz * dz;
+      if (r2 < H * H) rho += y.w * W(std::sqrt(r2));
+    }
+    ef += m * e(rho);
+  }
+  for (size_t k = 0; k < b.size(); ++k) {
+    if (b.invReference.empty() || b.invReference[k] == 0.0f) continue;
+    const Vec4 y = b.position[k];
+    double sum = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const Vec4 x = f.position[i];
+      const double dxx = double(x.x) - y.x, dy = double(x.y) - y.y, dz = double(x.z) - y.z;
+      const double r2 = dxx * dxx + dy * dy + dz * dz;
+      if (r2 < H * H) sum += W(std::sqrt(r2));
+    }
+    const double rho = rho0 * sum * b.invReference[k];
+    const double M = m * y.w / (rho0 * b.invReference[k]);
+    ew += M * e(rho);
+  }
+  parts[0] = ke; parts[1] = pe; parts[2] = ef; parts[3] = ew;
+  return ke + pe + ef + ew;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string scenePath = std::string(SPHXR_SCENES_DIR) + "/tank_rest.json";
   double windows = 6, window = 0.5, threads = 0;
-  bool detail = false;
+  double dampFrom = -1.0, dampUntil = -1.0, dampRate = 0.0;  // --damp: no damping unless asked
+  bool detail = false, energy = false;
+  double energyStart = 0.0;
   std::string wallPressure;
   for (int a = 1; a < argc; ++a) {
     const bool hasValue = a + 1 < argc;
@@ -60,6 +132,13 @@ int main(int argc, char** argv) {
       if (!ParsePositive(argv[++a], &windows)) return std::fprintf(stderr, "sphxr_bench_rest: --windows wants a positive number\n"), 2;
     } else if (!std::strcmp(argv[a], "--window") && hasValue) {
       if (!ParsePositive(argv[++a], &window)) return std::fprintf(stderr, "sphxr_bench_rest: --window wants positive seconds\n"), 2;
+    } else if (!std::strcmp(argv[a], "--damp") && a + 3 < argc) {
+      if (!sphxr::bench::ParseNumber(argv[a + 1], &dampFrom) || !sphxr::bench::ParseNumber(argv[a + 2], &dampUntil) ||
+          !(dampFrom >= 0.0) || !(dampUntil > dampFrom) || !ParsePositive(argv[a + 3], &dampRate))
+        return std::fprintf(stderr, "sphxr_bench_rest: --damp wants FROM UNTIL RATE: 0 <= FROM < UNTIL seconds, RATE > 0 per second\n"), 2;
+      a += 3;
+    } else if (!std::strcmp(argv[a], "--energy")) {
+      energy = true;
     } else if (!std::strcmp(argv[a], "--detail")) {
       detail = true;
     } else if (!std::strcmp(argv[a], "--wall-pressure") && hasValue) {
@@ -102,6 +181,17 @@ int main(int argc, char** argv) {
         return 1;
       }
       clamped += solver->LastStep().clamped;
+      if (solver->Time() > dampFrom && solver->Time() <= dampUntil) {
+        // The quench experiment (docs/physics.md): every velocity times exp(-rate dt) after each step.
+        HostFluid f;
+        solver->Download(&f);
+        const float k = std::exp(-static_cast<float>(dampRate) * solver->LastStep().dt);
+        for (Vec4& v : f.velocity) { v.x *= k; v.y *= k; v.z *= k; }
+        if (sphxr::Status s = solver->Upload(f); !s) {
+          std::fprintf(stderr, "sphxr_bench_rest: %s\n", s.message().c_str());
+          return 1;
+        }
+      }
     }
     HostFluid current;
     solver->Download(&current);
@@ -133,6 +223,13 @@ int main(int argc, char** argv) {
                 drift[drift.size() / 2], drift[drift.size() * 9 / 10], drift.back(),
                 1e3 * speedSum / static_cast<double>(current.size()), 1e3 * speedMax, static_cast<long long>(clamped));
     std::fflush(stdout);
+    if (energy) {
+      double parts[4];
+      const double E = Energy(*solver, current, parts);
+      if (w == 1) energyStart = E;
+      std::printf("  energy %.9e J (change since the first window %+.4e J): kinetic %.4e, gravity %.9e, fluid %.6e, walls %.6e\n",
+                  E, E - energyStart, parts[0], parts[1], parts[2], parts[3]);
+    }
     previous = std::move(current);
   }
   // Layer pressures at the end, each particle against rho0 g times its own depth.
