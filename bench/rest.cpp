@@ -18,6 +18,7 @@
 
 #include "bench_util.h"
 #include "sphxr/app/scene_file.h"
+#include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
 
 namespace {
@@ -36,8 +37,8 @@ void Usage() {
                "  --wall-pressure W  mirrored | wall_density: override the scene's tank.wall_pressure\n"
                "  --detail      the 12 largest drifts of the last window; per layer the mean height and the\n"
                "                pressure and density of the particles 2.5 spacings or more from the side walls\n"
-               "  --energy      after each window the total energy (kinetic, gravity, fluid and wall internal;\n"
-               "                brute force over all pairs, for small scenes)\n"
+               "  --energy      after each window the total energy (sim/measure.h SphEnergy: kinetic, gravity,\n"
+               "                the fluid's and the walls' internal energy)\n"
                "  --damp FROM UNTIL RATE  multiply every velocity by exp(-RATE dt) after each step between FROM and\n"
                "                UNTIL seconds (a quench: does the motion come back once it is off?)\n",
                SPHXR_SCENES_DIR);
@@ -48,71 +49,6 @@ bool ParsePositive(const char* text, double* out) {
   if (!sphxr::bench::ParseNumber(text, &v) || !(v > 0.0)) return false;
   *out = v;
   return true;
-}
-
-// The energy the solver's conservative forces derive from (docs/physics.md, "Why still water rattles"):
-// kinetic + gravity + the Tait internal energy sum_i m e(rho_i) of the fluid (e' = p / rho^2, zero below
-// rho0 where p is clamped) + the walls' own sum_b M_b e(rho_b) under tank.wall_pressure = "wall_density"
-// (M_b = m Psi_b R_b / rho0 makes the walls' forces its derivative; stages.h, WallPressureStage).
-// Densities are recomputed here in double precision, brute force over all pairs: O(N^2), meant for
-// tank_rest's 4,000 particles (a second per call), not for large scenes. With the viscosities at 0 it
-// stays constant up to the integrator's error; with them it can only fall.
-double Energy(const sphxr::sim::Solver& solver, const HostFluid& f, double* parts) {
-  const auto& sc = solver.Scene();
-  const double dx = sc.params.spacing, H = dx * sc.params.supportFactor, rho0 = sc.params.restDensity;
-  const double B = sc.params.stiffness, m = solver.ParticleMass(), g = -sc.gravity.y;
-  const double sigma = 8.0 / (M_PI * H * H * H);
-  auto W = [&](double r) {  // the cubic spline of kernel.h, in double
-    const double q = r / H;
-    if (q >= 1) return 0.0;
-    if (q <= 0.5) return sigma * (6 * (q * q * q - q * q) + 1);
-    const double t = 1 - q;
-    return sigma * 2 * t * t * t;
-  };
-  auto e = [&](double rho) {
-    if (rho <= rho0) return 0.0;
-    auto F = [&](double r) { return B * (std::pow(r, 6) / (6 * std::pow(rho0, 7)) + 1 / r); };
-    return F(rho) - F(rho0);
-  };
-  sphxr::sim::HostBoundary b;
-  solver.DownloadBoundary(&b);
-  double ke = 0, pe = 0, ef = 0, ew = 0;
-  const size_t n = f.size();
-  for (size_t i = 0; i < n; ++i) {
-    const Vec4 v = f.velocity[i], x = f.position[i];
-    ke += 0.5 * m * (double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
-    pe += m * g * x.y;
-    double rho = 0;
-    for (size_t j = 0; j < n; ++j) {
-      const Vec4 y = f.position[j];
-      const double dxx = double(x.x) - y.x, dy = double(x.y) - y.y, dz = double(x.z) - y.z;
-      const double r2 = dxx * dxx + dy * dy + dz * dz;
-      if (r2 < H * H) rho += m * W(std::sqrt(r2));
-    }
-    for (size_t k = 0; k < b.size(); ++k) {
-      const Vec4 y = b.position[k];
-      const double dxx = double(x.x) - y.x, dy = double(x.y) - y.y, dz = double(x.z) - y.z;
-      const double r2 = dxx * dxx + dy * dy + dz * dz;
-      if (r2 < H * H) rho += y.w * W(std::sqrt(r2));
-    }
-    ef += m * e(rho);
-  }
-  for (size_t k = 0; k < b.size(); ++k) {
-    if (b.invReference.empty() || b.invReference[k] == 0.0f) continue;
-    const Vec4 y = b.position[k];
-    double sum = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const Vec4 x = f.position[i];
-      const double dxx = double(x.x) - y.x, dy = double(x.y) - y.y, dz = double(x.z) - y.z;
-      const double r2 = dxx * dxx + dy * dy + dz * dz;
-      if (r2 < H * H) sum += W(std::sqrt(r2));
-    }
-    const double rho = rho0 * sum * b.invReference[k];
-    const double M = m * y.w / (rho0 * b.invReference[k]);
-    ew += M * e(rho);
-  }
-  parts[0] = ke; parts[1] = pe; parts[2] = ef; parts[3] = ew;
-  return ke + pe + ef + ew;
 }
 
 }  // namespace
@@ -224,11 +160,12 @@ int main(int argc, char** argv) {
                 1e3 * speedSum / static_cast<double>(current.size()), 1e3 * speedMax, static_cast<long long>(clamped));
     std::fflush(stdout);
     if (energy) {
-      double parts[4];
-      const double E = Energy(*solver, current, parts);
-      if (w == 1) energyStart = E;
+      sphxr::sim::HostBoundary walls;
+      solver->DownloadBoundary(&walls);
+      const sphxr::sim::EnergySummary e = sphxr::sim::SphEnergy(solver->Scene(), solver->ParticleMass(), current, walls);
+      if (w == 1) energyStart = e.Total();
       std::printf("  energy %.9e J (change since the first window %+.4e J): kinetic %.4e, gravity %.9e, fluid %.6e, walls %.6e\n",
-                  E, E - energyStart, parts[0], parts[1], parts[2], parts[3]);
+                  e.Total(), e.Total() - energyStart, e.kinetic, e.gravity, e.fluid, e.walls);
     }
     previous = std::move(current);
   }

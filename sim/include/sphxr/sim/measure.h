@@ -1,6 +1,7 @@
 #pragma once
 // Measurements on a host copy of the fluid, shared by the headless runner, tests and benchmarks.
 #include "sphxr/sim/fields.h"
+#include "sphxr/sim/params.h"
 
 namespace sphxr::sim {
 
@@ -28,5 +29,22 @@ struct MomentumSummary {
   double sumAbs = 0;              // sum of |v| (scale for relative errors)
 };
 MomentumSummary Momentum(const HostFluid& fluid);
+
+/// The energy the solver's conservative forces derive from, in joules (docs/physics.md, "Why still water
+/// rattles"): kinetic, gravity (zero at y = 0), the fluid's Tait internal energy sum_i m e(rho_i) with
+/// e' = p / rho^2 (e = 0 at and below rho0, where p is clamped to 0), and, for walls with their own density
+/// (boundary.invReference not empty), the walls' sum_b M_b e(rho_b) with rho_b = rho0 invReference_b
+/// sum_f W_bf and M_b = m Psi_b / (rho0 invReference_b): the force of that energy on a fluid particle is
+/// the wall half of WallPressureStage's pair term. Densities are recomputed here in double precision with
+/// the cubic spline of support `spacing * supportFactor` (an implementation of its own, not kernel.h), on a
+/// uniform grid. With all artificial viscosities 0 the total stays constant up to the integrator's error;
+/// with them it can only fall. Mirrored walls have no energy of their own, so for them the total is not
+/// conserved.
+struct EnergySummary {
+  double kinetic = 0, gravity = 0, fluid = 0, walls = 0;
+  double Total() const { return kinetic + gravity + fluid + walls; }
+};
+EnergySummary SphEnergy(const SceneSetup& scene, float particleMass, const HostFluid& fluid,
+                        const HostBoundary& boundary);
 
 }  // namespace sphxr::sim
