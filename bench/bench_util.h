@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -24,6 +25,16 @@ inline bool ParseNumber(const char* text, double* out) {
   char* end = nullptr;
   const double v = std::strtod(text, &end);
   if (end == text || *end != '\0' || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+/// A command-line integer: the whole text one base-10 integer (nothing after it, no overflow) in [lo, hi].
+inline bool ParseInteger(const char* text, long lo, long hi, long* out) {
+  char* end = nullptr;
+  errno = 0;  // overflow shows only here: strtol clamps the value to LONG_MIN / LONG_MAX
+  const long v = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi) return false;
   *out = v;
   return true;
 }

@@ -8,8 +8,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,15 +25,34 @@ namespace {
 using sphxr::bench::Median;
 using sphxr::bench::Ms;
 
+const char* kUsage = "usage: sphxr_bench_frame [--steps N] [--frames M] [--threads T]\n";
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace sphxr;
-  int steps = 30, frames = 10, threads = 0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--frames")) frames = std::atoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--threads")) threads = std::atoi(argv[i + 1]);
+  int steps = 30, frames = 10, threads = 0;  // threads 0: all cores
+  // All options are checked here, before the GL context: a typo fails at once, also without a display.
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::printf("%s", kUsage);
+      return 0;
+    }
+    int* value = a == "--steps" ? &steps : a == "--frames" ? &frames : a == "--threads" ? &threads : nullptr;
+    if (!value || i + 1 >= argc) {
+      std::fprintf(stderr, "sphxr_bench_frame: %s '%s'\n%s", value ? "missing value after" : "unknown argument",
+                   a.c_str(), kUsage);
+      return 2;
+    }
+    const long lo = value == &threads ? 0 : 1, hi = value == &threads ? 1024 : 1000000;
+    const char* v = argv[++i];
+    long n = 0;
+    if (!bench::ParseInteger(v, lo, hi, &n)) {
+      std::fprintf(stderr, "sphxr_bench_frame: %s %s: must be an integer from %ld to %ld\n", a.c_str(), v, lo, hi);
+      return 2;
+    }
+    *value = static_cast<int>(n);
   }
   const int width = 1280, height = 720;
   std::unique_ptr<render::HeadlessContext> context;

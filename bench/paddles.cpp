@@ -124,23 +124,36 @@ int Main(int argc, char** argv) {
       }
       return argv[++i];
     };
+    // A bad number ends the program with one line naming it, before any scene is loaded.
+    auto integer = [&](long lo, long hi, int* out) {
+      const char* v = next();
+      long n = 0;
+      if (!ParseInteger(v, lo, hi, &n)) {
+        std::fprintf(stderr, "sphxr_bench_paddles: %s %s: must be an integer from %ld to %ld\n", a.c_str(), v, lo, hi);
+        std::exit(2);
+      }
+      *out = static_cast<int>(n);
+    };
     if (a == "--scene") args.scene = next();
-    else if (a == "--rounds") args.rounds = std::atoi(next());
-    else if (a == "--warmup") args.warmup = std::atoi(next());
-    else if (a == "--measured") args.measured = std::atoi(next());
-    else if (a == "--threads") args.threads = std::atoi(next());
-    else if (a == "--spacing") args.spacing = static_cast<float>(std::atof(next()));
-    else if (a == "--quick") args.rounds = 1, args.warmup = 20, args.measured = 40;
+    else if (a == "--rounds") integer(1, 1000000, &args.rounds);
+    else if (a == "--warmup") integer(0, 1000000, &args.warmup);
+    else if (a == "--measured") integer(1, 1000000, &args.measured);
+    else if (a == "--threads") integer(0, 1024, &args.threads);  // 0: all cores
+    else if (a == "--spacing") {
+      const char* v = next();
+      double h = 0.0;
+      if (!ParseNumber(v, &h) || !(h > 0.0 && h < 1.0)) {
+        std::fprintf(stderr, "sphxr_bench_paddles: --spacing %s: must be a number between 0 and 1 (m)\n", v);
+        std::exit(2);
+      }
+      args.spacing = static_cast<float>(h);
+    } else if (a == "--quick") args.rounds = 1, args.warmup = 20, args.measured = 40;
     else {
       std::fprintf(stderr,
                    "usage: sphxr_bench_paddles [--scene FILE] [--rounds R] [--warmup N] [--measured N] [--threads T]\n"
                    "                           [--spacing H] [--quick]\n");
       return a == "--help" ? 0 : 2;
     }
-  }
-  if (args.rounds < 1 || args.warmup < 0 || args.measured < 1 || args.threads < 0) {
-    std::fprintf(stderr, "rounds and measured must be at least 1, warmup and threads 0 or more\n");
-    return 2;
   }
   SetLogLevel(LogLevel::kWarn);
   const double loadStart = LoadAverage();

@@ -81,10 +81,9 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       out->quick = true;
     } else if (a == "--threads") {
       if (!next(&v)) return false;
-      char* end = nullptr;
-      const long t = std::strtol(v, &end, 10);
-      if (!*v || *end || t < 0 || t > 1024) {
-        std::fprintf(stderr, "--threads %s: must be an integer from 0 to 1024\n", v);
+      long t = 0;
+      if (!ParseInteger(v, 0, 1024, &t)) {
+        std::fprintf(stderr, "sphxr_bench_perf: --threads %s: must be an integer from 0 to 1024\n", v);
         return false;
       }
       out->threads = static_cast<int>(t);
@@ -98,16 +97,16 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       if (!next(&v)) return false;
       double h = 0.0;
       if (!ParseNumber(v, &h) || !(h > 0.0 && h < 1.0)) {
-        std::fprintf(stderr, "--spacing %s: must be a number between 0 and 1 (m)\n", v);
+        std::fprintf(stderr, "sphxr_bench_perf: --spacing %s: must be a number between 0 and 1 (m)\n", v);
         return false;
       }
       out->spacings.push_back(static_cast<float>(h));
     } else if (a == "--warmup" || a == "--measured") {
       if (!next(&v)) return false;
-      char* end = nullptr;
-      const long n = std::strtol(v, &end, 10);
-      if (!*v || *end || n < (a == "--warmup" ? 0 : 1) || n > 1000000) {
-        std::fprintf(stderr, "%s %s: must be an integer from %d to 1000000\n", a.c_str(), v, a == "--warmup" ? 0 : 1);
+      const long lo = a == "--warmup" ? 0 : 1;
+      long n = 0;
+      if (!ParseInteger(v, lo, 1000000, &n)) {
+        std::fprintf(stderr, "sphxr_bench_perf: %s %s: must be an integer from %ld to 1000000\n", a.c_str(), v, lo);
         return false;
       }
       (a == "--warmup" ? out->warmup : out->measured) = static_cast<int>(n);

@@ -78,6 +78,14 @@ const char* kUsage =
     "  --unpaired      no lock-step reference: half the time, but the speed-up is then against reference runs\n"
     "                  made minutes apart (noise on a shared machine)\n";
 
+/// Prints the usage to stderr; false, for ParseArgs to return.
+bool Usage() {
+  std::fputs(kUsage, stderr);
+  return false;
+}
+
+/// False on bad usage, after printing why: the usage for an unknown option or a missing value, one line
+/// for a bad number (the usage would not say which).
 bool ParseArgs(int argc, char** argv, Args* out) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -90,15 +98,22 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     if (a == "--quick") {
       out->quick = true;
     } else if (a == "--threads" && next(&v)) {
-      out->threads = std::atoi(v.c_str());
+      long t = 0;
+      if (!ParseInteger(v.c_str(), 0, 1024, &t)) {
+        std::fprintf(stderr, "sphxr_bench_reuse: --threads %s: must be an integer from 0 to 1024\n", v.c_str());
+        return false;
+      }
+      out->threads = static_cast<int>(t);
     } else if (a == "--csv" && next(&v)) {
       out->csv = v;
     } else if (a == "--scene" && next(&v)) {
-      if (v != "deep_tank" && v != "dam_break_1m") return false;
+      if (v != "deep_tank" && v != "dam_break_1m") return Usage();
       out->only = v;
     } else if (a == "--time" && next(&v)) {
-      out->time = std::atof(v.c_str());
-      if (!(out->time > 0.0)) return false;
+      if (!ParseNumber(v.c_str(), &out->time) || !(out->time > 0.0)) {
+        std::fprintf(stderr, "sphxr_bench_reuse: --time %s: must be a finite number above 0 (s)\n", v.c_str());
+        return false;
+      }
     } else if (a == "--presets") {
       out->presetsOnly = true;
     } else if (a == "--unpaired") {
@@ -106,7 +121,7 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     } else if (a == "--help" || a == "-h") {
       out->help = true;
     } else {
-      return false;
+      return Usage();
     }
   }
   return true;
@@ -351,9 +366,10 @@ int main(int argc, char** argv) {
   using namespace sphxr;
   using namespace sphxr::bench;
   Args args;
-  if (!ParseArgs(argc, argv, &args) || args.help) {
-    std::fputs(kUsage, args.help ? stdout : stderr);
-    return args.help ? 0 : 2;
+  if (!ParseArgs(argc, argv, &args)) return 2;
+  if (args.help) {
+    std::fputs(kUsage, stdout);
+    return 0;
   }
   SetLogLevel(LogLevel::kWarn);
   if (args.threads > 0) omp_set_num_threads(args.threads);

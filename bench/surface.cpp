@@ -68,15 +68,39 @@ int Run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool hasValue = i + 1 < argc;
-    if (a == "--threads" && hasValue) threads = std::atoi(argv[++i]);
-    else if (a == "--time" && hasValue) time = std::atof(argv[++i]);
-    else if (a == "--repeat" && hasValue) repeat = std::atoi(argv[++i]);
-    else if (a == "--run" && hasValue) run = std::atoi(argv[++i]);
-    else if (a == "--compare-runs" && hasValue) {
-      for (std::stringstream list(argv[++i]); list.good();) {
+    // A bad number gets one line naming it (the usage would not say which), checked before the scene loads.
+    bool ok = true;
+    auto integer = [&](long lo, long hi, int* out) {
+      const char* v = argv[++i];
+      long n = 0;
+      if (!ParseInteger(v, lo, hi, &n)) {
+        std::fprintf(stderr, "sphxr_bench_surface: %s %s: must be an integer from %ld to %ld\n", a.c_str(), v, lo, hi);
+        return false;
+      }
+      *out = static_cast<int>(n);
+      return true;
+    };
+    if (a == "--threads" && hasValue) ok = integer(1, 1024, &threads);
+    else if (a == "--repeat" && hasValue) ok = integer(1, 1000000, &repeat);
+    else if (a == "--run" && hasValue) ok = integer(0, 1000000, &run);  // 0: the backend's run length
+    else if (a == "--time" && hasValue) {
+      const char* v = argv[++i];
+      if (!ParseNumber(v, &time) || time < 0.0) {
+        std::fprintf(stderr, "sphxr_bench_surface: --time %s: must be a finite number, 0 or more (s)\n", v);
+        ok = false;
+      }
+    } else if (a == "--compare-runs" && hasValue) {
+      const char* v = argv[++i];
+      for (std::stringstream list(v); ok && list.good();) {
         std::string k;
         std::getline(list, k, ',');
-        compareRuns.push_back(std::atoi(k.c_str()));
+        long n = 0;
+        ok = ParseInteger(k.c_str(), 1, 1000000, &n);  // an empty entry ("1,,2", "1,") fails too
+        if (ok) compareRuns.push_back(static_cast<int>(n));
+      }
+      if (!ok) {
+        std::fprintf(stderr, "sphxr_bench_surface: --compare-runs %s: must be integers from 1 to 1000000, comma-separated\n",
+                     v);
       }
     } else if (a == "--csv" && hasValue) csv = argv[++i];
     else if (a == "--scene" && hasValue) scenePath = argv[++i];
@@ -84,12 +108,7 @@ int Run(int argc, char** argv) {
       std::fprintf(stderr, "%s", kUsage);
       return a == "--help" ? 0 : 2;
     }
-  }
-  const bool runsValid = std::all_of(compareRuns.begin(), compareRuns.end(), [](int k) { return k >= 1; });
-  if (threads < 1 || repeat < 1 || !(time >= 0.0) || run < 0 || !runsValid) {
-    std::fprintf(stderr, "--threads, --repeat and --compare-runs must be at least 1, --time and --run not negative\n%s",
-                 kUsage);
-    return 2;
+    if (!ok) return 2;
   }
   app::SceneFile scene;
   if (Status s = app::LoadScene(scenePath, &scene); !s) {

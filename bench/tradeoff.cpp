@@ -73,10 +73,9 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       out->quick = true;
     } else if (a == "--threads") {
       if (!next(&v)) return false;
-      char* end = nullptr;
-      const long t = std::strtol(v, &end, 10);
-      if (!*v || *end || t < 0 || t > 1024) {
-        std::fprintf(stderr, "--threads %s: must be an integer from 0 to 1024\n", v);
+      long t = 0;
+      if (!ParseInteger(v, 0, 1024, &t)) {
+        std::fprintf(stderr, "sphxr_bench_tradeoff: --threads %s: must be an integer from 0 to 1024\n", v);
         return false;
       }
       out->threads = static_cast<int>(t);

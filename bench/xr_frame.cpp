@@ -92,11 +92,18 @@ bool RunOnce(const char* label, bool validation, int frames) {
 
 int main(int argc, char** argv) {
   int frames = 300;
+  // Checked before glfwInit: a bad option fails at once, also without a display.
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--frames") == 0 && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else {
+    if (std::strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
+      long n = 0;
+      if (!bench::ParseInteger(argv[++i], 1, 1000000, &n)) {
+        std::fprintf(stderr, "sphxr_bench_xr_frame: --frames %s: must be an integer from 1 to 1000000\n", argv[i]);
+        return 2;
+      }
+      frames = static_cast<int>(n);
+    } else {
       std::fprintf(stderr, "usage: sphxr_bench_xr_frame [--frames N]\n");
-      return 2;
+      return std::strcmp(argv[i], "--help") == 0 ? 0 : 2;
     }
   }
   if (!std::getenv("XR_RUNTIME_JSON")) setenv("XR_RUNTIME_JSON", SPHXR_SIM_RUNTIME_JSON, 1);
