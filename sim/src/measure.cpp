@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <unordered_map>
 #include <vector>
+
+#include "sphxr/sim/host_grid.h"
 
 namespace sphxr::sim {
 
@@ -42,48 +42,15 @@ MomentumSummary Momentum(const HostFluid& fluid) {
   return m;
 }
 
-namespace {
-
-// Points binned on a grid of cells one support radius wide: the neighbours of x within the support lie in
-// the 27 cells around it.
-class PointGrid {
- public:
-  PointGrid(const std::vector<Vec4>& points, double cell) : m_points(points), m_cell(cell) {
-    for (size_t i = 0; i < points.size(); ++i) m_cells[Key(points[i].x, points[i].y, points[i].z, 0, 0, 0)].push_back(i);
-  }
-  template <class F>
-  void ForNear(double x, double y, double z, F&& f) const {
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const auto it = m_cells.find(Key(x, y, z, dx, dy, dz));
-          if (it == m_cells.end()) continue;
-          for (size_t j : it->second) {
-            const Vec4 q = m_points[j];
-            f(j, x - q.x, y - q.y, z - q.z);
-          }
-        }
-  }
-
- private:
-  uint64_t Key(double x, double y, double z, int dx, int dy, int dz) const {
-    auto c = [&](double v, int d) { return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v / m_cell)) + d + (1 << 20)) & 0x1fffff; };
-    return c(x, dx) | (c(y, dy) << 21) | (c(z, dz) << 42);
-  }
-  const std::vector<Vec4>& m_points;
-  double m_cell;
-  std::unordered_map<uint64_t, std::vector<size_t>> m_cells;
-};
-
-}  // namespace
-
 EnergySummary SphEnergy(const SceneSetup& scene, float particleMass, const HostFluid& fluid,
                         const HostBoundary& boundary) {
   const SolverParams& p = scene.params;
   const double H = static_cast<double>(p.spacing) * p.supportFactor, rho0 = p.restDensity, B = p.stiffness;
   const double gamma = p.exponent, m = particleMass;
   const double sigma = 8.0 / (3.14159265358979323846 * H * H * H);
-  auto W = [&](double r2) {  // the cubic spline (Monaghan 1992) with support H
+  auto W = [&](const Vec4& a, const Vec4& b) {  // the cubic spline (Monaghan 1992), support H, in double
+    const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
+    const double r2 = dx * dx + dy * dy + dz * dz;
     if (r2 >= H * H) return 0.0;
     const double q = std::sqrt(r2) / H;
     if (q <= 0.5) return sigma * (6.0 * (q * q * q - q * q) + 1.0);
@@ -91,19 +58,20 @@ EnergySummary SphEnergy(const SceneSetup& scene, float particleMass, const HostF
     return sigma * 2.0 * t * t * t;
   };
   // e(rho) = int_rho0^rho B ((s/rho0)^gamma - 1) / s^2 ds for rho > rho0.
-  auto F = [&](double r) { return B * (std::pow(r / rho0, gamma) * r / ((gamma - 1.0) * r * r) + 1.0 / r); };
+  auto F = [&](double r) { return B * (std::pow(r / rho0, gamma) / ((gamma - 1.0) * r) + 1.0 / r); };
   auto e = [&](double rho) { return rho > rho0 ? F(rho) - F(rho0) : 0.0; };
   EnergySummary out;
-  const PointGrid fluidGrid(fluid.position, H), wallGrid(boundary.position, H);
+  Vec3 lo, hi;
+  BoundingBox({&fluid.position, &boundary.position}, &lo, &hi);
+  const HostGrid fluidGrid(fluid.position, lo, hi, static_cast<float>(H) * 1.0001f);  // cells >= H despite rounding
+  const HostGrid wallGrid(boundary.position, lo, hi, static_cast<float>(H) * 1.0001f);
   for (size_t i = 0; i < fluid.size(); ++i) {
     const Vec4 x = fluid.position[i], v = fluid.velocity[i];
     out.kinetic += 0.5 * m * (double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
     out.gravity -= m * (double(scene.gravity.x) * x.x + double(scene.gravity.y) * x.y + double(scene.gravity.z) * x.z);
     double rho = 0.0;
-    fluidGrid.ForNear(x.x, x.y, x.z, [&](size_t, double dx, double dy, double dz) { rho += m * W(dx * dx + dy * dy + dz * dz); });
-    wallGrid.ForNear(x.x, x.y, x.z, [&](size_t b, double dx, double dy, double dz) {
-      rho += boundary.position[b].w * W(dx * dx + dy * dy + dz * dz);
-    });
+    fluidGrid.ForEachNear(Xyz(x), [&](uint32_t j) { rho += m * W(x, fluid.position[j]); });
+    wallGrid.ForEachNear(Xyz(x), [&](uint32_t b) { rho += boundary.position[b].w * W(x, boundary.position[b]); });
     out.fluid += m * e(rho);
   }
   if (!boundary.invReference.empty()) {
@@ -112,7 +80,7 @@ EnergySummary SphEnergy(const SceneSetup& scene, float particleMass, const HostF
       if (!(inv > 0.0)) continue;
       const Vec4 y = boundary.position[b];
       double sum = 0.0;
-      fluidGrid.ForNear(y.x, y.y, y.z, [&](size_t, double dx, double dy, double dz) { sum += W(dx * dx + dy * dy + dz * dz); });
+      fluidGrid.ForEachNear(Xyz(y), [&](uint32_t j) { sum += W(y, fluid.position[j]); });
       out.walls += m * y.w / (rho0 * inv) * e(rho0 * sum * inv);
     }
   }
