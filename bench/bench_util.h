@@ -39,6 +39,19 @@ inline bool ParseInteger(const char* text, long lo, long hi, long* out) {
   return true;
 }
 
+/// ParseInteger for a command-line option's value: on a bad value prints the one line
+/// "<program>: <option> <text>: must be an integer from <lo> to <hi>" to stderr and returns false.
+inline bool IntegerOption(const char* program, const std::string& option, const char* text, long lo, long hi,
+                          int* out) {
+  long n = 0;
+  if (!ParseInteger(text, lo, hi, &n)) {
+    std::fprintf(stderr, "%s: %s %s: must be an integer from %ld to %ld\n", program, option.c_str(), text, lo, hi);
+    return false;
+  }
+  *out = static_cast<int>(n);
+  return true;
+}
+
 /// "model name" of the first processor in /proc/cpuinfo ("unknown" when absent).
 inline std::string CpuModel() {
   std::ifstream in("/proc/cpuinfo");

@@ -46,13 +46,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     const long lo = value == &threads ? 0 : 1, hi = value == &threads ? 1024 : 1000000;
-    const char* v = argv[++i];
-    long n = 0;
-    if (!bench::ParseInteger(v, lo, hi, &n)) {
-      std::fprintf(stderr, "sphxr_bench_frame: %s %s: must be an integer from %ld to %ld\n", a.c_str(), v, lo, hi);
-      return 2;
-    }
-    *value = static_cast<int>(n);
+    if (!bench::IntegerOption("sphxr_bench_frame", a, argv[++i], lo, hi, value)) return 2;
   }
   const int width = 1280, height = 720;
   std::unique_ptr<render::HeadlessContext> context;

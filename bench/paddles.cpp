@@ -126,13 +126,7 @@ int Main(int argc, char** argv) {
     };
     // A bad number ends the program with one line naming it, before any scene is loaded.
     auto integer = [&](long lo, long hi, int* out) {
-      const char* v = next();
-      long n = 0;
-      if (!ParseInteger(v, lo, hi, &n)) {
-        std::fprintf(stderr, "sphxr_bench_paddles: %s %s: must be an integer from %ld to %ld\n", a.c_str(), v, lo, hi);
-        std::exit(2);
-      }
-      *out = static_cast<int>(n);
+      if (!IntegerOption("sphxr_bench_paddles", a, next(), lo, hi, out)) std::exit(2);
     };
     if (a == "--scene") args.scene = next();
     else if (a == "--rounds") integer(1, 1000000, &args.rounds);

@@ -82,12 +82,7 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       out->quick = true;
     } else if (a == "--threads") {
       if (!next(&v)) return false;
-      long t = 0;
-      if (!ParseInteger(v, 0, 1024, &t)) {
-        std::fprintf(stderr, "sphxr_bench_perf: --threads %s: must be an integer from 0 to 1024\n", v);
-        return false;
-      }
-      out->threads = static_cast<int>(t);
+      if (!IntegerOption("sphxr_bench_perf", a, v, 0, 1024, &out->threads)) return false;
     } else if (a == "--csv") {
       if (!next(&v)) return false;
       out->csv = v;
@@ -104,13 +99,9 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       out->spacings.push_back(static_cast<float>(h));
     } else if (a == "--warmup" || a == "--measured") {
       if (!next(&v)) return false;
-      const long lo = a == "--warmup" ? 0 : 1;
-      long n = 0;
-      if (!ParseInteger(v, lo, 1000000, &n)) {
-        std::fprintf(stderr, "sphxr_bench_perf: %s %s: must be an integer from %ld to 1000000\n", a.c_str(), v, lo);
+      const bool warmup = a == "--warmup";
+      if (!IntegerOption("sphxr_bench_perf", a, v, warmup ? 0 : 1, 1000000, warmup ? &out->warmup : &out->measured))
         return false;
-      }
-      (a == "--warmup" ? out->warmup : out->measured) = static_cast<int>(n);
     } else if (a == "--help" || a == "-h") {
       out->help = true;
     } else {

@@ -98,12 +98,7 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     if (a == "--quick") {
       out->quick = true;
     } else if (a == "--threads" && next(&v)) {
-      long t = 0;
-      if (!ParseInteger(v.c_str(), 0, 1024, &t)) {
-        std::fprintf(stderr, "sphxr_bench_reuse: --threads %s: must be an integer from 0 to 1024\n", v.c_str());
-        return false;
-      }
-      out->threads = static_cast<int>(t);
+      if (!IntegerOption("sphxr_bench_reuse", a, v.c_str(), 0, 1024, &out->threads)) return false;
     } else if (a == "--csv" && next(&v)) {
       out->csv = v;
     } else if (a == "--scene" && next(&v)) {

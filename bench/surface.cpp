@@ -70,16 +70,7 @@ int Run(int argc, char** argv) {
     const bool hasValue = i + 1 < argc;
     // A bad number gets one line naming it (the usage would not say which), checked before the scene loads.
     bool ok = true;
-    auto integer = [&](long lo, long hi, int* out) {
-      const char* v = argv[++i];
-      long n = 0;
-      if (!ParseInteger(v, lo, hi, &n)) {
-        std::fprintf(stderr, "sphxr_bench_surface: %s %s: must be an integer from %ld to %ld\n", a.c_str(), v, lo, hi);
-        return false;
-      }
-      *out = static_cast<int>(n);
-      return true;
-    };
+    auto integer = [&](long lo, long hi, int* out) { return IntegerOption("sphxr_bench_surface", a, argv[++i], lo, hi, out); };
     if (a == "--threads" && hasValue) ok = integer(1, 1024, &threads);
     else if (a == "--repeat" && hasValue) ok = integer(1, 1000000, &repeat);
     else if (a == "--run" && hasValue) ok = integer(0, 1000000, &run);  // 0: the backend's run length

@@ -73,12 +73,7 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       out->quick = true;
     } else if (a == "--threads") {
       if (!next(&v)) return false;
-      long t = 0;
-      if (!ParseInteger(v, 0, 1024, &t)) {
-        std::fprintf(stderr, "sphxr_bench_tradeoff: --threads %s: must be an integer from 0 to 1024\n", v);
-        return false;
-      }
-      out->threads = static_cast<int>(t);
+      if (!IntegerOption("sphxr_bench_tradeoff", a, v, 0, 1024, &out->threads)) return false;
     } else if (a == "--csv") {
       if (!next(&v)) return false;
       out->csv = v;

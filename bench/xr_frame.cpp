@@ -95,12 +95,7 @@ int main(int argc, char** argv) {
   // Checked before glfwInit: a bad option fails at once, also without a display.
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
-      long n = 0;
-      if (!bench::ParseInteger(argv[++i], 1, 1000000, &n)) {
-        std::fprintf(stderr, "sphxr_bench_xr_frame: --frames %s: must be an integer from 1 to 1000000\n", argv[i]);
-        return 2;
-      }
-      frames = static_cast<int>(n);
+      if (!bench::IntegerOption("sphxr_bench_xr_frame", "--frames", argv[++i], 1, 1000000, &frames)) return 2;
     } else {
       std::fprintf(stderr, "usage: sphxr_bench_xr_frame [--frames N]\n");
       return std::strcmp(argv[i], "--help") == 0 ? 0 : 2;
