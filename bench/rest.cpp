@@ -107,8 +107,10 @@ int main(int argc, char** argv) {
               static_cast<long long>(solver->FluidCount()), dx, static_cast<int>(windows), window);
   std::printf("| window (s) | drift median | q90 | max (spacings) | mean speed (mm/s) | max speed (mm/s) | clamped |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|\n");
-  HostFluid previous;
+  HostFluid previous, damped;
   solver->Download(&previous);
+  sphxr::sim::HostBoundary walls;  // static walls: fetched once, for --energy
+  if (energy) solver->DownloadBoundary(&walls);
   for (int w = 1; w <= static_cast<int>(windows); ++w) {
     int64_t clamped = 0;
     while (solver->Time() < window * w - 1e-9) {
@@ -119,7 +121,7 @@ int main(int argc, char** argv) {
       clamped += solver->LastStep().clamped;
       if (solver->Time() > dampFrom && solver->Time() <= dampUntil) {
         // The quench experiment (docs/physics.md): every velocity times exp(-rate dt) after each step.
-        HostFluid f;
+        HostFluid& f = damped;  // reused: no allocation per step
         solver->Download(&f);
         const float k = std::exp(-static_cast<float>(dampRate) * solver->LastStep().dt);
         for (Vec4& v : f.velocity) { v.x *= k; v.y *= k; v.z *= k; }
@@ -160,8 +162,6 @@ int main(int argc, char** argv) {
                 1e3 * speedSum / static_cast<double>(current.size()), 1e3 * speedMax, static_cast<long long>(clamped));
     std::fflush(stdout);
     if (energy) {
-      sphxr::sim::HostBoundary walls;
-      solver->DownloadBoundary(&walls);
       const sphxr::sim::EnergySummary e = sphxr::sim::SphEnergy(solver->Scene(), solver->ParticleMass(), current, walls);
       if (w == 1) energyStart = e.Total();
       std::printf("  energy %.9e J (change since the first window %+.4e J): kinetic %.4e, gravity %.9e, fluid %.6e, walls %.6e\n",
