@@ -1,5 +1,6 @@
 #include "sphxr/sim/solver.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,9 +12,13 @@
 #include "morton.h"
 #include "sampling.h"
 #include "sphxr/common/log.h"
+#include "sphxr/sim/host_grid.h"
 
 namespace sphxr::sim {
 namespace {
+
+// Gravity above this (about 100 g) only makes the force step condition shrink dt towards nothing.
+constexpr double kMaxGravity = 1000.0;
 
 bool Finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 std::string Str(Vec3 v) { return Format("[%g, %g, %g]", v.x, v.y, v.z); }
@@ -35,8 +40,15 @@ bool Contains(const Aabb& outer, const Aabb& inner, float slack) {
 int64_t AvailableHostBytes() {
   const long pages = sysconf(_SC_PHYS_PAGES);
   const long pageSize = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || pageSize <= 0) return std::numeric_limits<int64_t>::max();
-  return static_cast<int64_t>(pages) * pageSize * 3 / 4;  // leave a quarter to the OS and the renderer
+  int64_t have = std::numeric_limits<int64_t>::max();
+  if (pages > 0 && pageSize > 0) have = static_cast<int64_t>(pages) * pageSize * 3 / 4;  // a quarter to the OS and renderer
+  // A process limit (ulimit -v) is a harder ceiling; half of it, as the program and its libraries
+  // (OpenGL, OpenMP stacks) map a lot of address space of their own.
+  struct rlimit limit;
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    have = std::min<int64_t>(have, static_cast<int64_t>(limit.rlim_cur / 2));
+  }
+  return have;
 }
 
 Status ValidateReuse(const ReuseParams& r) {
@@ -77,6 +89,15 @@ Status ValidateBodies(const SceneSetup& scene) {
       return Status::Error(Format("%s: viscosity = %g is invalid: must be from 0 to 10 (negative: the walls')", key.c_str(), b.viscosity));
     }
     if (!Finite(b.pose.position) || !Finite(b.pose.orientation)) return Status::Error(key + ": non-finite pose");
+    // A body larger than the whole tank cannot stir it, and its sampling would dwarf the water's.
+    const Vec3 extent = scene.tank.max - scene.tank.min;
+    const float tankSize = Length(extent);
+    float reach = 0.0f;
+    for (const Vec3& x : b.points) reach = std::max(reach, Length(x));
+    if (reach > tankSize) {
+      return Status::Error(Format("%s: its shapes reach %g m from its origin, more than the tank's %g m diagonal",
+                                  key.c_str(), reach, tankSize));
+    }
   }
   return Status::Ok();
 }
@@ -84,7 +105,8 @@ Status ValidateBodies(const SceneSetup& scene) {
 Status ValidateScene(const SceneSetup& scene) {
   for (const ParamInfo& p : SolverParamInfos()) {
     const float v = scene.params.*p.member;
-    if (!std::isfinite(v) || v < p.min || v > p.max) {
+    // Compared as floats: the value is stored as one, so the limit typed exactly (cfl 0.01) must pass.
+    if (!std::isfinite(v) || v < static_cast<float>(p.min) || v > static_cast<float>(p.max)) {
       return Status::Error(Format("solver.%s = %g is invalid: must be a number from %g to %g%s%s (%s)", p.key, v, p.min,
                                   p.max, p.unit[0] ? " " : "", p.unit, p.help));
     }
@@ -94,6 +116,14 @@ Status ValidateScene(const SceneSetup& scene) {
   }
   if (Status s = ValidateReuse(scene.reuse); !s) return s;
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
+  {
+    const double gx = scene.gravity.x, gy = scene.gravity.y, gz = scene.gravity.z;
+    const double g = std::sqrt(gx * gx + gy * gy + gz * gz);  // in double: a float Length overflows at 2e19
+    if (g > kMaxGravity) {
+      return Status::Error(Format("gravity = %s has magnitude %g m/s^2: at most %g (%.0f g) is supported",
+                                  Str(scene.gravity).c_str(), g, kMaxGravity, kMaxGravity / 9.81));
+    }
+  }
   if (scene.boundaryLayers < 1 || scene.boundaryLayers > 4) {
     return Status::Error(Format("tank.boundary_layers = %d is invalid: must be 1 to 4", scene.boundaryLayers));
   }
@@ -367,6 +397,13 @@ Status Solver::Step() {
     }
   }
 
+  // A step that cannot advance the clock would loop forever (the force condition under an exploding
+  // acceleration): say so instead.
+  if (!(dt > 0.0f) || !std::isfinite(dt) || m_last.time + dt == m_last.time) {
+    return Status::Error(Format("the time step collapsed to %g s at t = %.6g s (largest acceleration %g m/s^2): the "
+                                "simulation has become unstable",
+                                dt, m_last.time, m_maxAccel));
+  }
   const int64_t stepNumber = m_totals.steps + 1;
   StageHook hook;
   HostFluid host;
@@ -491,13 +528,18 @@ void Solver::InitBodies(const Physics& physics) {
     const std::vector<Vec3>& pts = setup.points;
     const float a = setup.viscosity >= 0.0f ? setup.viscosity : m_scene.params.boundaryViscosity;
     float radius = 0.0f;
+    std::vector<Vec4> cloud(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) cloud[i] = MakeVec4(pts[i]);
+    Vec3 lo, hi;
+    BoundingBox({&cloud}, &lo, &hi);
+    const HostGrid near(cloud, lo, hi, physics.kernel.H);  // O(n) sums; the points are bounded by the tank
     for (size_t i = 0; i < pts.size(); ++i) {
       float sum = 0.0f;
-      for (const Vec3& q : pts) {
-        const Vec3 d = pts[i] - q;
+      near.ForEachNear(pts[i], [&](uint32_t j) {
+        const Vec3 d = pts[i] - pts[j];
         const float r2 = Dot(d, d);
         if (r2 < physics.kernel.H2) sum += physics.kernel.W(std::sqrt(r2));
-      }
+      });
       local.push_back(MakeVec4(pts[i], psiScale / sum));
       bodyOf.push_back(static_cast<uint32_t>(k));
       alpha.push_back(a);

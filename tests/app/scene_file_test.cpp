@@ -266,6 +266,35 @@ TEST(SceneFileTest, OutOfRangeSolverValuesRefused) {
   }
 }
 
+TEST(SceneFileTest, SolverAcceptsTheRangeEndsItPrints) {
+  // The solver stores parameters as floats; a value typed exactly at a printed limit (cfl 0.01,
+  // support_factor 1.8) must not be refused with "must be a number from 0.01 ...". A range end may
+  // still be refused for another, named reason (a too-fine grid, no room for the walls' mass).
+  for (const sim::ParamInfo& p : sim::SolverParamInfos()) {
+    for (double v : {p.min, p.max}) {
+      // The smallest spacing in a 2 mm tank: 20 spacings across (a 0.2 m tank would be 24M wall particles).
+      const double size = std::string(p.key) == "spacing" && v == p.min ? 0.002 : 0.2;
+      const SceneFile scene = ParseOk(Format(R"({ "solver": { "%s": %.17g }, "tank": { "min": [0,0,0], "max": [%g,%g,%g] } })",
+                                             p.key, v, size, size, size));
+      std::unique_ptr<sim::Solver> solver;
+      const Status s = sim::Solver::Create(scene.setup, test::TestConfig(), &solver);
+      EXPECT_EQ(s.message().find("is invalid: must be a number from"), std::string::npos)
+          << p.key << " = " << v << ": " << s.message();
+    }
+  }
+}
+
+TEST(SceneFileTest, GravityBeyondAHundredGRefused) {
+  // 1e30 m/s^2 used to overflow the float length to inf, make dt 0 and hang the run.
+  ExpectSolverRefuses(R"({ "tank": { "min": [0,0,0], "max": [0.2,0.2,0.1] }, "gravity": [0, -1e30, 0] })",
+                      {"gravity", "at most 1000"});
+  ExpectSolverRefuses(R"({ "tank": { "min": [0,0,0], "max": [0.2,0.2,0.1] }, "gravity": [800, -800, 0] })",
+                      {"gravity", "at most 1000"});
+  const SceneFile ok = ParseOk(R"({ "tank": { "min": [0,0,0], "max": [0.2,0.2,0.1] }, "gravity": [0, -98.1, 0] })");
+  std::unique_ptr<sim::Solver> solver;
+  EXPECT_TRUE(sim::Solver::Create(ok.setup, test::TestConfig(), &solver).ok());
+}
+
 TEST(SceneFileTest, FluidBlockOutsideTheTankRefusedBySolver) {
   ExpectSolverRefuses(R"({ "tank": { "min": [0,0,0], "max": [0.2,0.2,0.1] },
                            "fluid": [ { "min": [0.1,0,0], "max": [0.3,0.1,0.1] } ] })",

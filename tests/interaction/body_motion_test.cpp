@@ -84,6 +84,15 @@ TEST(BodyMotion, BadBodiesAreRefused) {
   s = Solver::Create(scene, test::TestConfig(), &solver);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("radius"), std::string::npos) << s.message();
+  // A body that reaches further than the tank's diagonal (0.41 m here) is refused by name; a capsule of
+  // radius 10 m used to sample 3M points and hang in the O(n^2) volume sums.
+  scene.bodies[0].shapes = interaction::BladeOnHandle();
+  scene.bodies[0].points = {Vec3{0, 0, 0}, Vec3{0.5f, 0, 0}};
+  s = Solver::Create(scene, test::TestConfig(), &solver);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("more than the tank"), std::string::npos) << s.message();
+  scene.bodies[0].points = {Vec3{0, 0, 0}, Vec3{0.3f, 0, 0}};
+  EXPECT_TRUE(Solver::Create(scene, test::TestConfig(), &solver).ok());
 }
 
 }  // namespace
