@@ -83,7 +83,11 @@ int main(int argc, char** argv) {
         return std::fprintf(stderr, "sphxr_bench_rest: --wall-pressure wants mirrored or wall_density\n"), 2;
     } else if (!std::strcmp(argv[a], "--threads") && hasValue) {
       if (!ParsePositive(argv[++a], &threads)) return std::fprintf(stderr, "sphxr_bench_rest: --threads wants a positive count\n"), 2;
+    } else if (!std::strcmp(argv[a], "--help") || !std::strcmp(argv[a], "-h")) {
+      Usage();
+      return 0;
     } else {
+      std::fprintf(stderr, "sphxr_bench_rest: %s: unknown option, or its values are missing\n", argv[a]);
       Usage();
       return 2;
     }

@@ -102,7 +102,10 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     } else if (a == "--csv" && next(&v)) {
       out->csv = v;
     } else if (a == "--scene" && next(&v)) {
-      if (v != "deep_tank" && v != "dam_break_1m") return Usage();
+      if (v != "deep_tank" && v != "dam_break_1m") {
+        std::fprintf(stderr, "sphxr_bench_reuse: --scene %s: must be deep_tank or dam_break_1m\n", v.c_str());
+        return false;
+      }
       out->only = v;
     } else if (a == "--time" && next(&v)) {
       if (!ParseNumber(v.c_str(), &out->time) || !(out->time > 0.0)) {
@@ -116,6 +119,7 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     } else if (a == "--help" || a == "-h") {
       out->help = true;
     } else {
+      std::fprintf(stderr, "sphxr_bench_reuse: %s: unknown option or missing value\n", a.c_str());
       return Usage();
     }
   }

@@ -245,6 +245,9 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   if (Status s = OpenGlWindow(request, &m.window); !s) return s;
   if (Status s = render::Renderer::Create(config, &m.renderer); !s) return s;
   SPHXR_LOG_INFO("desktop window %dx%d, %s", options.windowWidth, options.windowHeight, render::GlDescription());
+  if (const std::string ignored = HeadlessOnlyOptions(options); !ignored.empty()) {
+    SPHXR_LOG_WARN("%s: honoured by --headless runs only; the window ignores them", ignored.c_str());
+  }
 
   // Our callbacks first: ImGui's backend chains to them after taking what it needs.
   glfwSetWindowUserPointer(m.window, app.get());

@@ -94,7 +94,8 @@ Status WritePly(const std::string& path, const sim::HostFluid& fluid) {
     SPHXR_FLUID_FIELDS(SPHXR_PLY_VALUE)
 #undef SPHXR_PLY_VALUE
   }
-  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
+  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
   return Status::Ok();
 }
 
@@ -120,7 +121,8 @@ Status WriteVtk(const std::string& path, const sim::HostFluid& fluid) {
   }
   SPHXR_FLUID_FIELDS(SPHXR_VTK_FIELD)
 #undef SPHXR_VTK_FIELD
-  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
+  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
   return Status::Ok();
 }
 
@@ -144,7 +146,8 @@ Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh) {
     std::fwrite(&three, 1, 1, f.get());
     std::fwrite(index, 4, 3, f.get());
   }
-  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
+  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
   return Status::Ok();
 }
 
@@ -165,7 +168,8 @@ Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh) {
     const long long a = 3 * t + 1, b = a + 1, c = a + 2;  // OBJ counts from 1
     std::fprintf(f.get(), "f %lld//%lld %lld//%lld %lld//%lld\n", a, a, b, b, c, c);
   }
-  if (std::ferror(f.get())) return Status::Error(path + ": write failed");
+  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
+  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
   return Status::Ok();
 }
 

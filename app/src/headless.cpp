@@ -90,7 +90,7 @@ std::string UsageText() {
          "             [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
-         "             [--progress | --no-progress] [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
+         "             [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
          "             [--image-size WxH] [--render water|particles] [--quality auto|scene] [--gl-debug]\n"
          "\n"
          "  --xr              the headset (OpenXR), with a mirror window; the default when a runtime answers.\n"
@@ -279,6 +279,19 @@ Status LoadSceneWithOptions(const Options& options, SceneFile* scene) {
   return Status::Ok();
 }
 
+std::string HeadlessOnlyOptions(const Options& options) {
+  std::string out;
+  auto add = [&](bool given, const char* flag) {
+    if (given) out += (out.empty() ? "" : ", ") + std::string(flag);
+  };
+  add(!options.statsPath.empty(), "--stats");
+  add(options.exportEvery > 0, "--export-every");
+  add(options.exportSurfaceEvery > 0, "--export-surface-every");
+  add(options.time > 0.0, "--time");
+  add(options.steps > 0, "--steps");
+  return out;
+}
+
 Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
@@ -307,6 +320,17 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (!options.statsPath.empty()) {
     stats.open(options.statsPath);
     if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
+  }
+  if (!options.screenshotPath.empty()) {  // written after the run: check the place before it
+    const std::filesystem::path shot(options.screenshotPath);
+    const std::filesystem::path dir = shot.has_parent_path() ? shot.parent_path() : std::filesystem::path(".");
+    std::error_code ec;
+    if (std::filesystem::is_directory(shot, ec)) {
+      return Status::Error("--screenshot " + options.screenshotPath + ": is a directory; give a file name (.png)");
+    }
+    if (!std::filesystem::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
+      return Status::Error("--screenshot " + options.screenshotPath + ": cannot write into " + dir.string());
+    }
   }
   if (options.exportEvery > 0 || options.exportSurfaceEvery > 0) {
     std::error_code ec;
@@ -470,6 +494,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
         }
       }
       stats << '\n';
+      if (!stats) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?) at step " + std::to_string(step));
     }
     if (options.exportEvery > 0 && step % options.exportEvery == 0) {
       if (Status s = exportNow(step); !s) return s;
@@ -485,6 +510,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     progress.Update(std::min(1.0, fraction), solver->Time(), step, 1e3 * wall / step);
   }
   summary->wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (stats.is_open()) {
+    stats.close();  // the last rows leave the buffer here
+    if (stats.fail()) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?)");
+  }
 
   const sim::Totals& totals = solver->GetTotals();
   summary->steps = totals.steps;

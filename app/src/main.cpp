@@ -3,14 +3,19 @@
 // one line saying why: no runtime -> the desktop window; no window -> headless; a session lost mid-run ->
 // the desktop window (or exit when there is no display or the --frame-limit is reached).
 #include <cstdio>
+#include <exception>
+#include <new>
 #include <string>
 
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/headless.h"
+#include "sphxr/app/scene_file.h"
 #include "sphxr/app/xr_mode.h"
 #include "sphxr/common/log.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   using sphxr::app::Mode;
   sphxr::app::Options options;
   if (sphxr::Status s = sphxr::app::ParseCommandLine(argc, argv, &options); !s) {
@@ -20,6 +25,20 @@ int main(int argc, char** argv) {
   if (options.help) {
     std::fputs(sphxr::app::UsageText().c_str(), stdout);
     return 0;
+  }
+  // A bad scene is one error, whatever the mode (a window failing on it is not "unavailable").
+  {
+    sphxr::app::SceneFile scene;
+    if (sphxr::Status s = sphxr::app::LoadSceneWithOptions(options, &scene); !s) {
+      std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
+      return 1;
+    }
+  }
+  // Files only a headless run writes: asked for without a mode, they pick it.
+  if (options.mode == Mode::kAuto && (!options.statsPath.empty() || options.exportEvery > 0 ||
+                                      options.exportSurfaceEvery > 0)) {
+    SPHXR_LOG_INFO("--stats/--export-every asked for without a mode: running headless");
+    options.mode = Mode::kHeadless;
   }
   // The default: the headset when a runtime answers (asked without creating a session).
   if (options.mode == Mode::kAuto && sphxr::app::DisplayAvailable() && sphxr::app::XrRuntimeAvailable(nullptr)) {
@@ -63,7 +82,7 @@ int main(int argc, char** argv) {
   }
   sphxr::app::RunSummary summary;
   sphxr::Status run = sphxr::app::RunHeadless(options, &summary);
-  if (!run && autoPicture && run.message().rfind("--screenshot/--frames:", 0) == 0) {
+  if (!run && autoPicture && run.message().rfind("--screenshot", 0) == 0) {  // also "--screenshot/--frames:"
     SPHXR_LOG_WARN("no picture (%s): running without one", run.message().c_str());
     options.screenshotPath.clear();
     run = sphxr::app::RunHeadless(options, &summary);
@@ -73,4 +92,19 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // The memory check before allocating (sim's Solver::Create) counts what the particles need; what it
+  // cannot see (other processes, fragmentation) ends here as one line instead of an abort.
+  try {
+    return Main(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "sphxr: error: out of memory: use a larger --spacing or a smaller scene\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sphxr: error: %s\n", e.what());
+  }
+  return 1;
 }

@@ -401,6 +401,8 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
 }
 
 Status LoadScene(const std::string& path, SceneFile* out) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return Status::Error(path + ": is a directory, not a scene file");
   std::ifstream in(path);
   if (!in) return Status::Error(path + ": cannot open the scene file");
   std::stringstream buffer;

@@ -255,6 +255,9 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     outcome->fallback = true;
     return s;
   }
+  if (const std::string ignored = HeadlessOnlyOptions(options); !ignored.empty()) {
+    SPHXR_LOG_WARN("%s: honoured by --headless runs only; the headset session ignores them", ignored.c_str());
+  }
   if (Status s = StartSimulation(app); !s) return s;
 
   const glm::mat4 sceneToPlay = glm::translate(glm::mat4(1.0f), glm::vec3(app.offset.x, app.offset.y, app.offset.z));

@@ -453,6 +453,73 @@ TEST(HeadlessTest, BadFlagFailsWithUsageHint) {
   EXPECT_NE(lines[0].find("--threads"), std::string::npos) << lines[0];
 }
 
+TEST(HeadlessTest, SceneThatIsADirectoryFailsCleanly) {
+  test::TempDir dir("scenedir");
+  const Result r = RunBinary("--headless --scene " + Quote(dir.path().string()) + " --steps 5", dir);
+  ASSERT_TRUE(r.Exited());
+  EXPECT_NE(r.Code(), 0);
+  const std::vector<std::string> lines = Lines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_NE(lines[0].find("is a directory"), std::string::npos) << lines[0];
+}
+
+// Every mode loads the scene first: a window must not call a bad scene "window unavailable" and then
+// repeat the error from the headless fallback (with or without a display).
+TEST(HeadlessTest, DesktopWithABadSceneIsOneError) {
+  test::TempDir dir("desktopbad");
+  const std::string scene = dir.Write("bad.json", "hello");
+  const Result r = RunBinary("--desktop --scene " + Quote(scene) + " --frame-limit 3", dir);
+  ASSERT_TRUE(r.Exited());
+  EXPECT_EQ(r.Code(), 1);
+  const std::vector<std::string> lines = Lines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_NE(lines[0].find("not valid JSON"), std::string::npos) << lines[0];
+}
+
+// A full disk (/dev/full) must fail the run, not print a summary over a CSV that was never written.
+TEST(HeadlessTest, StatsThatCannotBeWrittenFailTheRun) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  test::TempDir dir("statsfull");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 3 --stats /dev/full --threads 1 --no-progress", dir);
+  ASSERT_TRUE(r.Exited());
+  EXPECT_EQ(r.Code(), 1);
+  EXPECT_EQ(r.out.find("sphxr summary"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("--stats /dev/full: write failed"), std::string::npos) << r.err;
+}
+
+// So must a particle export that does not reach the disk (a small file used to sit in stdio's buffer
+// past the error check, and fclose's failure was ignored).
+TEST(HeadlessTest, ExportThatCannotBeWrittenFailsTheRun) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  test::TempDir dir("exportfull");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::filesystem::path out = dir.path() / "out";
+  std::filesystem::create_directories(out);
+  std::filesystem::create_symlink("/dev/full", out / "particles_000002.ply");
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 3 --export-every 2 --out " +
+                                 Quote(out.string()) + " --threads 1 --no-progress",
+                             dir);
+  ASSERT_TRUE(r.Exited());
+  EXPECT_EQ(r.Code(), 1);
+  EXPECT_NE(r.err.find("particles_000002.ply: write failed"), std::string::npos) << r.err;
+}
+
+// The screenshot is written after the run; a place it cannot go is refused before the run costs anything.
+TEST(HeadlessTest, ScreenshotIntoAMissingDirectoryRefusedBeforeTheRun) {
+  test::TempDir dir("shotdir");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string shot = (dir.path() / "missing" / "x.png").string();
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 3 --screenshot " + Quote(shot) +
+                                 " --threads 1 --no-progress",
+                             dir);
+  ASSERT_TRUE(r.Exited());
+  EXPECT_EQ(r.Code(), 1);
+  const std::vector<std::string> lines = Lines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << "refused before the solver starts (which logs its device):\n" << r.err;
+  EXPECT_NE(lines[0].find("cannot write into"), std::string::npos) << lines[0];
+}
+
 TEST(HeadlessTest, HelpPrintsUsage) {
   test::TempDir dir("help");
   const Result r = RunBinary("--help", dir);

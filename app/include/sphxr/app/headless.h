@@ -56,6 +56,11 @@ struct SceneFile;
 /// --reuse on|off. The headless runner, the desktop window and --xr all start from this.
 Status LoadSceneWithOptions(const Options& options, SceneFile* scene);
 
+/// The options given that only a headless run honours (--stats, --export-every, --export-surface-every,
+/// --time, --steps), e.g. "--stats, --time"; empty when none. The desktop window and --xr warn with it
+/// once their window is open (a fallback to headless still honours them).
+std::string HeadlessOnlyOptions(const Options& options);
+
 /// What a headless run measured (also printed as the summary).
 struct RunSummary {
   int fluid = 0;
