@@ -303,6 +303,10 @@ int main(int argc, char** argv) {
     return 0;
   }
   SetLogLevel(LogLevel::kWarn);
+  if (!args.csv.empty() && !std::ofstream(args.csv, std::ios::app)) {  // before minutes of measuring
+    std::fprintf(stderr, "--csv %s: cannot open for writing\n", args.csv.c_str());
+    return 1;
+  }
 
   const std::string model = CpuModel();
   const int cpus = CpuCount();

@@ -257,6 +257,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       out->particleImages = r == "particles";
     } else if (arg == "--stats") {
       if (Status s = value(&v); !s) return s;
+      if (v[0] == '\0') return Status::Error("--stats: needs a file name");
       out->statsPath = v;
     } else {
       return Status::Error("unknown argument '" + arg + "' (see --help)");
@@ -378,6 +379,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   SPHXR_LOG_INFO("%s: %d fluid + %d boundary particles, spacing %g m, device %s, sound speed %.3g m/s",
                  scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str(), summary->fluid,
                  summary->boundary, spacing, sim::DeviceName(solver->ActiveDevice()), solver->SoundSpeed());
+  if (summary->fluid == 0) {
+    SPHXR_LOG_WARN("the scene has no fluid particles (no fluid block, or every block too thin or filled by "
+                   "obstacles at spacing %g m): only the walls and paddles run", spacing);
+  }
 
   const bool probeEveryStep = scene.damBreak.has_value() && stats.is_open();
   if (stats) {
