@@ -1,6 +1,7 @@
 #pragma once
-// A plain uniform grid over points on the host, for measurements that must not lean on the solver's own
-// neighbour grid (bench/perf.cpp's brute-force pair count, measure.h's SphEnergy).
+// A plain uniform grid over points on the host: for measurements that must not lean on the solver's own
+// neighbour grid (bench/perf.cpp's brute-force pair count, measure.h's SphEnergy) and the one-off kernel sums over
+// a moving body's own particles (Solver::InitBodies).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
