@@ -333,6 +333,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       return Status::Error("--screenshot " + options.screenshotPath + ": cannot write into " + dir.string());
     }
   }
+  if (options.outDir != Options{}.outDir && options.exportEvery <= 0 && options.exportSurfaceEvery <= 0) {
+    SPHXR_LOG_WARN("--out %s: nothing is exported without --export-every or --export-surface-every",
+                   options.outDir.c_str());
+  }
   if (options.exportEvery > 0 || options.exportSurfaceEvery > 0) {
     std::error_code ec;
     std::filesystem::create_directories(options.outDir, ec);

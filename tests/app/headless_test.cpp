@@ -520,6 +520,15 @@ TEST(HeadlessTest, ScreenshotIntoAMissingDirectoryRefusedBeforeTheRun) {
   EXPECT_NE(lines[0].find("cannot write into"), std::string::npos) << lines[0];
 }
 
+TEST(HeadlessTest, OutWithoutAnExportIsNamed) {
+  test::TempDir dir("outonly");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 2 --out elsewhere --threads 1 --no-progress", dir);
+  ASSERT_EQ(r.Code(), 0) << r.err;
+  EXPECT_NE(r.err.find("--out elsewhere: nothing is exported without --export-every"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "elsewhere"));
+}
+
 TEST(HeadlessTest, HelpPrintsUsage) {
   test::TempDir dir("help");
   const Result r = RunBinary("--help", dir);
