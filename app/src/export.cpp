@@ -13,6 +13,15 @@ struct FileCloser {
 };
 using File = std::unique_ptr<FILE, FileCloser>;
 
+// Closes `f` and reports any write that failed, including the last buffered bytes that only fclose
+// writes (a full disk). The FileCloser above is for early returns, whose error is already reported.
+Status Close(File* f, const std::string& path) {
+  FILE* raw = f->release();
+  const bool failed = std::ferror(raw) != 0;
+  if (std::fclose(raw) != 0 || failed) return Status::Error(path + ": write failed");
+  return Status::Ok();
+}
+
 // Components of one field as floats/ints: Vec4 fields export x, y, z (w is a spare lane).
 template <class T>
 constexpr int Components() {
@@ -94,9 +103,7 @@ Status WritePly(const std::string& path, const sim::HostFluid& fluid) {
     SPHXR_FLUID_FIELDS(SPHXR_PLY_VALUE)
 #undef SPHXR_PLY_VALUE
   }
-  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
-  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
-  return Status::Ok();
+  return Close(&f, path);
 }
 
 Status WriteVtk(const std::string& path, const sim::HostFluid& fluid) {
@@ -121,9 +128,7 @@ Status WriteVtk(const std::string& path, const sim::HostFluid& fluid) {
   }
   SPHXR_FLUID_FIELDS(SPHXR_VTK_FIELD)
 #undef SPHXR_VTK_FIELD
-  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
-  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
-  return Status::Ok();
+  return Close(&f, path);
 }
 
 Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh) {
@@ -146,9 +151,7 @@ Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh) {
     std::fwrite(&three, 1, 1, f.get());
     std::fwrite(index, 4, 3, f.get());
   }
-  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
-  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
-  return Status::Ok();
+  return Close(&f, path);
 }
 
 Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh) {
@@ -168,9 +171,7 @@ Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh) {
     const long long a = 3 * t + 1, b = a + 1, c = a + 2;  // OBJ counts from 1
     std::fprintf(f.get(), "f %lld//%lld %lld//%lld %lld//%lld\n", a, a, b, b, c, c);
   }
-  // Flushed here: what still sits in stdio's buffer would otherwise fail unseen in fclose.
-  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) return Status::Error(path + ": write failed");
-  return Status::Ok();
+  return Close(&f, path);
 }
 
 }  // namespace sphxr::app

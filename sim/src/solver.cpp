@@ -69,6 +69,7 @@ bool Finite(Quat q) { return std::isfinite(q.w) && std::isfinite(q.x) && std::is
 
 Status ValidateBodies(const SceneSetup& scene) {
   if (scene.bodies.size() > 64) return Status::Error(Format("%zu moving bodies: at most 64", scene.bodies.size()));
+  const float tankSize = Length(scene.tank.max - scene.tank.min);
   for (size_t k = 0; k < scene.bodies.size(); ++k) {
     const RigidBodySetup& b = scene.bodies[k];
     const std::string key = Format("body %zu", k);
@@ -90,8 +91,6 @@ Status ValidateBodies(const SceneSetup& scene) {
     }
     if (!Finite(b.pose.position) || !Finite(b.pose.orientation)) return Status::Error(key + ": non-finite pose");
     // A body larger than the whole tank cannot stir it, and its sampling would dwarf the water's.
-    const Vec3 extent = scene.tank.max - scene.tank.min;
-    const float tankSize = Length(extent);
     float reach = 0.0f;
     for (const Vec3& x : b.points) reach = std::max(reach, Length(x));
     if (reach > tankSize) {
