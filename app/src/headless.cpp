@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +25,37 @@
 
 namespace sphxr::app {
 namespace {
+
+volatile std::sig_atomic_t g_interrupt = 0;
+
+extern "C" void OnInterrupt(int signal) { g_interrupt = signal; }
+
+/// SIGINT and SIGTERM set g_interrupt while a run steps; SA_RESETHAND makes a second signal act as if
+/// we had never caught the first (the process ends). The previous handlers come back afterwards.
+class InterruptScope {
+ public:
+  InterruptScope() {
+    g_interrupt = 0;
+    struct sigaction action {};
+    action.sa_handler = OnInterrupt;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &action, &m_int);
+    sigaction(SIGTERM, &action, &m_term);
+    // A signal ignored on entry (a background job of a script, nohup) stays ignored.
+    if (m_int.sa_handler == SIG_IGN) sigaction(SIGINT, &m_int, nullptr);
+    if (m_term.sa_handler == SIG_IGN) sigaction(SIGTERM, &m_term, nullptr);
+  }
+  ~InterruptScope() {
+    sigaction(SIGINT, &m_int, nullptr);
+    sigaction(SIGTERM, &m_term, nullptr);
+  }
+  InterruptScope(const InterruptScope&) = delete;
+  InterruptScope& operator=(const InterruptScope&) = delete;
+
+ private:
+  struct sigaction m_int {}, m_term {};
+};
 
 Status ParseDouble(const std::string& flag, const char* text, double lo, double hi, double* out) {
   char* end = nullptr;
@@ -60,12 +92,19 @@ class Progress {
     std::fprintf(stderr, "\r[%.*s%.*s] %3d%%  t = %.4f s  step %lld  %.2f ms/step ", filled,
                  "##############################", width - filled, "                              ",
                  static_cast<int>(fraction * 100.0), simTime, static_cast<long long>(steps), msPerStep);
-    if (fraction >= 1.0) std::fprintf(stderr, "\n");
+    m_open = fraction < 1.0;
+    if (!m_open) std::fprintf(stderr, "\n");
     std::fflush(stderr);
+  }
+  /// Ends a bar left unfinished (a run stopped early), so that the next line starts on its own.
+  void Finish() {
+    if (m_open) std::fprintf(stderr, "\n");
+    m_open = false;
   }
 
  private:
   bool m_enabled;
+  bool m_open = false;
   std::chrono::steady_clock::time_point m_last{};
 };
 
@@ -460,11 +499,16 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   };
   if (Status s = frameNow(); !s) return s;
 
+  InterruptScope interruptScope;
   double activeSum = 0.0;
   double forceSum = 0.0;
   double nextFrame = 0.0;  // paddles: display frames at paddleFrameRate get new targets
   const auto begin = std::chrono::steady_clock::now();
   while (targetSteps > 0 ? solver->GetTotals().steps < targetSteps : solver->Time() < targetTime - 1e-9) {
+    if (g_interrupt) {
+      summary->interrupted = g_interrupt;
+      break;
+    }
     if (paddles && solver->Time() >= nextFrame - 1e-9) {
       nextFrame += 1.0 / scene.paddleFrameRate;
       if (Status s = paddles->BeginFrame(nextFrame); !s) return s;
@@ -519,6 +563,21 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     progress.Update(std::min(1.0, fraction), solver->Time(), step, 1e3 * wall / step);
   }
   summary->wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (g_interrupt && !summary->interrupted) summary->interrupted = g_interrupt;  // during the last step
+  if (summary->interrupted) {
+    const int64_t step = solver->GetTotals().steps;
+    progress.Finish();
+    SPHXR_LOG_WARN("%s at step %lld (t = %.4f s): stopping; the summary and the files cover the run so far",
+                   summary->interrupted == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)",
+                   static_cast<long long>(step), solver->Time());
+    // The state reached is not lost: one more export at this step unless it was just written.
+    if (options.exportEvery > 0 && step % options.exportEvery != 0) {
+      if (Status s = exportNow(step); !s) return s;
+    }
+    if (options.exportSurfaceEvery > 0 && step % options.exportSurfaceEvery != 0) {
+      if (Status s = exportSurface(step); !s) return s;
+    }
+  }
   if (stats.is_open()) {
     stats.close();  // the last rows leave the buffer here
     if (stats.fail()) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?)");
@@ -586,6 +645,12 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                 "threshold %g, idle %d)\n",
                 100.0 * summary->meanActiveFraction, scene.setup.reuse.delta1, scene.setup.reuse.delta2,
                 scene.setup.reuse.threshold, scene.setup.reuse.idle);
+  }
+  if (summary->interrupted) {
+    std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n", summary->interrupted == SIGINT ? "SIGINT" : "SIGTERM",
+                summary->simulatedTime,
+                targetSteps > 0 ? Format("%lld steps", static_cast<long long>(targetSteps)).c_str()
+                                : Format("%.4g s", targetTime).c_str());
   }
   std::printf("  particles lost  %lld (clamped back into the tank: %lld times)\n", static_cast<long long>(summary->lost),
               static_cast<long long>(summary->clampedEvents));

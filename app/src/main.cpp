@@ -91,7 +91,7 @@ int Main(int argc, char** argv) {
     std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
     return 1;
   }
-  return 0;
+  return summary.interrupted ? 128 + summary.interrupted : 0;  // the shell's convention: 130 after Ctrl-C
 }
 
 }  // namespace

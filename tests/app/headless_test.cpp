@@ -1,7 +1,13 @@
 // The command line (ParseCommandLine) and the headless runner end to end: the real sphxr binary
 // (SPHXR_BINARY) on a small scene, its summary, stats CSV and PLY exports; bad input exits cleanly.
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <cmath>
 #include <cstdio>
@@ -519,6 +525,68 @@ TEST(HeadlessTest, ScreenshotIntoAMissingDirectoryRefusedBeforeTheRun) {
   ASSERT_EQ(lines.size(), 1u) << "refused before the solver starts (which logs its device):\n" << r.err;
   EXPECT_NE(lines[0].find("cannot write into"), std::string::npos) << lines[0];
 }
+
+// Ctrl-C (or a SIGTERM from a batch system) during a long run stops it after the step in progress and
+// loses nothing: whole CSV rows, one per step the summary counts, the state exported at that step, and
+// the shell's exit code 128 + signal.
+void InterruptRun(int signal, const char* name) {
+  test::TempDir dir(std::string("interrupt_") + name);
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string csv = dir.File("stats.csv"), outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
+  const std::string out = (dir.path() / "out").string();
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(o, 1);
+    dup2(e, 2);
+    execl(SPHXR_BINARY, SPHXR_BINARY, "--headless", "--scene", scene.c_str(), "--steps", "100000000", "--stats", csv.c_str(),
+          "--export-every", "7", "--out", out.c_str(), "--threads", "1", "--no-progress", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Signal once the run is under way (the CSV's buffer has reached the file).
+  const auto start = std::chrono::steady_clock::now();
+  auto written = [&]() {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(csv, ec);
+    return ec ? 0 : size;
+  };
+  while (written() < 4096 && std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(kill(pid, signal), 0);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() - start > std::chrono::seconds(240)) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      FAIL() << "the run did not stop after " << name;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const std::string stdoutText = test::ReadFile(outPath), stderrText = test::ReadFile(errPath);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping:\n" << stderrText;
+  EXPECT_EQ(WEXITSTATUS(status), 128 + signal) << stderrText;
+  EXPECT_NE(stdoutText.find(std::string("interrupted     by ") + name), std::string::npos) << stdoutText;
+  EXPECT_NE(stderrText.find(" at step "), std::string::npos) << stderrText;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(stdoutText, m, std::regex(R"(steps +(\d+) )"))) << stdoutText;
+  const long long steps = std::stoll(m[1]);
+  ASSERT_GT(steps, 7);
+  const std::vector<std::string> rows = Lines(test::ReadFile(csv));
+  ASSERT_EQ(static_cast<long long>(rows.size()), steps + 1) << "a header and one row per step";
+  const size_t fields = Split(rows[0], ',').size();
+  for (size_t i = 1; i < rows.size(); ++i) ASSERT_EQ(Split(rows[i], ',').size(), fields) << "row " << i << ": " << rows[i];
+  EXPECT_EQ(std::stoll(Split(rows.back(), ',')[0]), steps);
+  char last[64];
+  std::snprintf(last, sizeof(last), "particles_%06lld.ply", steps);
+  const Ply ply = ReadPly((std::filesystem::path(out) / last).string());
+  EXPECT_EQ(ply.vertices, static_cast<size_t>(kSmallSceneParticles)) << "the state at the interrupted step is exported";
+}
+
+TEST(HeadlessTest, InterruptKeepsWholeRowsAndTheLastState) { InterruptRun(SIGINT, "SIGINT"); }
+TEST(HeadlessTest, TerminateKeepsWholeRowsAndTheLastState) { InterruptRun(SIGTERM, "SIGTERM"); }
 
 TEST(HeadlessTest, OutWithoutAnExportIsNamed) {
   test::TempDir dir("outonly");

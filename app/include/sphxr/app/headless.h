@@ -89,10 +89,14 @@ struct RunSummary {
   double paddleMeanForce = 0.0;      // N, mean over steps and paddles of the filtered |force|
   float paddlePeakHaptic = 0.0f;     // largest haptic amplitude over the run
   int64_t frames = 0;                // PNG frames written to --frames DIR
+  int interrupted = 0;               // the signal (SIGINT, SIGTERM) that stopped the run early, else 0
 };
 
 /// Runs a scene headless: load, apply overrides, simulate, export, summarise. The summary is printed
-/// to stdout; errors come back as the status.
+/// to stdout; errors come back as the status. A SIGINT (Ctrl-C) or SIGTERM during the steps stops the
+/// run after the step in progress: the stats CSV keeps whole rows, the particles and the surface are
+/// exported once more at that step (when exports are on), the summary covers the run so far, and
+/// `summary->interrupted` names the signal (status ok). A second signal ends the process at once.
 Status RunHeadless(const Options& options, RunSummary* summary);
 
 }  // namespace sphxr::app
