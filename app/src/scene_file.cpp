@@ -435,8 +435,8 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
     return Status::Error("--set " + key + "=" + value + ": not a finite number");
   }
   if (v < info->min || v > info->max) {
-    return Status::Error(Format("--set %s=%s: out of range, must be from %g to %g %s", key.c_str(), value.c_str(),
-                                info->min, info->max, info->unit));
+    return Status::Error(Format("--set %s=%s: out of range, must be from %g to %g%s%s", key.c_str(), value.c_str(),
+                                info->min, info->max, *info->unit ? " " : "", info->unit));
   }
   setup->params.*(info->member) = static_cast<float>(v);
   return Status::Ok();
