@@ -287,6 +287,22 @@ TEST(ExtremesTest, ValidateNamesTheStageWhereAValueOverflows) {
   EXPECT_FALSE(std::isfinite(f.pressure[byId.at(id)])) << "particle " << id << " pressure " << f.pressure[byId.at(id)];
 }
 
+// A step too small to move the clock (here: a particle shot off at 1e36 m/s makes the CFL step ~1e-39 s)
+// would loop forever in a run to a given time; Step says so instead.
+TEST(ExtremesTest, ATimeStepThatCannotAdvanceTheClockIsAnError) {
+  auto solver = test::CreateOrFail(test::SmallDamBreak(0.01f));
+  ASSERT_TRUE(solver);
+  ASSERT_TRUE(solver->Step().ok());
+  HostFluid f = test::DownloadFluid(*solver);
+  f.velocity[0] = MakeVec4(Vec3{1e36f, 0.0f, 0.0f});
+  ASSERT_TRUE(solver->Upload(f).ok());
+  Status s = Status::Ok();
+  for (int k = 0; k < 5 && s.ok(); ++k) s = solver->Step();
+  ASSERT_FALSE(s.ok()) << "the run must stop, not spin";
+  EXPECT_NE(s.message().find("the time step collapsed"), std::string::npos) << s.message();
+  EXPECT_GT(solver->Time(), 0.0);
+}
+
 TEST(ExtremesTest, ValidateModePassesAHealthyRun) {
   SolverConfig config = test::TestConfig();
   config.validate = true;
