@@ -40,11 +40,11 @@ class InterruptScope {
     action.sa_handler = OnInterrupt;
     sigemptyset(&action.sa_mask);
     action.sa_flags = SA_RESETHAND;
-    sigaction(SIGINT, &action, &m_int);
-    sigaction(SIGTERM, &action, &m_term);
+    sigaction(SIGINT, nullptr, &m_int);
+    sigaction(SIGTERM, nullptr, &m_term);
     // A signal ignored on entry (a background job of a script, nohup) stays ignored.
-    if (m_int.sa_handler == SIG_IGN) sigaction(SIGINT, &m_int, nullptr);
-    if (m_term.sa_handler == SIG_IGN) sigaction(SIGTERM, &m_term, nullptr);
+    if (m_int.sa_handler != SIG_IGN) sigaction(SIGINT, &action, nullptr);
+    if (m_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &action, nullptr);
   }
   ~InterruptScope() {
     sigaction(SIGINT, &m_int, nullptr);
@@ -506,10 +506,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   double nextFrame = 0.0;  // paddles: display frames at paddleFrameRate get new targets
   const auto begin = std::chrono::steady_clock::now();
   while (targetSteps > 0 ? solver->GetTotals().steps < targetSteps : solver->Time() < targetTime - 1e-9) {
-    if (g_interrupt) {
-      summary->interrupted = g_interrupt;
-      break;
-    }
+    if (g_interrupt) break;
     if (paddles && solver->Time() >= nextFrame - 1e-9) {
       nextFrame += 1.0 / scene.paddleFrameRate;
       if (Status s = paddles->BeginFrame(nextFrame); !s) return s;
@@ -564,7 +561,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     progress.Update(std::min(1.0, fraction), solver->Time(), step, 1e3 * wall / step);
   }
   summary->wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-  if (g_interrupt && !summary->interrupted) summary->interrupted = g_interrupt;  // during the last step
+  summary->interrupted = g_interrupt;  // also a signal during the last step
   if (summary->interrupted) {
     const int64_t step = solver->GetTotals().steps;
     progress.Finish();

@@ -438,35 +438,33 @@ TEST(HeadlessTest, FluidOutsideTheTankFailsCleanly) {
                      {"fluid[0]"});
 }
 
+// A failed run whose whole stderr is one line containing `needle`; `code` the exit code (0: any but 0).
+void ExpectOneLineError(const Result& r, const std::string& needle, int code = 0, const char* why = "") {
+  ASSERT_TRUE(r.Exited()) << "crashed: status " << r.status << "\nstderr:\n" << r.err;
+  if (code == 0) {
+    EXPECT_NE(r.Code(), 0);
+  } else {
+    EXPECT_EQ(r.Code(), code);
+  }
+  const std::vector<std::string> lines = Lines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << why << r.err;
+  EXPECT_NE(lines[0].find(needle), std::string::npos) << lines[0];
+}
+
 TEST(HeadlessTest, MissingSceneFileFailsCleanly) {
   test::TempDir dir("missing");
   const std::string scene = dir.File("does_not_exist.json");
-  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 5", dir);
-  ASSERT_TRUE(r.Exited());
-  EXPECT_NE(r.Code(), 0);
-  const std::vector<std::string> lines = Lines(r.err);
-  ASSERT_EQ(lines.size(), 1u) << r.err;
-  EXPECT_NE(lines[0].find(scene), std::string::npos) << lines[0];
+  ExpectOneLineError(RunBinary("--headless --scene " + Quote(scene) + " --steps 5", dir), scene);
 }
 
 TEST(HeadlessTest, BadFlagFailsWithUsageHint) {
   test::TempDir dir("badflag");
-  const Result r = RunBinary("--headless --threads -1", dir);
-  ASSERT_TRUE(r.Exited());
-  EXPECT_NE(r.Code(), 0);
-  const std::vector<std::string> lines = Lines(r.err);
-  ASSERT_EQ(lines.size(), 1u) << r.err;
-  EXPECT_NE(lines[0].find("--threads"), std::string::npos) << lines[0];
+  ExpectOneLineError(RunBinary("--headless --threads -1", dir), "--threads");
 }
 
 TEST(HeadlessTest, SceneThatIsADirectoryFailsCleanly) {
   test::TempDir dir("scenedir");
-  const Result r = RunBinary("--headless --scene " + Quote(dir.path().string()) + " --steps 5", dir);
-  ASSERT_TRUE(r.Exited());
-  EXPECT_NE(r.Code(), 0);
-  const std::vector<std::string> lines = Lines(r.err);
-  ASSERT_EQ(lines.size(), 1u) << r.err;
-  EXPECT_NE(lines[0].find("is a directory"), std::string::npos) << lines[0];
+  ExpectOneLineError(RunBinary("--headless --scene " + Quote(dir.path().string()) + " --steps 5", dir), "is a directory");
 }
 
 // Every mode loads the scene first: a window must not call a bad scene "window unavailable" and then
@@ -474,12 +472,7 @@ TEST(HeadlessTest, SceneThatIsADirectoryFailsCleanly) {
 TEST(HeadlessTest, DesktopWithABadSceneIsOneError) {
   test::TempDir dir("desktopbad");
   const std::string scene = dir.Write("bad.json", "hello");
-  const Result r = RunBinary("--desktop --scene " + Quote(scene) + " --frame-limit 3", dir);
-  ASSERT_TRUE(r.Exited());
-  EXPECT_EQ(r.Code(), 1);
-  const std::vector<std::string> lines = Lines(r.err);
-  ASSERT_EQ(lines.size(), 1u) << r.err;
-  EXPECT_NE(lines[0].find("not valid JSON"), std::string::npos) << lines[0];
+  ExpectOneLineError(RunBinary("--desktop --scene " + Quote(scene) + " --frame-limit 3", dir), "not valid JSON", 1);
 }
 
 // A full disk (/dev/full) must fail the run, not print a summary over a CSV that was never written.
@@ -516,14 +509,10 @@ TEST(HeadlessTest, ScreenshotIntoAMissingDirectoryRefusedBeforeTheRun) {
   test::TempDir dir("shotdir");
   const std::string scene = dir.Write("scene.json", kSmallScene);
   const std::string shot = (dir.path() / "missing" / "x.png").string();
-  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 3 --screenshot " + Quote(shot) +
-                                 " --threads 1 --no-progress",
-                             dir);
-  ASSERT_TRUE(r.Exited());
-  EXPECT_EQ(r.Code(), 1);
-  const std::vector<std::string> lines = Lines(r.err);
-  ASSERT_EQ(lines.size(), 1u) << "refused before the solver starts (which logs its device):\n" << r.err;
-  EXPECT_NE(lines[0].find("cannot write into"), std::string::npos) << lines[0];
+  ExpectOneLineError(RunBinary("--headless --scene " + Quote(scene) + " --steps 3 --screenshot " + Quote(shot) +
+                                     " --threads 1 --no-progress",
+                                 dir),
+                     "cannot write into", 1, "refused before the solver starts (which logs its device):\n");
 }
 
 // Ctrl-C (or a SIGTERM from a batch system) during a long run stops it after the step in progress and
