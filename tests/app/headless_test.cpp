@@ -530,6 +530,9 @@ void InterruptRun(int signal, const char* name) {
     const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(o, 1);
     dup2(e, 2);
+    // As from a terminal: a signal this test's own parent ignores (a background job) must not stay ignored.
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
     execl(SPHXR_BINARY, SPHXR_BINARY, "--headless", "--scene", scene.c_str(), "--steps", "100000000", "--stats", csv.c_str(),
           "--export-every", "7", "--out", out.c_str(), "--threads", "1", "--no-progress", static_cast<char*>(nullptr));
     _exit(127);
