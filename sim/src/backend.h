@@ -39,6 +39,9 @@ class Backend {
   virtual void Download(HostFluid* out) const = 0;
   virtual void DownloadBoundary(HostBoundary* out) const = 0;
   virtual void Upload(const HostFluid& fluid) = 0;
+  /// FIRE's sums over the fluid after a step (stages.h FireSumsOp), and its velocity mixing v <- keep v + mix a.
+  virtual FireSums FireReduce() = 0;
+  virtual void FireMix(float keep, float mix) = 0;
   virtual int FluidCount() const = 0;
   virtual int BoundaryCount() const = 0;
 

@@ -249,6 +249,16 @@ class BackendImpl final : public Backend {
     m_scratchI32.resize(n);
   }
 
+  FireSums FireReduce() override {
+    const thrust::counting_iterator<int> first(0);
+    return thrust::transform_reduce(Traits::Policy(), first, first + FluidCount(), FireSumsOp{Fluid()}, FireSums{},
+                                    FireSumsCombine{});
+  }
+
+  void FireMix(float keep, float mix) override {
+    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), FluidCount(), FireMixStage{Fluid(), keep, mix});
+  }
+
   int FluidCount() const override { return static_cast<int>(m_fluid.position.size()); }
   int BoundaryCount() const override { return static_cast<int>(m_boundary.size()); }
   SurfaceExtractor* Surface() override { return &m_surface; }

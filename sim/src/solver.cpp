@@ -502,6 +502,60 @@ Status Solver::Upload(const HostFluid& fluid) {
   return Status::Ok();
 }
 
+Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress& progress) {
+  if (!(seconds > 0.0) || !std::isfinite(seconds)) {
+    return Status::Error("settle time " + std::to_string(seconds) + " s: must be a positive number of seconds");
+  }
+  if (m_totals.steps != 0) return Status::Error("settle: only before the first step (it replaces the start)");
+  const auto begin = std::chrono::steady_clock::now();
+  const ReuseParams reuse = m_scene.reuse;
+  if (reuse.enabled) {  // every particle computes while settling
+    ReuseParams off = reuse;
+    off.enabled = false;
+    if (Status s = SetReuse(off); !s) return s;
+  }
+  SettleReport r;
+  double alpha = 0.1;
+  int downhill = 0;
+  while (m_last.time < seconds) {
+    if (Status s = Step(); !s) return s;
+    ++r.steps;
+    // FIRE (Bitzek et al. 2006) with the solver's CFL step as its step: mix the velocities toward the
+    // forces while they do work, stop everything when they do not.
+    const FireSums sums = m_backend->FireReduce();
+    r.maxAccel = std::sqrt(sums.maxAccel2);
+    if (sums.power > 0.0) {
+      const double mix = alpha * std::sqrt(sums.speed2 / std::max(sums.accel2, 1e-30));
+      m_backend->FireMix(static_cast<float>(1.0 - alpha), static_cast<float>(mix));
+      if (++downhill > 5) alpha *= 0.99;
+    } else {
+      m_backend->FireMix(0.0f, 0.0f);
+      alpha = 0.1;
+      downhill = 0;
+    }
+    if (progress && !progress(std::min(m_last.time, seconds))) {
+      r.stopped = true;
+      break;
+    }
+  }
+  m_backend->FireMix(0.0f, 0.0f);
+  r.time = m_last.time;
+  for (BodyMotion& b : m_bodies) {  // a body stays where it is, at rest, on the restarted clock
+    b.from = b.to = b.pose;
+    b.fromTime = b.toTime = 0.0;
+    b.velocity = b.angular = Vec3{};
+  }
+  m_last = StepInfo{};
+  m_totals = Totals{};
+  m_maxAccel = 0.0f;
+  if (reuse.enabled) {
+    if (Status s = SetReuse(reuse); !s) return s;
+  }
+  r.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (report) *report = r;
+  return Status::Ok();
+}
+
 Status Solver::SetReuse(const ReuseParams& reuse) {
   if (Status s = ValidateReuse(reuse); !s) return s;
   m_scene.reuse = reuse;

@@ -4,6 +4,7 @@
 // backends: see sim/src/stages.h for the per-particle stages and sim/src/backend_impl.h for the step.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -56,6 +57,18 @@ struct Totals {
   double stepSeconds = 0.0;      // wall time in Step()
 };
 
+/// What Solver::Settle did.
+struct SettleReport {
+  double time = 0.0;         // s of steps taken (simulated, then discarded: the run starts at t = 0)
+  int64_t steps = 0;
+  float maxAccel = 0.0f;     // m/s^2, the largest |a| at the last step (gravity included; 0 at a rest state)
+  double wallSeconds = 0.0;
+  bool stopped = false;      // the progress callback asked to stop before `seconds`
+};
+/// Called after every step of a Settle with the simulated seconds done; returning false stops it there
+/// (a caller that draws a progress bar limits its own redraw rate).
+using SettleProgress = std::function<bool(double done)>;
+
 class Backend;
 struct Physics;
 
@@ -68,6 +81,14 @@ class Solver {
 
   /// Advances one time step. Fails only in validate mode (a non-finite value, named by stage and particle).
   Status Step();
+
+  /// Relaxes the water toward a rest state before a run (docs/physics.md, "Tenth session"): `seconds`
+  /// of the solver's own steps, each followed by FIRE's velocity mixing (Bitzek et al. 2006): while the
+  /// forces do work (sum a.v > 0) v <- (1 - alpha) v + alpha |v| a/|a|, with alpha falling from 0.1 by
+  /// 1 % per step after five such steps in a row; when they do not, every particle stops and alpha is
+  /// 0.1 again. Reuse is off meanwhile. Afterwards every velocity is zero and the clock, the step count
+  /// and the totals restart at 0: the settled state replaces the start. Only before the first Step.
+  Status Settle(double seconds, SettleReport* report, const SettleProgress& progress = {});
 
   const StepInfo& LastStep() const { return m_last; }
   const Totals& GetTotals() const { return m_totals; }
