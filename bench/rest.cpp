@@ -29,7 +29,7 @@ using sphxr::sim::Vec4;
 void Usage() {
   std::fprintf(stderr,
                "usage: sphxr_bench_rest [--scene FILE] [--windows N] [--window S] [--threads N] [--wall-pressure W] [--detail]\n"
-               "                        [--energy] [--damp FROM UNTIL RATE] [--fire UNTIL]\n"
+               "                        [--energy] [--damp FROM UNTIL RATE] [--settle S]\n"
                "  --scene FILE  scene (default %s/tank_rest.json)\n"
                "  --windows N   number of windows (default 6)\n"
                "  --window S    simulated seconds per window (default 0.5)\n"
@@ -41,9 +41,8 @@ void Usage() {
                "                the fluid's and the walls' internal energy)\n"
                "  --damp FROM UNTIL RATE  multiply every velocity by exp(-RATE dt) after each step between FROM and\n"
                "                UNTIL seconds (a quench: does the motion come back once it is off?)\n"
-               "  --fire UNTIL  minimise the energy until UNTIL seconds: after each step, FIRE's velocity mixing\n"
-               "                (Bitzek et al. 2006) with the step's accelerations, velocities zeroed when a.v < 0;\n"
-               "                then the plain solver (does water started at a rest state stay there?)\n",
+               "  --settle S    first Solver::Settle for S simulated seconds (FIRE on the solver's steps, Bitzek et\n"
+               "                al. 2006; sphxr --settle); the windows then start at its rest state, at t = 0\n",
                SPHXR_SCENES_DIR);
 }
 
@@ -60,7 +59,7 @@ int main(int argc, char** argv) {
   std::string scenePath = std::string(SPHXR_SCENES_DIR) + "/tank_rest.json";
   double windows = 6, window = 0.5, threads = 0;
   double dampFrom = -1.0, dampUntil = -1.0, dampRate = 0.0;  // --damp: no damping unless asked
-  double fireUntil = -1.0;                                     // --fire: no minimising unless asked
+  double settle = 0.0;                                         // --settle: none unless asked
   bool detail = false, energy = false;
   double energyStart = 0.0;
   std::string wallPressure;
@@ -77,8 +76,8 @@ int main(int argc, char** argv) {
           !(dampFrom >= 0.0) || !(dampUntil > dampFrom) || !ParsePositive(argv[a + 3], &dampRate))
         return std::fprintf(stderr, "sphxr_bench_rest: --damp wants FROM UNTIL RATE: 0 <= FROM < UNTIL seconds, RATE > 0 per second\n"), 2;
       a += 3;
-    } else if (!std::strcmp(argv[a], "--fire") && hasValue) {
-      if (!ParsePositive(argv[++a], &fireUntil)) return std::fprintf(stderr, "sphxr_bench_rest: --fire wants positive seconds\n"), 2;
+    } else if (!std::strcmp(argv[a], "--settle") && hasValue) {
+      if (!ParsePositive(argv[++a], &settle)) return std::fprintf(stderr, "sphxr_bench_rest: --settle wants positive seconds\n"), 2;
     } else if (!std::strcmp(argv[a], "--energy")) {
       energy = true;
     } else if (!std::strcmp(argv[a], "--detail")) {
@@ -118,9 +117,15 @@ int main(int argc, char** argv) {
   std::printf("| window (s) | drift median | q90 | max (spacings) | mean speed (mm/s) | max speed (mm/s) | clamped |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|\n");
   HostFluid previous, damped;
-  double fireAlpha = 0.1;  // --fire's state
-  int firePositive = 0;
-  float fireMaxAccel = 0.0f;
+  if (settle > 0.0) {
+    sphxr::sim::SettleReport report;
+    if (sphxr::Status s = solver->Settle(settle, &report); !s) {
+      std::fprintf(stderr, "sphxr_bench_rest: %s\n", s.message().c_str());
+      return 1;
+    }
+    std::printf("settled: %.4g s, %lld steps, %.1f s wall; largest |a| at the end %.3g m/s^2; windows from t = 0\n",
+                report.time, static_cast<long long>(report.steps), report.wallSeconds, report.maxAccel);
+  }
   solver->Download(&previous);
   sphxr::sim::HostBoundary walls;  // static walls: fetched once, for --energy
   if (energy) solver->DownloadBoundary(&walls);
@@ -132,42 +137,6 @@ int main(int argc, char** argv) {
         return 1;
       }
       clamped += solver->LastStep().clamped;
-      if (solver->Time() <= fireUntil) {
-        // FIRE on the solver's own symplectic Euler steps: v <- (1 - alpha) v + alpha |v| a/|a| while the
-        // accelerations do work (a.v > 0), v <- 0 and alpha reset when they do not.
-        HostFluid& f = damped;
-        solver->Download(&f);
-        double power = 0.0, vv = 0.0, aa = 0.0;
-        float aMax = 0.0f;
-        for (size_t i = 0; i < f.size(); ++i) {
-          const Vec4 v = f.velocity[i], ac = f.acceleration[i];
-          power += static_cast<double>(v.x) * ac.x + static_cast<double>(v.y) * ac.y + static_cast<double>(v.z) * ac.z;
-          vv += static_cast<double>(v.x) * v.x + static_cast<double>(v.y) * v.y + static_cast<double>(v.z) * v.z;
-          aa += static_cast<double>(ac.x) * ac.x + static_cast<double>(ac.y) * ac.y + static_cast<double>(ac.z) * ac.z;
-          aMax = std::max(aMax, std::sqrt(ac.x * ac.x + ac.y * ac.y + ac.z * ac.z));
-        }
-        fireMaxAccel = aMax;
-        if (power > 0.0) {
-          const float mix = static_cast<float>(fireAlpha * std::sqrt(vv / std::max(aa, 1e-30)));
-          const float keep = static_cast<float>(1.0 - fireAlpha);
-          for (size_t i = 0; i < f.size(); ++i) {
-            Vec4& v = f.velocity[i];
-            const Vec4 ac = f.acceleration[i];
-            v.x = keep * v.x + mix * ac.x;
-            v.y = keep * v.y + mix * ac.y;
-            v.z = keep * v.z + mix * ac.z;
-          }
-          if (++firePositive > 5) fireAlpha *= 0.99;
-        } else {
-          for (Vec4& v : f.velocity) v.x = v.y = v.z = 0.0f;
-          fireAlpha = 0.1;
-          firePositive = 0;
-        }
-        if (sphxr::Status s = solver->Upload(f); !s) {
-          std::fprintf(stderr, "sphxr_bench_rest: %s\n", s.message().c_str());
-          return 1;
-        }
-      }
       if (solver->Time() > dampFrom && solver->Time() <= dampUntil) {
         // The quench experiment (docs/physics.md): every velocity times exp(-rate dt) after each step.
         HostFluid& f = damped;  // reused: no allocation per step
@@ -209,7 +178,6 @@ int main(int argc, char** argv) {
     std::printf("| %.2f-%.2f | %.3f | %.3f | %.3f | %.2f | %.2f | %lld |\n", window * (w - 1), window * w,
                 drift[drift.size() / 2], drift[drift.size() * 9 / 10], drift.back(),
                 1e3 * speedSum / static_cast<double>(current.size()), 1e3 * speedMax, static_cast<long long>(clamped));
-    if (solver->Time() <= fireUntil + window) std::printf("  FIRE: max |a| %.3g m/s^2 at the window's last step\n", fireMaxAccel);
     std::fflush(stdout);
     if (energy) {
       const sphxr::sim::EnergySummary e = sphxr::sim::SphEnergy(solver->Scene(), solver->ParticleMass(), current, walls);

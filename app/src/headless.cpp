@@ -81,7 +81,7 @@ Status ParseInt(const std::string& flag, const char* text, int64_t lo, int64_t h
 /// A progress bar on a terminal, redrawn at most ten times a second.
 class Progress {
  public:
-  explicit Progress(bool enabled) : m_enabled(enabled) {}
+  explicit Progress(bool enabled, const char* label = "") : m_enabled(enabled), m_label(label) {}
   void Update(double fraction, double simTime, int64_t steps, double msPerStep) {
     if (!m_enabled) return;
     const auto now = std::chrono::steady_clock::now();
@@ -89,7 +89,7 @@ class Progress {
     m_last = now;
     const int width = 30;
     const int filled = std::clamp(static_cast<int>(fraction * width), 0, width);
-    std::fprintf(stderr, "\r[%.*s%.*s] %3d%%  t = %.4f s  step %lld  %.2f ms/step ", filled,
+    std::fprintf(stderr, "\r%s[%.*s%.*s] %3d%%  t = %.4f s  step %lld  %.2f ms/step ", m_label, filled,
                  "##############################", width - filled, "                              ",
                  static_cast<int>(fraction * 100.0), simTime, static_cast<long long>(steps), msPerStep);
     m_open = fraction < 1.0;
@@ -104,6 +104,7 @@ class Progress {
 
  private:
   bool m_enabled;
+  const char* m_label;
   bool m_open = false;
   std::chrono::steady_clock::time_point m_last{};
 };
@@ -125,8 +126,8 @@ DamBreakMeasure MeasureDamBreak(const DamBreakProbe& probe, const sim::HostFluid
 }  // namespace
 
 std::string UsageText() {
-  return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--device auto|cpu|cuda]\n"
-         "             [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
+  return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--settle S]\n"
+         "             [--device auto|cpu|cuda] [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
          "             [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
@@ -146,6 +147,9 @@ std::string UsageText() {
          "  --scene FILE      JSON scene (default: " SPHXR_SCENES_DIR "/dam_break.json)\n"
          "  --time S          simulated seconds to run (default: the scene's run.time)\n"
          "  --steps N         number of steps instead of a time\n"
+         "  --settle S        before the run, relax the water to rest for S simulated seconds (energy\n"
+         "                    minimisation on the solver's steps; the run then starts at t = 0 from that\n"
+         "                    state; default: the scene's run.settle; 0: none)\n"
          "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda\n"
          "  --threads T       CPU backend threads (0 = all cores)\n"
          "  --spacing H       particle spacing in m (rescales the particle count of the scene)\n"
@@ -208,6 +212,9 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     } else if (arg == "--time") {
       if (Status s = value(&v); !s) return s;
       if (Status s = ParseDouble(arg, v, 1e-9, 1e6, &out->time); !s) return s;
+    } else if (arg == "--settle") {
+      if (Status s = value(&v); !s) return s;
+      if (Status s = ParseDouble(arg, v, 0.0, 3600.0, &out->settle); !s) return s;
     } else if (arg == "--steps") {
       if (Status s = value(&v); !s) return s;
       if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->steps); !s) return s;
@@ -330,6 +337,7 @@ std::string HeadlessOnlyOptions(const Options& options) {
   add(options.exportSurfaceEvery > 0, "--export-surface-every");
   add(options.time > 0.0, "--time");
   add(options.steps > 0, "--steps");
+  add(options.settle >= 0.0, "--settle");
   return out;
 }
 
@@ -439,7 +447,27 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     stats << "\n";
   }
 
-  Progress progress(options.progress == 1 || (options.progress == -1 && isatty(STDERR_FILENO)));
+  const bool showProgress = options.progress == 1 || (options.progress == -1 && isatty(STDERR_FILENO));
+  // Ctrl-C/SIGTERM from here on stop the settling or the run after the step in progress.
+  InterruptScope interruptScope;
+  const double settle = options.settle >= 0.0 ? options.settle : scene.runSettle;
+  if (settle > 0.0) {
+    SPHXR_LOG_INFO("settling: %g simulated s of energy minimisation (FIRE) before t = 0", settle);
+    Progress bar(showProgress, "settling ");
+    const auto t0 = std::chrono::steady_clock::now();
+    auto update = [&](double done) {
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const int64_t steps = solver->GetTotals().steps;
+      bar.Update(done / settle, done, steps, steps > 0 ? 1e3 * wall / static_cast<double>(steps) : 0.0);
+      return !g_interrupt;
+    };
+    if (Status s = solver->Settle(settle, &summary->settle, update); !s) return Status::Error("--settle: " + s.message());
+    bar.Finish();
+    SPHXR_LOG_INFO("settled: %.4g s in %lld steps (%.1f s wall); largest |a| at the end %.3g m/s^2; the run starts here",
+                   summary->settle.time, static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds,
+                   summary->settle.maxAccel);
+  }
+  Progress progress(showProgress);
   sim::HostFluid host;
   auto exportNow = [&](int64_t step) -> Status {
     solver->Download(&host);
@@ -500,7 +528,6 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   };
   if (Status s = frameNow(); !s) return s;
 
-  InterruptScope interruptScope;
   double activeSum = 0.0;
   double forceSum = 0.0;
   double nextFrame = 0.0;  // paddles: display frames at paddleFrameRate get new targets
@@ -643,6 +670,12 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                 "threshold %g, idle %d)\n",
                 100.0 * summary->meanActiveFraction, scene.setup.reuse.delta1, scene.setup.reuse.delta2,
                 scene.setup.reuse.threshold, scene.setup.reuse.idle);
+  }
+  if (summary->settle.steps > 0) {
+    std::printf("  settled         %.4g s of energy minimisation before t = 0%s (%lld steps, %.2f s wall; largest |a| "
+                "at the end %.3g m/s^2)\n",
+                summary->settle.time, summary->settle.stopped ? ", stopped early" : "",
+                static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds, summary->settle.maxAccel);
   }
   if (summary->interrupted) {
     std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n", summary->interrupted == SIGINT ? "SIGINT" : "SIGTERM",

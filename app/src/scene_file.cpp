@@ -213,7 +213,7 @@ class Reader {
     if (root.contains("run")) {
       const json& run = root["run"];
       if (!run.is_object()) return Error("run", "must be an object");
-      CheckKeys(run, "run", {"time", "steps"});
+      CheckKeys(run, "run", {"time", "steps", "settle"});
       if (run.contains("time")) {
         if (Status st = Number(run["time"], "run.time", &m_out->runTime); !st) return st;
         if (m_out->runTime <= 0) return Error("run.time", "must be positive");
@@ -223,6 +223,10 @@ class Reader {
           return Error("run.steps", "must be a positive integer");
         }
         m_out->runSteps = run["steps"].get<int64_t>();
+      }
+      if (run.contains("settle")) {
+        if (Status st = Number(run["settle"], "run.settle", &m_out->runSettle); !st) return st;
+        if (m_out->runSettle < 0 || m_out->runSettle > 3600) return Error("run.settle", "must be 0 to 3600 seconds");
       }
     }
     if (root.contains("probe")) {

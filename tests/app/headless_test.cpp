@@ -45,7 +45,7 @@ TEST(CommandLineTest, AcceptsEveryFlag) {
   const std::vector<std::string> args = {
       "--headless", "--scene", "x.json", "--steps", "20", "--device", "cpu", "--threads", "2", "--spacing", "0.01",
       "--set", "stiffness=1e5", "--set", "cfl=0.3", "--export-every", "10", "--out", "dir", "--export-format", "vtk",
-      "--stats", "s.csv", "--validate", "--no-progress"};
+      "--stats", "s.csv", "--validate", "--no-progress", "--settle", "2.5"};
   const Status s = Parse(args, &o);
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_EQ(o.mode, Mode::kHeadless);
@@ -62,6 +62,7 @@ TEST(CommandLineTest, AcceptsEveryFlag) {
   EXPECT_EQ(o.statsPath, "s.csv");
   EXPECT_TRUE(o.validate);
   EXPECT_EQ(o.progress, 0);
+  EXPECT_DOUBLE_EQ(o.settle, 2.5);
   EXPECT_FALSE(o.help);
 
   ASSERT_TRUE(Parse({"--time", "0.5", "--device", "cuda", "--progress"}, &o).ok());
@@ -117,6 +118,7 @@ TEST(CommandLineTest, DefaultsWhenNothingIsGiven) {
   EXPECT_EQ(o.exportFormat, "ply");
   EXPECT_EQ(o.progress, -1);
   EXPECT_FALSE(o.validate);
+  EXPECT_LT(o.settle, 0.0) << "the scene's run.settle";
   // the default scene is the dam break, and it exists
   EXPECT_EQ(std::filesystem::path(o.scenePath).filename(), "dam_break.json");
   EXPECT_TRUE(std::filesystem::exists(o.scenePath)) << o.scenePath;
@@ -125,7 +127,7 @@ TEST(CommandLineTest, DefaultsWhenNothingIsGiven) {
 TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
   // Values for the documented flags that take one; a flag missing here and taking a value fails below.
   const std::map<std::string, std::string> values = {
-      {"--scene", "a.json"}, {"--time", "1"},         {"--steps", "5"},          {"--device", "cpu"},
+      {"--scene", "a.json"}, {"--time", "1"},         {"--steps", "5"},          {"--settle", "2"},          {"--device", "cpu"},
       {"--threads", "1"},    {"--spacing", "0.01"},   {"--set", "cfl=0.3"},      {"--export-every", "2"},
       {"--out", "d"},        {"--export-format", "ply"}, {"--stats", "f.csv"}, {"--reuse", "on"},
       {"--export-surface-every", "3"}, {"--surface-format", "obj"},
@@ -170,6 +172,8 @@ TEST(CommandLineTest, RejectsBadValuesNamingTheFlag) {
   ExpectRejected({"--steps", "10", "--time", "1"}, {"--time", "--steps"});
   ExpectRejected({"--time", "1", "--steps", "10"}, {"--time", "--steps"});
   ExpectRejected({"--steps", "0"}, {"--steps"});
+  ExpectRejected({"--settle", "-1"}, {"--settle", "0 to 3600"});
+  ExpectRejected({"--settle", "nan"}, {"--settle", "not a number"});
   ExpectRejected({"--steps", "1e3"}, {"--steps"});
   ExpectRejected({"--spacing", "0"}, {"--spacing"});
   ExpectRejected({"--spacing", "-0.01"}, {"--spacing"});
@@ -575,6 +579,75 @@ void InterruptRun(int signal, const char* name) {
   std::snprintf(last, sizeof(last), "particles_%06lld.ply", steps);
   const Ply ply = ReadPly((std::filesystem::path(out) / last).string());
   EXPECT_EQ(ply.vertices, static_cast<size_t>(kSmallSceneParticles)) << "the state at the interrupted step is exported";
+}
+
+// --settle relaxes the water before the run and then restarts the clock: the summary says so, the run's
+// own steps are counted from 1 at t = dt, and the first export is the settled state, at rest.
+TEST(HeadlessTest, SettleRunsBeforeTheRunAndRestartsTheClock) {
+  test::TempDir dir("settle");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string csv = dir.File("stats.csv");
+  const std::string out = dir.File("frames");
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --settle 0.05 --steps 10 --stats " + Quote(csv) +
+                                 " --export-every 10 --out " + Quote(out) + " --threads 1 --no-progress",
+                             dir);
+  ASSERT_TRUE(r.Exited() && r.Code() == 0) << "stdout:\n" << r.out << "\nstderr:\n" << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"(settled +([0-9.]+) s of energy minimisation before t = 0 \((\d+) steps)")))
+      << r.out;
+  EXPECT_GE(std::stod(m[1]), 0.05);
+  EXPECT_LT(std::stod(m[1]), 0.052) << "one step past the settle time at most";
+  EXPECT_GT(std::stoll(m[2]), 10);
+  EXPECT_NE(r.out.find("steps           10 "), std::string::npos) << "the settle's steps are not the run's:\n" << r.out;
+  EXPECT_NE(r.err.find("settling: 0.05 simulated s"), std::string::npos) << r.err;
+  const std::vector<std::string> rows = Lines(test::ReadFile(csv));
+  ASSERT_EQ(rows.size(), 11u);
+  const std::vector<std::string> first = Split(rows[1], ',');
+  EXPECT_EQ(first[0], "1");
+  EXPECT_DOUBLE_EQ(std::stod(first[1]), std::stod(first[2])) << "the clock restarts: t = dt after the first step";
+  const Ply ply = ReadPly((std::filesystem::path(out) / "particles_000000.ply").string());
+  EXPECT_EQ(ply.vertices, static_cast<size_t>(kSmallSceneParticles));
+}
+
+// A signal during the settling stops it too, with the summary and the exit code of an interrupted run.
+TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
+  test::TempDir dir("settle_interrupt");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(o, 1);
+    dup2(e, 2);
+    ::signal(SIGTERM, SIG_DFL);
+    execl(SPHXR_BINARY, SPHXR_BINARY, "--headless", "--scene", scene.c_str(), "--settle", "3600", "--steps", "5",
+          "--threads", "1", "--no-progress", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  while (test::ReadFile(errPath).find("settling:") == std::string::npos &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // a few hundred steps into it
+  ASSERT_EQ(kill(pid, SIGTERM), 0);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() - start > std::chrono::seconds(120)) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      FAIL() << "the settle did not stop after SIGTERM";
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const std::string stdoutText = test::ReadFile(outPath), stderrText = test::ReadFile(errPath);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping:\n" << stderrText;
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << stderrText;
+  EXPECT_NE(stdoutText.find("energy minimisation before t = 0, stopped early"), std::string::npos) << stdoutText;
+  EXPECT_NE(stdoutText.find("interrupted     by SIGTERM"), std::string::npos) << stdoutText;
+  EXPECT_NE(stdoutText.find("steps           0 "), std::string::npos) << "no step of the run was taken:\n" << stdoutText;
 }
 
 TEST(HeadlessTest, InterruptKeepsWholeRowsAndTheLastState) { InterruptRun(SIGINT, "SIGINT"); }

@@ -68,6 +68,7 @@ TEST(SceneFileTest, MinimalSceneParses) {
   EXPECT_EQ(scene.setup.gravity.y, defaults.gravity.y);
   EXPECT_EQ(scene.setup.openTop, defaults.openTop);
   EXPECT_EQ(scene.setup.boundaryLayers, defaults.boundaryLayers);
+  EXPECT_EQ(scene.runSettle, 0.0) << "no settling unless the scene asks";
   EXPECT_FALSE(scene.damBreak.has_value());
   // and the solver accepts it: 5 x 5 x 5 particles at the default spacing 0.02 m
   std::unique_ptr<sim::Solver> solver;
@@ -87,7 +88,7 @@ TEST(SceneFileTest, FullSceneParsesEveryKey) {
     "fluid": [ { "min": [-1, 0, -0.5], "max": [0, 0.5, 0.5], "velocity": [1, 0, -2] },
                { "min": [0.5, 0.5, 0], "max": [0.6, 0.6, 0.1] } ],
     "obstacles": [ { "min": [0.2, 0, -0.1], "max": [0.3, 0.2, 0.1] } ],
-    "run": { "time": 1.5, "steps": 100 },
+    "run": { "time": 1.5, "steps": 100, "settle": 12.5 },
     "probe": { "dam_break_column_width": 0.25 }
   })");
   EXPECT_TRUE(scene.warnings.empty());
@@ -115,6 +116,7 @@ TEST(SceneFileTest, FullSceneParsesEveryKey) {
   EXPECT_FLOAT_EQ(scene.setup.obstacles[0].max.y, 0.2f);
   EXPECT_DOUBLE_EQ(scene.runTime, 1.5);
   EXPECT_EQ(scene.runSteps, 100);
+  EXPECT_DOUBLE_EQ(scene.runSettle, 12.5);
   ASSERT_TRUE(scene.damBreak.has_value());
   EXPECT_FLOAT_EQ(scene.damBreak->columnWidth, 0.25f);
   EXPECT_FLOAT_EQ(scene.damBreak->wallX, -1.0f);
@@ -192,6 +194,9 @@ TEST(SceneFileTest, NonNumbersRefused) {
   ExpectRefused(R"({ "solver": { "spacing": Infinity }, )" + tank + "}", {"not valid JSON"});
   ExpectRefused(R"({ "gravity": [0, "down", 0], )" + tank + "}", {"gravity[1]", "must be a number"});
   ExpectRefused(R"({ "run": { "time": "long" }, )" + tank + "}", {"run.time", "must be a number"});
+  ExpectRefused(R"({ "run": { "settle": "yes" }, )" + tank + "}", {"run.settle", "must be a number"});
+  ExpectRefused(R"({ "run": { "settle": -1 }, )" + tank + "}", {"run.settle", "0 to 3600 seconds"});
+  ExpectRefused(R"({ "run": { "settle": 1e5 }, )" + tank + "}", {"run.settle", "0 to 3600 seconds"});
 }
 
 // A number literal too large for a double (1e999) makes nlohmann::json::parse throw json::out_of_range

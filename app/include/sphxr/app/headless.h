@@ -17,6 +17,7 @@ struct Options {
   std::string scenePath;
   double time = 0.0;        // s; 0 = the scene's run.time (or run.steps)
   int64_t steps = 0;        // 0 = use time
+  double settle = -1.0;     // s of Solver::Settle before the run; -1 = the scene's run.settle, 0 = none
   sim::Device device = sim::Device::kAuto;
   int threads = 0;          // 0 = all cores
   float spacing = 0.0f;     // m; 0 = the scene's spacing
@@ -90,6 +91,7 @@ struct RunSummary {
   float paddlePeakHaptic = 0.0f;     // largest haptic amplitude over the run
   int64_t frames = 0;                // PNG frames written to --frames DIR
   int interrupted = 0;               // the signal (SIGINT, SIGTERM) that stopped the run early, else 0
+  sim::SettleReport settle;          // --settle / run.settle (time 0: not settled)
 };
 
 /// Runs a scene headless: load, apply overrides, simulate, export, summarise. The summary is printed

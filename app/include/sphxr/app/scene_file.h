@@ -35,6 +35,7 @@ struct SceneFile {
   sim::SceneSetup setup;
   double runTime = 0.0;       // s, default run length ("run.time")
   int64_t runSteps = 0;       // default step count ("run.steps"), used when runTime == 0
+  double runSettle = 0.0;     // s of Solver::Settle before a headless run ("run.settle"; 0: none)
   std::optional<DamBreakProbe> damBreak;
   /// "paddles" section (absent: none). Scripted paddles carry their loaded trajectory.
   std::vector<interaction::PaddleDesc> paddles;
