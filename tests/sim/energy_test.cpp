@@ -15,23 +15,10 @@
 
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
+#include "test_scenes.h"
 
 namespace sphxr::sim {
 namespace {
-
-// tank_rest.json at twice the spacing: 10 x 10 x 5 particles of water in a closed box.
-SceneSetup Tank(SceneSetup::WallPressure walls, float alpha) {
-  SceneSetup s;
-  s.params.spacing = 0.02f;
-  s.params.stiffness = 57000.0f;
-  s.params.viscosity = alpha;
-  s.params.boundaryViscosity = alpha;
-  s.params.maxDt = 0.001f;
-  s.tank = {{0.0f, 0.0f, 0.0f}, {0.2f, 0.3f, 0.1f}};
-  s.fluid.push_back(FluidBlock{{{0.0f, 0.0f, 0.0f}, {0.2f, 0.2f, 0.1f}}, {}});
-  s.wallPressure = walls;
-  return s;
-}
 
 struct Trace {
   std::vector<double> total;  // every `every` steps, from step 0
@@ -71,8 +58,8 @@ double MaxDeviation(const Trace& t) {
 // measured 1.7 %), and half of that at half the step (measured 0.49 of it), which a force that is not
 // the derivative of E would not give.
 TEST(Energy, WallDensityWithoutViscosityConservesItToTheIntegratorsError) {
-  const Trace t = RunAndMeasure(Tank(SceneSetup::WallPressure::kWallDensity, 0.0f), 2000, 100);
-  SceneSetup halfStep = Tank(SceneSetup::WallPressure::kWallDensity, 0.0f);
+  const Trace t = RunAndMeasure(test::SmallRestTank(SceneSetup::WallPressure::kWallDensity, 0.0f), 2000, 100);
+  SceneSetup halfStep = test::SmallRestTank(SceneSetup::WallPressure::kWallDensity, 0.0f);
   halfStep.params.fixedDt = 0.0002f;  // the same 0.8 s, sampled at the same times
   const Trace h = RunAndMeasure(halfStep, 4000, 200);
   std::printf("wall_density, alpha 0: max |E - E0| %.3e J (half step %.3e J), max kinetic %.3e J\n", MaxDeviation(t),
@@ -87,7 +74,7 @@ TEST(Energy, WallDensityWithoutViscosityConservesItToTheIntegratorsError) {
 }
 
 TEST(Energy, MirroredWallsDoNotConserveIt) {
-  const Trace t = RunAndMeasure(Tank(SceneSetup::WallPressure::kMirrored, 0.0f), 2000, 100);
+  const Trace t = RunAndMeasure(test::SmallRestTank(SceneSetup::WallPressure::kMirrored, 0.0f), 2000, 100);
   RecordProperty("max_deviation_over_max_kinetic", std::to_string(MaxDeviation(t) / t.maxKinetic));
   std::printf("mirrored, alpha 0: max |E - E0| %.3e J, max kinetic %.3e J, clamps %lld\n", MaxDeviation(t),
               t.maxKinetic, static_cast<long long>(t.clamped));
@@ -95,7 +82,7 @@ TEST(Energy, MirroredWallsDoNotConserveIt) {
 }
 
 TEST(Energy, ViscosityOnlyTakesEnergyOut) {
-  const Trace t = RunAndMeasure(Tank(SceneSetup::WallPressure::kWallDensity, 0.3f), 2000, 100);
+  const Trace t = RunAndMeasure(test::SmallRestTank(SceneSetup::WallPressure::kWallDensity, 0.3f), 2000, 100);
   const double slack = 0.02 * t.maxKinetic;  // the integrator's error, as in the conserving test
   EXPECT_EQ(t.clamped, 0);
   std::printf("wall_density, alpha 0.3: E %.6e -> %.6e J, max kinetic %.3e J\n", t.total.front(), t.total.back(), t.maxKinetic);

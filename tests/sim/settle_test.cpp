@@ -13,23 +13,12 @@
 
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
+#include "test_scenes.h"
 
 namespace sphxr::sim {
 namespace {
 
-// tank_rest.json at twice the spacing: 10 x 10 x 5 particles of water in a closed box.
-SceneSetup Tank() {
-  SceneSetup s;
-  s.params.spacing = 0.02f;
-  s.params.stiffness = 57000.0f;
-  s.params.viscosity = 0.3f;
-  s.params.boundaryViscosity = 0.3f;
-  s.params.maxDt = 0.001f;
-  s.tank = {{0.0f, 0.0f, 0.0f}, {0.2f, 0.3f, 0.1f}};
-  s.fluid.push_back(FluidBlock{{{0.0f, 0.0f, 0.0f}, {0.2f, 0.2f, 0.1f}}, {}});
-  s.wallPressure = SceneSetup::WallPressure::kWallDensity;
-  return s;
-}
+SceneSetup Tank() { return test::SmallRestTank(SceneSetup::WallPressure::kWallDensity, 0.3f); }
 
 EnergySummary Energy(const Solver& solver) {
   HostFluid fluid;
