@@ -20,8 +20,10 @@ namespace {
 struct WallCase {
   const char* name;
   sim::SceneSetup::WallPressure wall;
-  double settle;          // s before the observation window
-  float maxDrift;         // spacings, any particle over the 0.5 s window
+  bool minimise;          // first Solver::Settle for the scene's run.settle seconds (tank_rest.json)
+  double settle;          // s of plain steps before the observation windows
+  int windows;            // observation windows of 0.5 s, each held to the drift bounds
+  float maxDrift;         // spacings, any particle over any 0.5 s window
   float medianDrift;      // spacings
   float pressureTolerance;  // relative, every layer of the lower 80 %
 };
@@ -36,58 +38,77 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   ASSERT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/tank_rest.json", &scene).ok());
   scene.setup.wallPressure = c.wall;
   std::unique_ptr<sim::Solver> solver;
-  ASSERT_TRUE(sim::Solver::Create(scene.setup, sim::SolverConfig{}, &solver).ok());
+  sim::SolverConfig config;
+  // The settled case takes ~150,000 steps of 4,000 particles: one thread does them as fast as two here
+  // (~1.7 ms per step either way; the CPU backend gives the same digits at any thread count) and leaves
+  // the other core to the test ctest -j2 runs beside it.
+  if (c.minimise) config.threads = 1;
+  ASSERT_TRUE(sim::Solver::Create(scene.setup, config, &solver).ok());
   const float dx = scene.setup.params.spacing;
   const float rho0 = scene.setup.params.restDensity;
   const float g = -scene.setup.gravity.y;
 
   // Settle: the lattice starts at exactly rho0 (zero pressure) and compresses under its weight.
+  if (c.minimise) {
+    ASSERT_GT(scene.runSettle, 0.0) << "tank_rest.json declares run.settle";
+    sim::SettleReport report;
+    ASSERT_TRUE(solver->Settle(scene.runSettle, &report).ok());
+    RecordProperty("settle_max_accel", std::to_string(report.maxAccel));
+  }
   const double settle = c.settle, observe = 0.5;
   while (solver->Time() < settle) ASSERT_TRUE(solver->Step().ok());
-  sim::HostFluid before;
-  solver->Download(&before);
-  std::unordered_map<uint32_t, sim::Vec4> start;
-  for (size_t i = 0; i < before.size(); ++i) start[before.id[i]] = before.position[i];
   float meanDensityError = 0.0f;
   int64_t steps = 0;
-  while (solver->Time() < settle + observe) {
-    ASSERT_TRUE(solver->Step().ok());
-    meanDensityError += solver->LastStep().meanDensityError;
-    ++steps;
+  float worstMax = 0.0f, worstMedian = 0.0f;  // spacings, over the windows
+  sim::HostFluid after;
+  for (int w = 0; w < c.windows; ++w) {
+    sim::HostFluid before;
+    solver->Download(&before);
+    std::unordered_map<uint32_t, sim::Vec4> start;
+    for (size_t i = 0; i < before.size(); ++i) start[before.id[i]] = before.position[i];
+    const double end = solver->Time() + observe;
+    while (solver->Time() < end) {
+      ASSERT_TRUE(solver->Step().ok());
+      meanDensityError += solver->LastStep().meanDensityError;
+      ++steps;
+    }
+    solver->Download(&after);
+    ASSERT_EQ(after.size(), before.size());
+
+    // Drift over each observation window (comments below the loop).
+    std::vector<float> drift;
+    for (size_t i = 0; i < after.size(); ++i) {
+      const sim::Vec4 a = after.position[i], b = start.at(after.id[i]);
+      drift.push_back(std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z)) / dx);
+    }
+    std::sort(drift.begin(), drift.end());
+    const float medianDrift = drift[drift.size() / 2], maxDrift = drift.back();
+    EXPECT_LT(maxDrift, c.maxDrift) << "window " << w << ": a particle moved " << maxDrift << " spacings while the water should rest";
+    EXPECT_LT(medianDrift, c.medianDrift) << "window " << w << ": median drift " << medianDrift << " spacings";
+    worstMax = std::max(worstMax, maxDrift);
+    worstMedian = std::max(worstMedian, medianDrift);
   }
   meanDensityError /= static_cast<float>(steps);
-  sim::HostFluid after;
-  solver->Download(&after);
-  ASSERT_EQ(after.size(), before.size());
-
-  // Drift over the observation window. The issue asks for at most 0.1 spacing.
-  // - wall_density (tank_rest's own setting): the water comes to rest (bench/rest.cpp: median drift per
+  RecordProperty("median_drift_spacings", std::to_string(worstMedian));
+  RecordProperty("max_drift_spacings", std::to_string(worstMax));
+  // The issue asks for at most 0.1 spacing.
+  // - wall_density_settled (tank_rest.json as it stands: wall_density and run.settle = 30 s): energy
+  //   minimisation first (Solver::Settle, FIRE on the solver's own steps), then the plain solver.
+  //   Measured (sphxr_bench_rest --settle 30 --windows 40): maximum 0.015-0.054 spacing per window over
+  //   the next 20 s, median 0.000. Held to the issue's 0.1 over four windows (2 s).
+  // - wall_density without the settle: the water comes to rest (bench/rest.cpp: median drift per
   //   0.5 s window 0.13, 0.18, 0.06, 0.05, 0.02, 0.01, 0.008, 0.006, 0.004 spacings) but a few particles
   //   keep rattling: in disordered spots near the floor left by the first second's rearrangement, and at
   //   the free surface. Their maximum per window falls to 0.11-0.22 spacing from 3.5 s on and then
   //   levels off (measured to 8.5 s; docs/physics.md). So the window starts at 4 s; the median is held
-  //   to the issue's 0.1, the maximum loosened to 0.3 spacing (the issue's 0.1 is not met). Why: the
-  //   simple cubic start is not a stable rest state under pressure (bench/lattice_stability.py), so the
-  //   water keeps sliding into lower-energy arrangements (docs/physics.md, "Why still water rattles").
-  //   A Wendland C2 kernel with a consistent mass keeps that lattice but not the free surface still
-  //   (maximum 0.08-0.19) and layers the pressure (+-10 %); not adopted (physics.md, eighth session).
-  //   The surface itself is unstable under the pressure clamp, with any kernel, and its rest states are
-  //   disordered and soft (bench/surface_stability.py; physics.md, ninth session): bursts to 0.25 go on
-  //   past 14 s even with Wendland, damping or a minimiser.
+  //   to the issue's 0.1, the maximum loosened to 0.3 spacing: this case measures the plain solver from
+  //   the lattice, which the issue's bound is not about. Why it rattles: the simple cubic start is not a
+  //   stable rest state under pressure (bench/lattice_stability.py), nor is the free surface of the
+  //   lattice (bench/surface_stability.py), so the water keeps sliding into lower-energy arrangements
+  //   (docs/physics.md, "Why still water rattles" and the ninth session).
   // - mirrored (the default elsewhere): the wall pressure p_b = p_i is not the derivative of any energy
   //   and keeps a ~1 cm/s circulation going (median 0.34, maximum 1.8 spacings over 0.5 s). Loosened to
   //   what is met, so that a regression to real flow still fails.
-  std::vector<float> drift;
-  for (size_t i = 0; i < after.size(); ++i) {
-    const sim::Vec4 a = after.position[i], b = start.at(after.id[i]);
-    drift.push_back(std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z)));
-  }
-  std::sort(drift.begin(), drift.end());
-  const float medianDrift = drift[drift.size() / 2], maxDrift = drift.back();
-  RecordProperty("median_drift_spacings", std::to_string(medianDrift / dx));
-  RecordProperty("max_drift_spacings", std::to_string(maxDrift / dx));
-  EXPECT_LT(maxDrift, c.maxDrift * dx) << "a particle moved " << maxDrift / dx << " spacings while the water should rest";
-  EXPECT_LT(medianDrift, c.medianDrift * dx) << "median drift " << medianDrift / dx << " spacings";
   EXPECT_LT(meanDensityError, 0.01f) << "mean compression over the observation window";
 
   // Hydrostatics: layer-averaged pressure (layers one spacing thick) against rho0 g depth over the lower
@@ -127,8 +148,9 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
 
 INSTANTIATE_TEST_SUITE_P(
     Walls, Hydrostatic,
-    ::testing::Values(WallCase{"wall_density", sim::SceneSetup::WallPressure::kWallDensity, 4.0, 0.3f, 0.1f, 0.05f},
-                      WallCase{"mirrored", sim::SceneSetup::WallPressure::kMirrored, 1.0, 3.0f, 1.0f, 0.08f}),
+    ::testing::Values(WallCase{"wall_density_settled", sim::SceneSetup::WallPressure::kWallDensity, true, 0.0, 4, 0.1f, 0.01f, 0.05f},
+                      WallCase{"wall_density", sim::SceneSetup::WallPressure::kWallDensity, false, 4.0, 1, 0.3f, 0.1f, 0.05f},
+                      WallCase{"mirrored", sim::SceneSetup::WallPressure::kMirrored, false, 1.0, 1, 3.0f, 1.0f, 0.08f}),
     [](const ::testing::TestParamInfo<WallCase>& info) { return std::string(info.param.name); });
 
 }  // namespace
