@@ -524,6 +524,11 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
     // forces while they do work, stop everything when they do not.
     const FireSums sums = m_backend->FireReduce();
     r.maxAccel = std::sqrt(sums.maxAccel2);
+    if (!std::isfinite(sums.power) || !std::isfinite(sums.accel2)) {
+      return Status::Error(Format("settle: the state became non-finite at step %lld (t = %.4g s); rerun with --validate "
+                                  "to find the stage and particle",
+                                  static_cast<long long>(r.steps), m_last.time));
+    }
     if (sums.power > 0.0) {
       const double mix = alpha * std::sqrt(sums.speed2 / std::max(sums.accel2, 1e-30));
       m_backend->FireMix(static_cast<float>(1.0 - alpha), static_cast<float>(mix));

@@ -105,5 +105,20 @@ TEST(SettleTest, RefusesBadTimesAndALateCall) {
   EXPECT_EQ(solver->GetTotals().steps, 1);
 }
 
+// A state that goes non-finite while settling is an error naming the step, not minutes of NaN steps.
+TEST(SettleTest, ANonFiniteStateStopsItWithAnError) {
+  std::unique_ptr<Solver> solver;
+  ASSERT_TRUE(Solver::Create(Tank(), SolverConfig{}, &solver).ok());
+  HostFluid fluid;
+  solver->Download(&fluid);
+  fluid.velocity[17].y = std::numeric_limits<float>::quiet_NaN();
+  ASSERT_TRUE(solver->Upload(fluid).ok());
+  SettleReport report;
+  const Status s = solver->Settle(10.0, &report);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("non-finite"), std::string::npos) << s.message();
+  EXPECT_LT(solver->GetTotals().steps, 5) << "stopped at once";
+}
+
 }  // namespace
 }  // namespace sphxr::sim
