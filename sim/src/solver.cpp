@@ -523,7 +523,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
     // FIRE (Bitzek et al. 2006) with the solver's CFL step as its step: mix the velocities toward the
     // forces while they do work, stop everything when they do not.
     const FireSums sums = m_backend->FireReduce();
-    r.maxAccel = std::sqrt(sums.maxAccel2);
+    r.maxAccel = m_maxAccel;  // this step's largest |a|, from its StepReduction
     if (!std::isfinite(sums.power) || !std::isfinite(sums.accel2)) {
       return Status::Error(Format("settle: the state became non-finite at step %lld (t = %.4g s); rerun with --validate "
                                   "to find the stage and particle",

@@ -592,12 +592,12 @@ struct IntegrateStage {
 };
 
 // ---- settling: FIRE (Bitzek et al. 2006) on the solver's own steps (Solver::Settle) ----------------
-/// Sums over the fluid of the step just taken: the power a.v, |v|^2, |a|^2 and the largest |a|^2.
+/// Sums over the fluid of the step just taken: the power a.v, |v|^2 and |a|^2 (the largest |a| is the
+/// step's own StepReduction).
 struct FireSums {
   double power = 0.0;
   double speed2 = 0.0;
   double accel2 = 0.0;
-  float maxAccel2 = 0.0f;
 };
 
 struct FireSumsOp {
@@ -608,9 +608,7 @@ struct FireSumsOp {
     FireSums s;
     s.power = static_cast<double>(v.x * a.x + v.y * a.y + v.z * a.z);
     s.speed2 = static_cast<double>(v.x * v.x + v.y * v.y + v.z * v.z);
-    const float a2 = a.x * a.x + a.y * a.y + a.z * a.z;
-    s.accel2 = static_cast<double>(a2);
-    s.maxAccel2 = a2;
+    s.accel2 = static_cast<double>(a.x * a.x + a.y * a.y + a.z * a.z);
     return s;
   }
 };
@@ -621,7 +619,6 @@ struct FireSumsCombine {
     r.power = a.power + b.power;
     r.speed2 = a.speed2 + b.speed2;
     r.accel2 = a.accel2 + b.accel2;
-    r.maxAccel2 = fmaxf(a.maxAccel2, b.maxAccel2);
     return r;
   }
 };

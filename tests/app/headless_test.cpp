@@ -519,6 +519,40 @@ TEST(HeadlessTest, ScreenshotIntoAMissingDirectoryRefusedBeforeTheRun) {
                      "cannot write into", 1, "refused before the solver starts (which logs its device):\n");
 }
 
+// Starts the real binary with `args` in a child whose stdout and stderr go to the two files. SIGINT and
+// SIGTERM start at their defaults, as from a terminal: a signal this test's own parent ignores (a
+// background job) must not stay ignored.
+pid_t SpawnSphxr(const std::vector<std::string>& args, const std::string& outPath, const std::string& errPath) {
+  std::vector<char*> argv{const_cast<char*>(SPHXR_BINARY)};
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(o, 1);
+    dup2(e, 2);
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
+    execv(SPHXR_BINARY, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits for the child until `deadline`; past it the child is killed and false returned.
+bool WaitUntil(pid_t pid, std::chrono::steady_clock::time_point deadline, int* status) {
+  while (waitpid(pid, status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, status, 0);
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
+
 // Ctrl-C (or a SIGTERM from a batch system) during a long run stops it after the step in progress and
 // loses nothing: whole CSV rows, one per step the summary counts, the state exported at that step, and
 // the shell's exit code 128 + signal.
@@ -527,20 +561,10 @@ void InterruptRun(int signal, const char* name) {
   const std::string scene = dir.Write("scene.json", kSmallScene);
   const std::string csv = dir.File("stats.csv"), outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
   const std::string out = (dir.path() / "out").string();
-  const pid_t pid = fork();
+  const pid_t pid = SpawnSphxr({"--headless", "--scene", scene, "--steps", "100000000", "--stats", csv, "--export-every",
+                                "7", "--out", out, "--threads", "1", "--no-progress"},
+                               outPath, errPath);
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(o, 1);
-    dup2(e, 2);
-    // As from a terminal: a signal this test's own parent ignores (a background job) must not stay ignored.
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGTERM, SIG_DFL);
-    execl(SPHXR_BINARY, SPHXR_BINARY, "--headless", "--scene", scene.c_str(), "--steps", "100000000", "--stats", csv.c_str(),
-          "--export-every", "7", "--out", out.c_str(), "--threads", "1", "--no-progress", static_cast<char*>(nullptr));
-    _exit(127);
-  }
   // Signal once the run is under way (the CSV's buffer has reached the file).
   const auto start = std::chrono::steady_clock::now();
   auto written = [&]() {
@@ -553,14 +577,7 @@ void InterruptRun(int signal, const char* name) {
   }
   ASSERT_EQ(kill(pid, signal), 0);
   int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() - start > std::chrono::seconds(240)) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      FAIL() << "the run did not stop after " << name;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  ASSERT_TRUE(WaitUntil(pid, start + std::chrono::seconds(240), &status)) << "the run did not stop after " << name;
   const std::string stdoutText = test::ReadFile(outPath), stderrText = test::ReadFile(errPath);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping:\n" << stderrText;
   EXPECT_EQ(WEXITSTATUS(status), 128 + signal) << stderrText;
@@ -614,18 +631,10 @@ TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
   test::TempDir dir("settle_interrupt");
   const std::string scene = dir.Write("scene.json", kSmallScene);
   const std::string outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
-  const pid_t pid = fork();
+  const pid_t pid = SpawnSphxr(
+      {"--headless", "--scene", scene, "--settle", "3600", "--steps", "5", "--threads", "1", "--no-progress"}, outPath,
+      errPath);
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(o, 1);
-    dup2(e, 2);
-    ::signal(SIGTERM, SIG_DFL);
-    execl(SPHXR_BINARY, SPHXR_BINARY, "--headless", "--scene", scene.c_str(), "--settle", "3600", "--steps", "5",
-          "--threads", "1", "--no-progress", static_cast<char*>(nullptr));
-    _exit(127);
-  }
   const auto start = std::chrono::steady_clock::now();
   while (test::ReadFile(errPath).find("settling:") == std::string::npos &&
          std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
@@ -634,14 +643,7 @@ TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // a few hundred steps into it
   ASSERT_EQ(kill(pid, SIGTERM), 0);
   int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() - start > std::chrono::seconds(120)) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      FAIL() << "the settle did not stop after SIGTERM";
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  ASSERT_TRUE(WaitUntil(pid, start + std::chrono::seconds(120), &status)) << "the settle did not stop after SIGTERM";
   const std::string stdoutText = test::ReadFile(outPath), stderrText = test::ReadFile(errPath);
   ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping:\n" << stderrText;
   EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << stderrText;

@@ -39,7 +39,7 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   scene.setup.wallPressure = c.wall;
   std::unique_ptr<sim::Solver> solver;
   sim::SolverConfig config;
-  // The settled case takes ~150,000 steps of 4,000 particles: one thread does them as fast as two here
+  // The settled case takes ~225,000 steps of 4,000 particles: one thread does them as fast as two here
   // (~1.7 ms per step either way; the CPU backend gives the same digits at any thread count) and leaves
   // the other core to the test ctest -j2 runs beside it.
   if (c.minimise) config.threads = 1;
