@@ -141,7 +141,9 @@ TEST(Reuse, GuardKeepsADeepTankAsCalmAsReuseOff) {
   scene.fluid.push_back(pool);
   auto maxSpeed = [&](bool reuseOn) {
     SceneSetup s = scene;
-    if (reuseOn) EXPECT_TRUE(ApplyReusePreset("balanced", &s.reuse));
+    if (reuseOn) {
+      EXPECT_TRUE(ApplyReusePreset("balanced", &s.reuse));
+    }
     auto solver = Make(s);
     float v = 0.0f;
     double active = 0.0;
@@ -152,7 +154,9 @@ TEST(Reuse, GuardKeepsADeepTankAsCalmAsReuseOff) {
       active += solver->LastStep().activeFraction;
       ++steps;
     }
-    if (reuseOn) EXPECT_LT(active / steps, 1.0) << "the guard must not switch reuse off entirely";
+    if (reuseOn) {
+      EXPECT_LT(active / steps, 1.0) << "the guard must not switch reuse off entirely";
+    }
     return v;
   };
   const float off = maxSpeed(false);
