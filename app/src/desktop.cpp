@@ -68,6 +68,7 @@ struct DesktopApp::Impl {
   DesktopHand hand;
   glm::vec3 handPrevious{0.0f};
   SimScene simScene;         // the scene's paddles (with the mouse's) and surface
+  std::shared_ptr<const StateFile> start;  // --load-state: where the scene of the command line starts
   float surfaceCell = 1.0f;  // surface cell size in particle spacings (panel)
   float panelHaptic = 0.0f;
   int64_t surfaceTriangles = 0;
@@ -179,6 +180,8 @@ struct DesktopApp::Impl {
   void MakeSimScene() {
     simScene = SimSceneFromFile(scene);
     simScene.setup = setup;
+    simScene.start = start;
+    simScene.startPath = options.loadState;
     hand.index = 1;
     bool handHeld = false;
     for (const interaction::PaddleDesc& d : simScene.paddles) {
@@ -209,6 +212,7 @@ struct DesktopApp::Impl {
     }
     scene = next;
     setup = scene.setup;
+    start.reset();  // --load-state belongs to the scene of the command line
     MakeSimScene();
     worker->Reset(simScene);
     FrameTank();
@@ -234,6 +238,8 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   m.options = options;
   if (Status s = LoadSceneWithOptions(options, &m.scene); !s) return s;
   m.setup = m.scene.setup;
+  // A bad state file is one line before any window opens.
+  if (Status s = ReadStartState(options.loadState, options.spacing, &m.setup, &m.start); !s) return s;
 
   render::RendererConfig config;
   config.debug = config.debug || options.glDebug;
@@ -287,7 +293,9 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
     solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
     SPHXR_LOG_INFO("simulation on %d CPU threads, one core left for drawing (--threads to change)", solverConfig.threads);
   }
-  if (options.quality != 0 && options.spacing <= 0.0f) {
+  if (m.start && options.quality != 0 && options.spacing <= 0.0f) {
+    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", m.start->spacing);
+  } else if (options.quality != 0 && options.spacing <= 0.0f) {
     QualityChoice choice;
     if (Status s = ChooseQuality(m.setup, solverConfig, 1.0, 1.0, &choice); !s) {
       return Status::Error(options.scenePath + ": " + s.message());

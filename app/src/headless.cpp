@@ -16,6 +16,7 @@
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/quality.h"
 #include "sphxr/app/scene_file.h"
+#include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/sim/measure.h"
 
@@ -127,6 +128,7 @@ DamBreakMeasure MeasureDamBreak(const DamBreakProbe& probe, const sim::HostFluid
 
 std::string UsageText() {
   return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--settle S]\n"
+         "             [--load-state FILE] [--save-state FILE]\n"
          "             [--device auto|cpu|cuda] [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
@@ -150,6 +152,10 @@ std::string UsageText() {
          "  --settle S        before the run, relax the water to rest for S simulated seconds (energy\n"
          "                    minimisation on the solver's steps; the run then starts at t = 0 from that\n"
          "                    state; default: the scene's run.settle; 0: none)\n"
+         "  --save-state FILE write the fluid and the clock to FILE at the end of the run (also when it is\n"
+         "                    stopped early), to start another run from (headless)\n"
+         "  --load-state FILE start from a state file instead of the scene's fluid (the same scene; its\n"
+         "                    spacing is the file's); --time is then the end time on the file's clock\n"
          "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda\n"
          "  --threads T       CPU backend threads (0 = all cores)\n"
          "  --spacing H       particle spacing in m (rescales the particle count of the scene)\n"
@@ -215,6 +221,10 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     } else if (arg == "--settle") {
       if (Status s = value(&v); !s) return s;
       if (Status s = ParseDouble(arg, v, 0.0, 3600.0, &out->settle); !s) return s;
+    } else if (arg == "--load-state" || arg == "--save-state") {
+      if (Status s = value(&v); !s) return s;
+      if (*v == '\0') return Status::Error(arg + ": give a file name");
+      (arg == "--load-state" ? out->loadState : out->saveState) = v;
     } else if (arg == "--steps") {
       if (Status s = value(&v); !s) return s;
       if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->steps); !s) return s;
@@ -338,6 +348,7 @@ std::string HeadlessOnlyOptions(const Options& options) {
   add(options.time > 0.0, "--time");
   add(options.steps > 0, "--steps");
   add(options.settle >= 0.0, "--settle");
+  add(!options.saveState.empty(), "--save-state");
   return out;
 }
 
@@ -345,7 +356,16 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
   if (Status s = LoadSceneWithOptions(options, &scene); !s) return s;
-  if (options.quality == 1 && options.spacing <= 0.0f) {
+  // A state file is read before anything is allocated; it fixes the spacing (unless --spacing says
+  // otherwise, which RestoreState then refuses) and replaces the settle.
+  if (!options.loadState.empty() && options.settle > 0.0) {
+    return Status::Error("--settle and --load-state: the state file is the start; settle in the run that saves it");
+  }
+  std::shared_ptr<const StateFile> state;
+  if (Status s = ReadStartState(options.loadState, options.spacing, &scene.setup, &state); !s) return s;
+  if (state && options.quality == 1 && options.spacing <= 0.0f) {
+    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", state->spacing);
+  } else if (options.quality == 1 && options.spacing <= 0.0f) {
     sim::SolverConfig probe;
     probe.device = options.device;
     probe.threads = options.threads;
@@ -364,6 +384,12 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     return Status::Error(options.scenePath + ": the scene has no run.time or run.steps; give --time or --steps");
   }
 
+  if (state && targetSteps <= 0 && state->clock.time >= targetTime - 1e-9) {
+    return Status::Error(Format("--load-state %s: the state is at t = %.6g s, at or past the end time %g s (--time is "
+                                "the end time on the state's clock)",
+                                options.loadState.c_str(), state->clock.time, targetTime));
+  }
+
   // Files are opened before the solver allocates anything, so a bad path costs nothing.
   std::ofstream stats;
   if (!options.statsPath.empty()) {
@@ -379,6 +405,17 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
     if (!std::filesystem::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
       return Status::Error("--screenshot " + options.screenshotPath + ": cannot write into " + dir.string());
+    }
+  }
+  if (!options.saveState.empty()) {  // written after the run: check the place before it
+    const std::filesystem::path file(options.saveState);
+    const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) {
+      return Status::Error("--save-state " + options.saveState + ": is a directory; give a file name");
+    }
+    if (!std::filesystem::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
+      return Status::Error("--save-state " + options.saveState + ": cannot write into " + dir.string());
     }
   }
   if (options.outDir != Options{}.outDir && options.exportEvery <= 0 && options.exportSurfaceEvery <= 0) {
@@ -425,6 +462,13 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     summary->paddles = paddles->Count();
     for (int k = 0; k < paddles->Count(); ++k) summary->paddleParticles += paddles->ParticleCount(k);
   }
+  if (state) {
+    if (Status s = RestoreState(*state, options.loadState, solver.get()); !s) return Status::Error("--load-state " + s.message());
+    SPHXR_LOG_INFO("started from %s: t = %.6g s, %d fluid particles (saved from '%s')", options.loadState.c_str(),
+                   state->clock.time, state->fluidCount, state->scene.c_str());
+    state.reset();  // the solver has it now
+  }
+  summary->startTime = solver->Time();
   const float spacing = scene.setup.params.spacing;
   summary->fluid = solver->FluidCount();
   summary->boundary = solver->BoundaryCount();
@@ -450,7 +494,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   const bool showProgress = options.progress == 1 || (options.progress == -1 && isatty(STDERR_FILENO));
   // Ctrl-C/SIGTERM from here on stop the settling or the run after the step in progress.
   InterruptScope interruptScope;
-  const double settle = options.settle >= 0.0 ? options.settle : scene.runSettle;
+  const double settle = options.loadState.empty() ? (options.settle >= 0.0 ? options.settle : scene.runSettle) : 0.0;
+  if (!options.loadState.empty() && scene.runSettle > 0.0) {
+    SPHXR_LOG_INFO("run.settle (%g s) skipped: the state file is the start", scene.runSettle);
+  }
   if (settle > 0.0) {
     SPHXR_LOG_INFO("settling: %g simulated s of energy minimisation (FIRE) before t = 0", settle);
     Progress bar(showProgress, "settling ");
@@ -584,7 +631,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       if (Status s = frameNow(); !s) return s;
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    const double fraction = targetSteps > 0 ? static_cast<double>(step) / targetSteps : solver->Time() / targetTime;
+    const double fraction = targetSteps > 0 ? static_cast<double>(step) / targetSteps
+                                            : (solver->Time() - summary->startTime) / (targetTime - summary->startTime);
     progress.Update(std::min(1.0, fraction), solver->Time(), step, 1e3 * wall / step);
   }
   summary->wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
@@ -602,6 +650,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (options.exportSurfaceEvery > 0 && step % options.exportSurfaceEvery != 0) {
       if (Status s = exportSurface(step); !s) return s;
     }
+  }
+  if (!options.saveState.empty()) {
+    if (Status s = WriteStateFile(options.saveState, *solver, scene.name); !s) return Status::Error("--save-state " + s.message());
+    summary->stateSaved = options.saveState;
   }
   if (stats.is_open()) {
     stats.close();  // the last rows leave the buffer here
@@ -654,8 +706,15 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   std::printf("  device          %s\n", sim::DeviceName(solver->ActiveDevice()));
   std::printf("  steps           %lld (%lld with dt clamped to the stability limit)\n",
               static_cast<long long>(summary->steps), static_cast<long long>(totals.dtClampedSteps));
-  std::printf("  simulated time  %.4f s in %.2f s wall (%.3f simulated s per wall s)\n", summary->simulatedTime,
-              summary->wallSeconds, summary->wallSeconds > 0 ? summary->simulatedTime / summary->wallSeconds : 0.0);
+  const double ran = summary->simulatedTime - summary->startTime;
+  if (summary->startTime > 0.0) {
+    std::printf("  simulated time  %.4f s to %.4f s (from the state file) in %.2f s wall (%.3f simulated s per wall s)\n",
+                summary->startTime, summary->simulatedTime, summary->wallSeconds,
+                summary->wallSeconds > 0 ? ran / summary->wallSeconds : 0.0);
+  } else {
+    std::printf("  simulated time  %.4f s in %.2f s wall (%.3f simulated s per wall s)\n", summary->simulatedTime,
+                summary->wallSeconds, summary->wallSeconds > 0 ? ran / summary->wallSeconds : 0.0);
+  }
   std::printf("  ms per step     %.3f total:", summary->msPerStep);
   for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) {
     std::printf(" %s %.3f", sim::StageName(static_cast<sim::Stage>(s)), summary->stageMsPerStep[s]);
@@ -717,6 +776,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
   if (summary->exports > 0) {
     std::printf("  exported        %lld files to %s\n", static_cast<long long>(summary->exports), options.outDir.c_str());
+  }
+  if (!summary->stateSaved.empty()) {
+    std::printf("  state           saved to %s at t = %.6g s (sphxr --load-state %s continues from there)\n",
+                summary->stateSaved.c_str(), summary->simulatedTime, summary->stateSaved.c_str());
   }
   return Status::Ok();
 }

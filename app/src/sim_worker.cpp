@@ -62,6 +62,14 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
   if (*paddles) {
     if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
   }
+  if (scene.start) {
+    // A mismatch here (the panel changed the spacing since) falls back to the scene's own start.
+    if (Status s = RestoreState(*scene.start, scene.startPath, solver->get()); !s) {
+      SPHXR_LOG_WARN("%s; starting from the scene instead", s.message().c_str());
+    } else {
+      SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.startPath.c_str(), scene.start->clock.time);
+    }
+  }
   return Status::Ok();
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sphxr/app/snapshot.h"
+#include "sphxr/app/state_file.h"
 #include "sphxr/common/status.h"
 #include "sphxr/interaction/hand.h"
 #include "sphxr/interaction/paddle.h"
@@ -32,6 +33,10 @@ struct SimScene {
   std::vector<interaction::PaddleDesc> paddles;
   double paddleFrameRate = 90.0;  // Hz (simulated): the paddles get the newest hands' targets this often
   SurfaceRequest surface;
+  /// --load-state: the fluid and clock to start from instead of the scene's (every reset returns
+  /// there); null: the scene's own start.
+  std::shared_ptr<const StateFile> start;
+  std::string startPath;
 };
 
 /// The scene file's scene, with a default hand-held paddle (interaction::BladeOnHandle sized to the

@@ -90,6 +90,7 @@ struct XrApp {
   SceneFile scene;
   sim::SceneSetup setup;  // the scene at the spacing in use
   SimScene simScene;      // with a paddle for each hand; what reset restores
+  std::shared_ptr<const StateFile> start;  // --load-state
   sim::Vec3 offset;       // play = sim + offset
   GLFWwindow* window = nullptr;
   bool imguiReady = false;
@@ -203,7 +204,10 @@ Status StartSimulation(XrApp& app) {
     // One core is left to the frame loop (and llvmpipe's rasteriser, on machines without a GPU).
     solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
   }
-  if (options.quality != 0 && options.spacing <= 0.0f) {
+  const std::shared_ptr<const StateFile>& start = app.start;
+  if (start && options.quality != 0 && options.spacing <= 0.0f) {
+    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", start->spacing);
+  } else if (options.quality != 0 && options.spacing <= 0.0f) {
     QualityChoice choice;
     if (Status s = ChooseQuality(app.setup, solverConfig, 1.0, 1.0, &choice); !s) {
       return Status::Error(options.scenePath + ": " + s.message());
@@ -215,6 +219,8 @@ Status StartSimulation(XrApp& app) {
   SceneFile atSpacing = app.scene;
   atSpacing.setup = app.setup;
   app.simScene = SimSceneFromFile(atSpacing, {0, 1});
+  app.simScene.start = start;
+  app.simScene.startPath = options.loadState;
   app.simScene.surface.enabled = app.mode == render::RenderMode::kWater;
   app.worker = std::make_unique<SimWorker>(solverConfig);
   if (Status s = app.worker->Start(app.simScene); !s) return Status::Error(options.scenePath + ": " + s.message());
@@ -240,6 +246,8 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   app.options = options;
   if (Status s = LoadSceneWithOptions(options, &app.scene); !s) return s;
   app.setup = app.scene.setup;
+  // A bad state file is one line before the headset session starts.
+  if (Status s = ReadStartState(options.loadState, options.spacing, &app.setup, &app.start); !s) return s;
   app.offset = XrSceneOffset(app.setup.tank);
   app.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
 

@@ -502,6 +502,43 @@ Status Solver::Upload(const HostFluid& fluid) {
   return Status::Ok();
 }
 
+SolverClock Solver::Clock() const {
+  SolverClock c;
+  c.time = m_last.time;
+  c.lastMaxSpeed = m_last.maxSpeed;
+  c.lastMaxAccel = m_maxAccel;
+  return c;
+}
+
+Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
+  if (m_totals.steps != 0) return Status::Error("restore: only before the first step (it replaces the start)");
+  if (!std::isfinite(clock.time) || clock.time < 0.0 || !std::isfinite(clock.lastMaxSpeed) ||
+      clock.lastMaxSpeed < 0.0f || !std::isfinite(clock.lastMaxAccel) || clock.lastMaxAccel < 0.0f) {
+    return Status::Error(Format("restore: the clock (t = %g s, last max speed %g m/s, last max |a| %g m/s^2) must be "
+                                "finite and not negative",
+                                clock.time, clock.lastMaxSpeed, clock.lastMaxAccel));
+  }
+  // (sizes are checked by Upload below)
+  for (size_t i = 0; i < std::min(fluid.position.size(), fluid.velocity.size()); ++i) {
+    if (!Finite(Xyz(fluid.position[i])) || !Finite(Xyz(fluid.velocity[i]))) {
+      return Status::Error(Format("restore: particle %zu (id %u) has a non-finite position or velocity", i,
+                                  i < fluid.id.size() ? fluid.id[i] : 0u));
+    }
+  }
+  if (Status s = Upload(fluid); !s) return Status::Error("restore: " + s.message());
+  m_last = StepInfo{};
+  m_last.time = clock.time;
+  m_last.maxSpeed = clock.lastMaxSpeed;
+  m_maxAccel = clock.lastMaxAccel;
+  m_totals = Totals{};
+  for (BodyMotion& b : m_bodies) {  // a body stays where it is, at rest, on the restored clock
+    b.from = b.to = b.pose;
+    b.fromTime = b.toTime = clock.time;
+    b.velocity = b.angular = Vec3{};
+  }
+  return Status::Ok();
+}
+
 Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress& progress) {
   if (!(seconds > 0.0) || !std::isfinite(seconds)) {
     return Status::Error("settle time " + std::to_string(seconds) + " s: must be a positive number of seconds");

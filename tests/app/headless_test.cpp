@@ -45,7 +45,8 @@ TEST(CommandLineTest, AcceptsEveryFlag) {
   const std::vector<std::string> args = {
       "--headless", "--scene", "x.json", "--steps", "20", "--device", "cpu", "--threads", "2", "--spacing", "0.01",
       "--set", "stiffness=1e5", "--set", "cfl=0.3", "--export-every", "10", "--out", "dir", "--export-format", "vtk",
-      "--stats", "s.csv", "--validate", "--no-progress", "--settle", "2.5"};
+      "--stats", "s.csv", "--validate", "--no-progress", "--settle", "2.5", "--load-state", "in.state",
+      "--save-state", "out.state"};
   const Status s = Parse(args, &o);
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_EQ(o.mode, Mode::kHeadless);
@@ -63,6 +64,8 @@ TEST(CommandLineTest, AcceptsEveryFlag) {
   EXPECT_TRUE(o.validate);
   EXPECT_EQ(o.progress, 0);
   EXPECT_DOUBLE_EQ(o.settle, 2.5);
+  EXPECT_EQ(o.loadState, "in.state");
+  EXPECT_EQ(o.saveState, "out.state");
   EXPECT_FALSE(o.help);
 
   ASSERT_TRUE(Parse({"--time", "0.5", "--device", "cuda", "--progress"}, &o).ok());
@@ -128,6 +131,7 @@ TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
   // Values for the documented flags that take one; a flag missing here and taking a value fails below.
   const std::map<std::string, std::string> values = {
       {"--scene", "a.json"}, {"--time", "1"},         {"--steps", "5"},          {"--settle", "2"},          {"--device", "cpu"},
+      {"--load-state", "a.state"}, {"--save-state", "b.state"},
       {"--threads", "1"},    {"--spacing", "0.01"},   {"--set", "cfl=0.3"},      {"--export-every", "2"},
       {"--out", "d"},        {"--export-format", "ply"}, {"--stats", "f.csv"}, {"--reuse", "on"},
       {"--export-surface-every", "3"}, {"--surface-format", "obj"},
@@ -174,6 +178,8 @@ TEST(CommandLineTest, RejectsBadValuesNamingTheFlag) {
   ExpectRejected({"--steps", "0"}, {"--steps"});
   ExpectRejected({"--settle", "-1"}, {"--settle", "0 to 3600"});
   ExpectRejected({"--settle", "nan"}, {"--settle", "not a number"});
+  ExpectRejected({"--load-state", ""}, {"--load-state", "file name"});
+  ExpectRejected({"--save-state"}, {"--save-state", "missing value"});
   ExpectRejected({"--steps", "1e3"}, {"--steps"});
   ExpectRejected({"--spacing", "0"}, {"--spacing"});
   ExpectRejected({"--spacing", "-0.01"}, {"--spacing"});
@@ -624,6 +630,50 @@ TEST(HeadlessTest, SettleRunsBeforeTheRunAndRestartsTheClock) {
   EXPECT_DOUBLE_EQ(std::stod(first[1]), std::stod(first[2])) << "the clock restarts: t = dt after the first step";
   const Ply ply = ReadPly((std::filesystem::path(out) / "particles_000000.ply").string());
   EXPECT_EQ(ply.vertices, static_cast<size_t>(kSmallSceneParticles));
+}
+
+// --save-state and --load-state: a run stopped half way and continued from its state file ends where
+// the run that went through ends, byte for byte (the CPU backend is deterministic); the continued run's
+// CSV starts at the saved time. Then the refusals, each one line before anything runs.
+TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
+  test::TempDir dir("state");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string half = dir.File("half.state"), continued = dir.File("continued.state"), whole = dir.File("whole.state");
+  const std::string csv = dir.File("continued.csv");
+  const std::string common = " --threads 1 --no-progress --scene " + Quote(scene);
+  const Result first = RunBinary("--headless --time 0.02 --save-state " + Quote(half) + common, dir);
+  ASSERT_TRUE(first.Exited() && first.Code() == 0) << first.err;
+  EXPECT_NE(first.out.find("state           saved to " + half), std::string::npos) << first.out;
+  const Result second = RunBinary("--headless --time 0.04 --load-state " + Quote(half) + " --save-state " +
+                                      Quote(continued) + " --stats " + Quote(csv) + common,
+                                  dir);
+  ASSERT_TRUE(second.Exited() && second.Code() == 0) << second.err;
+  EXPECT_NE(second.err.find("started from " + half), std::string::npos) << second.err;
+  EXPECT_NE(second.out.find("(from the state file)"), std::string::npos) << second.out;
+  const Result through = RunBinary("--headless --time 0.04 --save-state " + Quote(whole) + common, dir);
+  ASSERT_TRUE(through.Exited() && through.Code() == 0) << through.err;
+
+  const std::string a = test::ReadFile(continued), b = test::ReadFile(whole);
+  ASSERT_GT(a.size(), static_cast<size_t>(kSmallSceneParticles) * 60) << "every field of every particle";
+  EXPECT_TRUE(a == b) << "the continued run's state differs from the whole run's";
+  const std::vector<std::string> rows = Lines(test::ReadFile(csv));
+  ASSERT_GT(rows.size(), 2u);
+  const std::vector<std::string> firstRow = Split(rows[1], ',');
+  EXPECT_EQ(firstRow[0], "1") << "the continued run counts its own steps";
+  EXPECT_GT(std::stod(firstRow[1]), 0.02) << "and its clock goes on from the saved time";
+  EXPECT_LT(std::stod(firstRow[1]), 0.0215);
+
+  // Refusals.
+  ExpectOneLineError(RunBinary("--headless --time 0.04 --settle 1 --load-state " + Quote(half) + common, dir),
+                     "--settle and --load-state");
+  ExpectOneLineError(RunBinary("--headless --time 0.01 --load-state " + Quote(half) + common, dir), "at or past the end time");
+  ExpectOneLineError(RunBinary("--headless --time 0.04 --load-state " + Quote(scene) + common, dir), "not an sphxr state file");
+  ExpectOneLineError(RunBinary("--headless --time 0.04 --spacing 0.012 --load-state " + Quote(half) + common, dir),
+                     "another --spacing");
+  ExpectOneLineError(RunBinary("--headless --time 0.04 --save-state " + Quote(dir.path().string()) + common, dir),
+                     "is a directory");
+  ExpectOneLineError(RunBinary("--headless --time 0.04 --save-state /nonexistent/x.state" + common, dir),
+                     "cannot write into");
 }
 
 // A signal during the settling stops it too, with the summary and the exit code of an interrupted run.

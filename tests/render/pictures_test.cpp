@@ -18,6 +18,8 @@
 
 #include "render_support.h"
 #include "sphxr/app/desktop.h"
+#include "sphxr/app/headless.h"
+#include "sphxr/app/state_file.h"
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/snapshot.h"
@@ -307,6 +309,70 @@ TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
     EXPECT_EQ(app::WritePng(ArtifactPath("desktop_window.png"), shot).ok(), true);
     EXPECT_GE(desktop->FramesDrawn(), 7);
   }  // closes the window, stops the simulation thread
+  EXPECT_TRUE(xvfb.Alive()) << "the X server died";
+  if (saved.empty()) {
+    unsetenv("DISPLAY");
+  } else {
+    setenv("DISPLAY", saved.c_str(), 1);
+  }
+}
+
+// --load-state in the window: the water starts where a headless run saved it (every particle, and the
+// clock), and a reset (r) returns there rather than to the scene's lattice.
+TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
+  Xvfb xvfb;
+  ASSERT_FALSE(xvfb.Display().empty()) << "could not start Xvfb (install the xvfb package)";
+  const char* previous = std::getenv("DISPLAY");
+  const std::string saved = previous ? previous : "";
+  setenv("DISPLAY", xvfb.Display().c_str(), 1);
+  TempDir dir("desktop_state");
+  app::Options headless;
+  headless.mode = app::Mode::kHeadless;
+  headless.scenePath = dir.Write("small.json", kSmallScene);
+  headless.steps = 40;
+  headless.threads = 1;
+  headless.progress = 0;
+  headless.saveState = dir.File("small.state");
+  app::RunSummary summary;
+  ASSERT_TRUE(app::RunHeadless(headless, &summary).ok());
+  app::StateFile state;
+  ASSERT_TRUE(app::ReadStateFile(headless.saveState, &state).ok());
+  ASSERT_GT(state.clock.time, 0.0);
+
+  app::Options options;
+  options.scenePath = headless.scenePath;
+  options.loadState = headless.saveState;
+  options.windowWidth = 640;
+  options.windowHeight = 400;
+  options.threads = 1;
+  options.vsync = false;
+  {
+    std::unique_ptr<app::DesktopApp> desktop;
+    const Status s = app::DesktopApp::Create(options, &desktop);
+    ASSERT_TRUE(s.ok()) << s.message();
+    ASSERT_TRUE(desktop->Frame());
+    desktop->OnKey(GLFW_KEY_SPACE);  // pause, then reset: the rebuilt solver's first snapshot is the start
+    desktop->OnKey(GLFW_KEY_R);
+    std::shared_ptr<const app::SimSnapshot> snap;
+    for (int i = 0; i < 200; ++i) {
+      ASSERT_TRUE(desktop->Frame());
+      snap = desktop->Snapshot();
+      if (desktop->SimSteps() == 0 && snap && snap->steps == 0) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_TRUE(snap);
+    ASSERT_EQ(snap->steps, 0) << "the reset did not arrive";
+    EXPECT_EQ(snap->last.time, state.clock.time) << "the clock starts at the state's time";
+    ASSERT_EQ(snap->fluid.size(), state.fluid.size());
+    int differ = 0;
+    for (size_t i = 0; i < state.fluid.size(); ++i) {
+      const sim::Vec4 a = state.fluid.position[i], b = snap->fluid.position[i];
+      if ((a.x != b.x || a.y != b.y || a.z != b.z || state.fluid.id[i] != snap->fluid.id[i]) && differ++ < 3) {
+        ADD_FAILURE() << "particle " << i << " is not where the state file has it";
+      }
+    }
+    EXPECT_EQ(differ, 0);
+  }
   EXPECT_TRUE(xvfb.Alive()) << "the X server died";
   if (saved.empty()) {
     unsetenv("DISPLAY");

@@ -17,6 +17,8 @@ struct Options {
   std::string scenePath;
   double time = 0.0;        // s; 0 = the scene's run.time (or run.steps)
   int64_t steps = 0;        // 0 = use time
+  std::string loadState;    // --load-state: the run starts from this state file (state_file.h)
+  std::string saveState;    // --save-state: the state at the end of the run (also when stopped early)
   double settle = -1.0;     // s of Solver::Settle before the run; -1 = the scene's run.settle, 0 = none
   sim::Device device = sim::Device::kAuto;
   int threads = 0;          // 0 = all cores
@@ -92,6 +94,8 @@ struct RunSummary {
   int64_t frames = 0;                // PNG frames written to --frames DIR
   int interrupted = 0;               // the signal (SIGINT, SIGTERM) that stopped the run early, else 0
   sim::SettleReport settle;          // --settle / run.settle (time 0: not settled)
+  double startTime = 0.0;            // s on the clock at the first step (a --load-state's time, else 0)
+  std::string stateSaved;            // --save-state: the file written
 };
 
 /// Runs a scene headless: load, apply overrides, simulate, export, summarise. The summary is printed

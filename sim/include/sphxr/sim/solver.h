@@ -65,6 +65,14 @@ struct SettleReport {
   double wallSeconds = 0.0;
   bool stopped = false;      // the progress callback asked to stop before `seconds`
 };
+/// The clock of a solver: what a restart needs besides the fluid fields (the next step's time step
+/// depends on the last step's largest speed and acceleration).
+struct SolverClock {
+  double time = 0.0;        // s, simulated
+  float lastMaxSpeed = 0.0f;  // m/s, of the last step
+  float lastMaxAccel = 0.0f;  // m/s^2, of the last step
+};
+
 /// Called after every step of a Settle with the simulated seconds done; returning false stops it there
 /// (a caller that draws a progress bar limits its own redraw rate).
 using SettleProgress = std::function<bool(double done)>;
@@ -111,6 +119,14 @@ class Solver {
   Status SetReuse(const ReuseParams& reuse);
   /// Replaces the fluid state (tests, restarts). Sizes must match FluidCount().
   Status Upload(const HostFluid& fluid);
+  /// The clock, for a state file (app/src/state_file.h).
+  SolverClock Clock() const;
+  /// A restart from a saved state: replaces every fluid field and the clock. With the scene the state
+  /// was saved from, the steps that follow are the saved solver's own (bit for bit on the CPU backend,
+  /// tests/sim/restore_test.cpp). Moving bodies stay where they are (the scene's start pose), at rest.
+  /// Only before the first step; the step count and totals start at 0. Errors: sizes that do not match
+  /// FluidCount(), a non-finite clock or position.
+  Status Restore(const HostFluid& fluid, const SolverClock& clock);
   /// Neighbour-grid view for tests: cell index of a point, and the particle ranges.
   struct GridInfo {
     Vec3 origin;

@@ -1,0 +1,43 @@
+#pragma once
+// State files: the fluid and the clock of a run, to restart from (`sphxr --save-state FILE`,
+// `--load-state FILE`; docs/scenes.md "State files"). Every field of the one field list
+// (sim/fields.h) is stored with its name and element size, so a file from a build with other fields
+// is refused by name instead of being misread. Binary, little-endian, version 1:
+//
+//   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
+//   f64 time  f32 last max speed  f32 last max |a|  f32 spacing  i32 fluid  i32 boundary
+//   u32 n + n bytes: the scene's name
+//   u32 fields; per field: u32 n + n bytes of name, u32 element bytes, fluid x element bytes
+#include <memory>
+#include <string>
+
+#include "sphxr/common/status.h"
+#include "sphxr/sim/fields.h"
+#include "sphxr/sim/solver.h"
+
+namespace sphxr::app {
+
+struct StateFile {
+  sim::HostFluid fluid;
+  sim::SolverClock clock;
+  float spacing = 0.0f;
+  int fluidCount = 0;
+  int boundaryCount = 0;
+  std::string scene;  // the name of the scene it was saved from (informational)
+};
+
+/// Writes the solver's fluid and clock to `path`, through `path.tmp` and a rename, so that a failed
+/// write leaves any earlier file at `path` as it was.
+Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName);
+/// Reads a state file; a one-line error names the path and what is wrong (not a state file, another
+/// version or byte order, a field this build does not have or lacks, truncated).
+Status ReadStateFile(const std::string& path, StateFile* out);
+/// `--load-state path` for every mode: reads the file, refuses a `spacingOption` (--spacing, 0 when not
+/// given) other than the file's, and sets `setup`'s spacing to the file's. An empty path reads nothing.
+Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSetup* setup,
+                      std::shared_ptr<const StateFile>* out);
+/// Checks that `state` fits `solver` (the same fluid and boundary counts and spacing: the same scene at
+/// the same spacing) and restores it (sim::Solver::Restore).
+Status RestoreState(const StateFile& state, const std::string& path, sim::Solver* solver);
+
+}  // namespace sphxr::app

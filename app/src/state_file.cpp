@@ -1,0 +1,200 @@
+#include "sphxr/app/state_file.h"
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "sphxr/common/log.h"
+
+namespace sphxr::app {
+namespace {
+
+constexpr char kMagic[8] = {'S', 'P', 'H', 'X', 'R', 'S', 'T', '1'};
+constexpr uint32_t kByteOrder = 0x01020304u;
+constexpr uint32_t kVersion = 1;
+
+class Writer {
+ public:
+  explicit Writer(std::ofstream* out) : m_out(out) {}
+  void Bytes(const void* p, size_t n) { m_out->write(static_cast<const char*>(p), static_cast<std::streamsize>(n)); }
+  template <class T>
+  void Put(const T& v) {
+    Bytes(&v, sizeof(T));
+  }
+  void String(const std::string& s) {
+    Put(static_cast<uint32_t>(s.size()));
+    Bytes(s.data(), s.size());
+  }
+
+ private:
+  std::ofstream* m_out;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::vector<char> data) : m_data(std::move(data)) {}
+  bool Bytes(void* p, size_t n) {
+    if (n > m_data.size() - m_at) return false;
+    std::memcpy(p, m_data.data() + m_at, n);
+    m_at += n;
+    return true;
+  }
+  template <class T>
+  bool Get(T* v) {
+    return Bytes(v, sizeof(T));
+  }
+  bool String(std::string* s, uint32_t limit) {
+    uint32_t n = 0;
+    if (!Get(&n) || n > limit || n > m_data.size() - m_at) return false;
+    s->assign(m_data.data() + m_at, n);
+    m_at += n;
+    return true;
+  }
+  size_t At() const { return m_at; }
+  size_t Left() const { return m_data.size() - m_at; }
+
+ private:
+  std::vector<char> m_data;
+  size_t m_at = 0;
+};
+
+}  // namespace
+
+Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName) {
+  sim::HostFluid fluid;
+  solver.Download(&fluid);
+  const sim::SolverClock clock = solver.Clock();
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return Status::Error(path + ": cannot open " + tmp + " for writing: " + std::strerror(errno));
+    Writer w(&out);
+    w.Bytes(kMagic, sizeof(kMagic));
+    w.Put(kByteOrder);
+    w.Put(kVersion);
+    w.Put(clock.time);
+    w.Put(clock.lastMaxSpeed);
+    w.Put(clock.lastMaxAccel);
+    w.Put(solver.Scene().params.spacing);
+    w.Put(static_cast<int32_t>(solver.FluidCount()));
+    w.Put(static_cast<int32_t>(solver.BoundaryCount()));
+    w.String(sceneName);
+    uint32_t fields = 0;
+#define SPHXR_COUNT_FIELD(type, name) ++fields;
+    SPHXR_FLUID_FIELDS(SPHXR_COUNT_FIELD)
+#undef SPHXR_COUNT_FIELD
+    w.Put(fields);
+#define SPHXR_WRITE_FIELD(type, name)                                   \
+  w.String(#name);                                                      \
+  w.Put(static_cast<uint32_t>(sizeof(type)));                           \
+  w.Bytes(fluid.name.data(), fluid.name.size() * sizeof(type));
+    SPHXR_FLUID_FIELDS(SPHXR_WRITE_FIELD)
+#undef SPHXR_WRITE_FIELD
+    out.flush();
+    if (!out) {
+      out.close();
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
+      return Status::Error(path + ": write failed (disk full?); an earlier file there is unchanged");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return Status::Error(path + ": cannot move " + tmp + " into place: " + ec.message());
+  return Status::Ok();
+}
+
+Status ReadStateFile(const std::string& path, StateFile* out) {
+  *out = StateFile{};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Reader r(std::move(data));
+  auto truncated = [&]() { return Status::Error(Format("%s: truncated at byte %zu: not a whole state file", path.c_str(), r.At())); };
+  char magic[sizeof(kMagic)];
+  if (!r.Bytes(magic, sizeof(magic)) || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) {
+    return Status::Error(path + ": not an sphxr state file (written by sphxr --save-state)");
+  }
+  uint32_t order = 0, version = 0;
+  if (!r.Get(&order) || !r.Get(&version)) return truncated();
+  if (order != kByteOrder) return Status::Error(path + ": written on a machine of the other byte order");
+  if (version != kVersion) {
+    return Status::Error(Format("%s: state file version %u; this build reads version %u", path.c_str(), version, kVersion));
+  }
+  int32_t fluid = 0, boundary = 0;
+  if (!r.Get(&out->clock.time) || !r.Get(&out->clock.lastMaxSpeed) || !r.Get(&out->clock.lastMaxAccel) ||
+      !r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) {
+    return truncated();
+  }
+  if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
+  out->fluidCount = fluid;
+  out->boundaryCount = boundary;
+  uint32_t fields = 0;
+  if (!r.Get(&fields)) return truncated();
+  out->fluid.resize(static_cast<size_t>(fluid));
+  uint32_t found = 0;
+  for (uint32_t f = 0; f < fields; ++f) {
+    std::string name;
+    uint32_t element = 0;
+    if (!r.String(&name, 256) || !r.Get(&element)) return truncated();
+    bool known = false;
+#define SPHXR_READ_FIELD(type, fieldName)                                                                       \
+  if (name == #fieldName) {                                                                                     \
+    known = true;                                                                                               \
+    if (element != sizeof(type)) {                                                                              \
+      return Status::Error(Format("%s: field '%s' has %u-byte elements; this build's have %zu", path.c_str(),   \
+                                  name.c_str(), element, sizeof(type)));                                        \
+    }                                                                                                           \
+    if (!r.Bytes(out->fluid.fieldName.data(), static_cast<size_t>(fluid) * sizeof(type))) return truncated();   \
+    ++found;                                                                                                    \
+  }
+    SPHXR_FLUID_FIELDS(SPHXR_READ_FIELD)
+#undef SPHXR_READ_FIELD
+    if (!known) return Status::Error(path + ": field '" + name + "' is not one this build knows (saved by another version)");
+  }
+  uint32_t expected = 0;
+#define SPHXR_COUNT_FIELD(type, name) ++expected;
+  SPHXR_FLUID_FIELDS(SPHXR_COUNT_FIELD)
+#undef SPHXR_COUNT_FIELD
+  if (found != expected) {
+    return Status::Error(Format("%s: %u of this build's %u fields are in the file (saved by another version)", path.c_str(),
+                                found, expected));
+  }
+  if (r.Left() != 0) return Status::Error(Format("%s: %zu bytes after the last field: the file is damaged", path.c_str(), r.Left()));
+  return Status::Ok();
+}
+
+Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSetup* setup,
+                      std::shared_ptr<const StateFile>* out) {
+  out->reset();
+  if (path.empty()) return Status::Ok();
+  auto state = std::make_shared<StateFile>();
+  if (Status s = ReadStateFile(path, state.get()); !s) return Status::Error("--load-state " + s.message());
+  if (spacingOption > 0.0f && spacingOption != state->spacing) {
+    return Status::Error(Format("--load-state %s: saved at spacing %g m; --spacing %g m is another particle count "
+                                "(another --spacing)",
+                                path.c_str(), state->spacing, spacingOption));
+  }
+  setup->params.spacing = state->spacing;
+  *out = std::move(state);
+  return Status::Ok();
+}
+
+Status RestoreState(const StateFile& state, const std::string& path, sim::Solver* solver) {
+  const float spacing = solver->Scene().params.spacing;
+  if (state.fluidCount != solver->FluidCount() || state.boundaryCount != solver->BoundaryCount() ||
+      state.spacing != spacing) {
+    return Status::Error(Format("%s: saved from '%s' with %d fluid and %d boundary particles at spacing %g m; this scene "
+                                "has %d and %d at %g m (another scene, or another --spacing)",
+                                path.c_str(), state.scene.c_str(), state.fluidCount, state.boundaryCount, state.spacing,
+                                solver->FluidCount(), solver->BoundaryCount(), spacing));
+  }
+  if (Status s = solver->Restore(state.fluid, state.clock); !s) return Status::Error(path + ": " + s.message());
+  return Status::Ok();
+}
+
+}  // namespace sphxr::app

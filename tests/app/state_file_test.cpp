@@ -1,0 +1,144 @@
+// State files (app/src/state_file.cpp): what is written is read back bit for bit, and a damaged, foreign
+// or mismatched file is refused with one line that names the path and the reason. Whether a restored
+// run continues as the saved one would have: tests/sim/restore_test.cpp (the solver) and the headless
+// end-to-end test ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "sphxr/app/state_file.h"
+#include "support.h"
+
+namespace sphxr::app {
+namespace {
+
+std::unique_ptr<sim::Solver> SteppedSolver(int steps) {
+  auto solver = test::CreateOrFail(test::SmallDamBreak(0.01f));
+  for (int k = 0; solver && k < steps; ++k) EXPECT_TRUE(solver->Step().ok());
+  return solver;
+}
+
+std::string Bytes(const std::string& path) { return test::ReadFile(path); }
+
+void Put(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+void ExpectRefused(const std::string& path, const std::string& needle) {
+  StateFile state;
+  const Status s = ReadStateFile(path, &state);
+  ASSERT_FALSE(s.ok()) << "accepted: " << path;
+  EXPECT_NE(s.message().find(path), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find(needle), std::string::npos) << s.message();
+  EXPECT_EQ(s.message().find('\n'), std::string::npos) << "one line: " << s.message();
+}
+
+TEST(StateFile, WhatIsWrittenIsReadBackBitForBit) {
+  test::TempDir dir("state_roundtrip");
+  auto solver = SteppedSolver(25);
+  ASSERT_TRUE(solver);
+  const std::string path = dir.File("a.state");
+  ASSERT_TRUE(WriteStateFile(path, *solver, "small dam break").ok());
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp")) << "the temporary file is renamed into place";
+
+  StateFile state;
+  const Status s = ReadStateFile(path, &state);
+  ASSERT_TRUE(s.ok()) << s.message();
+  sim::HostFluid fluid;
+  solver->Download(&fluid);
+  EXPECT_EQ(state.scene, "small dam break");
+  EXPECT_EQ(state.fluidCount, solver->FluidCount());
+  EXPECT_EQ(state.boundaryCount, solver->BoundaryCount());
+  EXPECT_EQ(state.spacing, 0.01f);
+  EXPECT_EQ(state.clock.time, solver->Time());
+  EXPECT_EQ(state.clock.lastMaxSpeed, solver->Clock().lastMaxSpeed);
+  EXPECT_EQ(state.clock.lastMaxAccel, solver->Clock().lastMaxAccel);
+  EXPECT_GT(state.clock.lastMaxSpeed, 0.0f);
+  ASSERT_EQ(state.fluid.size(), fluid.size());
+#define SPHXR_COMPARE_FIELD(type, name)                                                                 \
+  EXPECT_EQ(std::memcmp(state.fluid.name.data(), fluid.name.data(), fluid.name.size() * sizeof(type)), 0) \
+      << "field " #name " differs";
+  SPHXR_FLUID_FIELDS(SPHXR_COMPARE_FIELD)
+#undef SPHXR_COMPARE_FIELD
+
+  // It restores into a fresh solver of the same scene, and the clock comes with it.
+  auto fresh = test::CreateOrFail(test::SmallDamBreak(0.01f));
+  ASSERT_TRUE(RestoreState(state, path, fresh.get()).ok());
+  EXPECT_EQ(fresh->Time(), solver->Time());
+}
+
+TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
+  test::TempDir dir("state_damaged");
+  auto solver = SteppedSolver(3);
+  ASSERT_TRUE(solver);
+  const std::string good = dir.File("good.state");
+  ASSERT_TRUE(WriteStateFile(good, *solver, "s").ok());
+  const std::string bytes = Bytes(good);
+  ASSERT_GT(bytes.size(), 100u);
+  const std::string bad = dir.File("bad.state");
+
+  ExpectRefused(dir.File("missing.state"), "cannot open");
+  Put(bad, "{ \"tank\": {} }\n");
+  ExpectRefused(bad, "not an sphxr state file");
+  Put(bad, bytes.substr(0, bytes.size() / 2));
+  ExpectRefused(bad, "truncated");
+  Put(bad, bytes.substr(0, 20));
+  ExpectRefused(bad, "truncated");
+  Put(bad, bytes + "x");
+  ExpectRefused(bad, "after the last field");
+
+  std::string other = bytes;  // the version (after 8 bytes of magic and 4 of byte order)
+  other[12] = 7;
+  Put(bad, other);
+  ExpectRefused(bad, "version 7");
+  other = bytes;
+  std::swap(other[8], other[11]);  // the byte-order mark reversed
+  Put(bad, other);
+  ExpectRefused(bad, "byte order");
+  other = bytes;
+  const size_t at = other.find("velocity");
+  ASSERT_NE(at, std::string::npos);
+  other.replace(at, 8, "velocitx");
+  Put(bad, other);
+  ExpectRefused(bad, "'velocitx' is not one this build knows");
+}
+
+TEST(StateFile, AnotherSceneOrSpacingIsRefused) {
+  test::TempDir dir("state_mismatch");
+  auto solver = SteppedSolver(2);
+  ASSERT_TRUE(solver);
+  const std::string path = dir.File("a.state");
+  ASSERT_TRUE(WriteStateFile(path, *solver, "small").ok());
+  StateFile state;
+  ASSERT_TRUE(ReadStateFile(path, &state).ok());
+  auto coarser = test::CreateOrFail(test::SmallDamBreak(0.02f));
+  ASSERT_TRUE(coarser);
+  const Status s = RestoreState(state, path, coarser.get());
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("saved from 'small'"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("another scene"), std::string::npos) << s.message();
+  EXPECT_EQ(coarser->Time(), 0.0) << "a refused state changes nothing";
+}
+
+TEST(StateFile, AFailedWriteLeavesTheEarlierFile) {
+  test::TempDir dir("state_failed_write");
+  auto solver = SteppedSolver(2);
+  ASSERT_TRUE(solver);
+  const std::string path = dir.File("a.state");
+  ASSERT_TRUE(WriteStateFile(path, *solver, "first").ok());
+  const std::string before = Bytes(path);
+  // The temporary file cannot be created where a directory of its name stands.
+  std::filesystem::create_directory(path + ".tmp");
+  ASSERT_TRUE(solver->Step().ok());
+  const Status s = WriteStateFile(path, *solver, "second");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(path), std::string::npos) << s.message();
+  EXPECT_EQ(Bytes(path), before) << "the earlier state file is unchanged";
+}
+
+}  // namespace
+}  // namespace sphxr::app
