@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "sphxr/app/headless.h"
+#include "sphxr/app/state_file.h"
 #include "sphxr/app/scene_file.h"
 #include "support.h"
 
@@ -567,8 +568,9 @@ void InterruptRun(int signal, const char* name) {
   const std::string scene = dir.Write("scene.json", kSmallScene);
   const std::string csv = dir.File("stats.csv"), outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
   const std::string out = (dir.path() / "out").string();
+  const std::string state = dir.File("stopped.state");
   const pid_t pid = SpawnSphxr({"--headless", "--scene", scene, "--steps", "100000000", "--stats", csv, "--export-every",
-                                "7", "--out", out, "--threads", "1", "--no-progress"},
+                                "7", "--out", out, "--threads", "1", "--no-progress", "--save-state", state},
                                outPath, errPath);
   ASSERT_GE(pid, 0);
   // Signal once the run is under way (the CSV's buffer has reached the file).
@@ -602,6 +604,12 @@ void InterruptRun(int signal, const char* name) {
   std::snprintf(last, sizeof(last), "particles_%06lld.ply", steps);
   const Ply ply = ReadPly((std::filesystem::path(out) / last).string());
   EXPECT_EQ(ply.vertices, static_cast<size_t>(kSmallSceneParticles)) << "the state at the interrupted step is exported";
+  // and saved, at the time of the CSV's last row, to continue from.
+  StateFile saved;
+  const Status read = ReadStateFile(state, &saved);
+  ASSERT_TRUE(read.ok()) << read.message();
+  EXPECT_EQ(saved.fluidCount, kSmallSceneParticles);
+  EXPECT_NEAR(saved.clock.time, std::stod(Split(rows.back(), ',')[1]), 1e-5);
 }
 
 // --settle relaxes the water before the run and then restarts the clock: the summary says so, the run's
