@@ -124,6 +124,22 @@ DamBreakMeasure MeasureDamBreak(const DamBreakProbe& probe, const sim::HostFluid
   return m;
 }
 
+/// A file that `flag` writes after the run: not a directory, in a directory we may write into (an
+/// empty path: nothing to check).
+Status CheckPlaceToWrite(const std::string& flag, const std::string& path, const char* nameHint) {
+  if (path.empty()) return Status::Ok();
+  const std::filesystem::path file(path);
+  const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) {
+    return Status::Error(flag + " " + path + ": is a directory; give a file name" + nameHint);
+  }
+  if (!std::filesystem::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
+    return Status::Error(flag + " " + path + ": cannot write into " + dir.string());
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 std::string UsageText() {
@@ -396,28 +412,9 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     stats.open(options.statsPath);
     if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
   }
-  if (!options.screenshotPath.empty()) {  // written after the run: check the place before it
-    const std::filesystem::path shot(options.screenshotPath);
-    const std::filesystem::path dir = shot.has_parent_path() ? shot.parent_path() : std::filesystem::path(".");
-    std::error_code ec;
-    if (std::filesystem::is_directory(shot, ec)) {
-      return Status::Error("--screenshot " + options.screenshotPath + ": is a directory; give a file name (.png)");
-    }
-    if (!std::filesystem::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
-      return Status::Error("--screenshot " + options.screenshotPath + ": cannot write into " + dir.string());
-    }
-  }
-  if (!options.saveState.empty()) {  // written after the run: check the place before it
-    const std::filesystem::path file(options.saveState);
-    const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-    std::error_code ec;
-    if (std::filesystem::is_directory(file, ec)) {
-      return Status::Error("--save-state " + options.saveState + ": is a directory; give a file name");
-    }
-    if (!std::filesystem::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
-      return Status::Error("--save-state " + options.saveState + ": cannot write into " + dir.string());
-    }
-  }
+  // Files written after the run: check their places before it.
+  if (Status s = CheckPlaceToWrite("--screenshot", options.screenshotPath, " (.png)"); !s) return s;
+  if (Status s = CheckPlaceToWrite("--save-state", options.saveState, ""); !s) return s;
   if (options.outDir != Options{}.outDir && options.exportEvery <= 0 && options.exportSurfaceEvery <= 0) {
     SPHXR_LOG_WARN("--out %s: nothing is exported without --export-every or --export-surface-every",
                    options.outDir.c_str());

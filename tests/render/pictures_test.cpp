@@ -222,12 +222,27 @@ glm::vec3 BladeCentre(const app::PaddlePose& p) {
   return V(p.pose.position) + glm::quat(q.w, q.x, q.y, q.z) * V(w);
 }
 
+/// Sets DISPLAY to a private Xvfb for the scope.
+class DisplayScope {
+ public:
+  explicit DisplayScope(const std::string& display) {
+    const char* previous = std::getenv("DISPLAY");
+    m_saved = previous ? previous : "";
+    setenv("DISPLAY", display.c_str(), 1);
+  }
+  ~DisplayScope() {
+    if (m_saved.empty()) unsetenv("DISPLAY");
+    else setenv("DISPLAY", m_saved.c_str(), 1);
+  }
+
+ private:
+  std::string m_saved;
+};
+
 TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
   Xvfb xvfb;
   ASSERT_FALSE(xvfb.Display().empty()) << "could not start Xvfb (install the xvfb package)";
-  const char* previous = std::getenv("DISPLAY");
-  const std::string saved = previous ? previous : "";
-  setenv("DISPLAY", xvfb.Display().c_str(), 1);
+  const DisplayScope display(xvfb.Display());
   TempDir dir("desktop");
   app::Options options;
   options.scenePath = dir.Write("small.json", kSmallScene);
@@ -310,11 +325,6 @@ TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
     EXPECT_GE(desktop->FramesDrawn(), 7);
   }  // closes the window, stops the simulation thread
   EXPECT_TRUE(xvfb.Alive()) << "the X server died";
-  if (saved.empty()) {
-    unsetenv("DISPLAY");
-  } else {
-    setenv("DISPLAY", saved.c_str(), 1);
-  }
 }
 
 // --load-state in the window: the water starts where a headless run saved it (every particle, and the
@@ -322,9 +332,7 @@ TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
 TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
   Xvfb xvfb;
   ASSERT_FALSE(xvfb.Display().empty()) << "could not start Xvfb (install the xvfb package)";
-  const char* previous = std::getenv("DISPLAY");
-  const std::string saved = previous ? previous : "";
-  setenv("DISPLAY", xvfb.Display().c_str(), 1);
+  const DisplayScope display(xvfb.Display());
   TempDir dir("desktop_state");
   app::Options headless;
   headless.mode = app::Mode::kHeadless;
@@ -374,11 +382,6 @@ TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
     EXPECT_EQ(differ, 0);
   }
   EXPECT_TRUE(xvfb.Alive()) << "the X server died";
-  if (saved.empty()) {
-    unsetenv("DISPLAY");
-  } else {
-    setenv("DISPLAY", saved.c_str(), 1);
-  }
 }
 
 }  // namespace
@@ -406,22 +409,6 @@ constexpr const char* kPoolScene = R"({
   "run": { "steps": 2 }
 })";
 
-/// Sets DISPLAY to a private Xvfb for the scope.
-class DisplayScope {
- public:
-  explicit DisplayScope(const std::string& display) {
-    const char* previous = std::getenv("DISPLAY");
-    m_saved = previous ? previous : "";
-    setenv("DISPLAY", display.c_str(), 1);
-  }
-  ~DisplayScope() {
-    if (m_saved.empty()) unsetenv("DISPLAY");
-    else setenv("DISPLAY", m_saved.c_str(), 1);
-  }
-
- private:
-  std::string m_saved;
-};
 
 TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanelShowsItsHaptics) {
   Xvfb xvfb;
