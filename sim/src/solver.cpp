@@ -525,7 +525,23 @@ Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
                                   i < fluid.id.size() ? fluid.id[i] : 0u));
     }
   }
-  if (Status s = Upload(fluid); !s) return Status::Error("restore: " + s.message());
+  Status uploaded;
+  const ReuseParams& reuse = m_scene.reuse;
+  const int32_t maxIdle = reuse.enabled ? reuse.idle : -1;
+  bool outOfRange = false;
+  for (int32_t ic : fluid.idle) outOfRange = outOfRange || ic > maxIdle || ic < -2 - maxIdle;
+  if (outOfRange && fluid.idle.size() == fluid.size()) {
+    // Saved under other reuse parameters (or with reuse on, now off): counts this run's IDLE does not
+    // allow start active, so that no particle reuses longer than IDLE steps.
+    HostFluid clamped = fluid;
+    for (int32_t& ic : clamped.idle) {
+      if (ic > maxIdle || ic < -2 - maxIdle) ic = -1;
+    }
+    uploaded = Upload(clamped);
+  } else {
+    uploaded = Upload(fluid);
+  }
+  if (!uploaded) return Status::Error("restore: " + uploaded.message());
   m_last = StepInfo{};
   m_last.time = clock.time;
   m_last.maxSpeed = clock.lastMaxSpeed;

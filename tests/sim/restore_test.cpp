@@ -4,6 +4,7 @@
 // with reuse's idle counts carried along. Then the refusals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -72,6 +73,33 @@ TEST(Restore, CarriesReuseIdleCounts) {
   ASSERT_TRUE(ApplyReusePreset("balanced", &scene.reuse));
   scene.reuse.enabled = true;
   ExpectRestoredRunMatches(scene);
+}
+
+TEST(Restore, IdleCountsBeyondThisRunsIdleStartActive) {
+  SceneSetup scene = test::SmallDamBreak(0.01f);
+  ASSERT_TRUE(ApplyReusePreset("fast", &scene.reuse));  // IDLE 5
+  scene.reuse.enabled = true;
+  auto saved = test::CreateOrFail(scene);
+  ASSERT_TRUE(saved);
+  HostFluid fluid;
+  int longest = -1;
+  for (int k = 0; k < 40 && longest <= 1; ++k) {  // until some particle has an idle count above 1
+    ASSERT_TRUE(saved->Step().ok());
+    saved->Download(&fluid);
+    for (int32_t ic : fluid.idle) longest = std::max(longest, static_cast<int>(ic));
+  }
+  ASSERT_GT(longest, 1) << "the fast preset should have set idle counts above 1 in a falling column";
+
+  scene.reuse.idle = 1;
+  auto restored = test::CreateOrFail(scene);
+  ASSERT_TRUE(restored);
+  ASSERT_TRUE(restored->Restore(fluid, saved->Clock()).ok());
+  HostFluid back;
+  restored->Download(&back);
+  for (size_t i = 0; i < back.size(); ++i) {
+    ASSERT_LE(back.idle[i], 1) << "particle " << i << " would reuse longer than this run's IDLE";
+    ASSERT_GE(back.idle[i], -3) << "particle " << i;
+  }
 }
 
 TEST(Restore, RefusesWhatCannotBeTheSameScene) {
