@@ -308,6 +308,28 @@ TEST(XrApp, ResetButtonRestartsTheScene) {
   ExpectNoValidationErrors(headset);
 }
 
+// --load-state in the headset: the session starts from a state a headless run saved (the same scene,
+// its spacing from the file); a file that is not a state file is one line before any session starts.
+TEST(XrApp, StartsFromAStateFile) {
+  SimHeadset headset("app_state");
+  SetUpHeadset(headset);
+  const std::string scene = WriteScene(headset.dir).string();
+  const std::string state = (headset.dir / "tank.state").string();
+  const AppRun saved = RunSphxr("--headless --scene " + scene + " --steps 10 --threads 1 --no-progress --save-state " + state,
+                                headset.dir);
+  ASSERT_EQ(saved.code, 0) << saved.out;
+  const AppRun r = RunSphxr("--xr --scene " + scene + " --frame-limit 5 --load-state " + state + kCommon, headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "started from " + state), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "starting from the scene instead"), 0) << r.out;
+  ExpectNoValidationErrors(headset);
+
+  const AppRun bad = RunSphxr("--xr --scene " + scene + " --frame-limit 5 --load-state " + scene + kCommon, headset.dir);
+  EXPECT_EQ(bad.code, 1) << bad.out;
+  EXPECT_EQ(CountOf(bad.out, "not an sphxr state file"), 1) << bad.out;
+  EXPECT_EQ(CountOf(bad.out, "desktop"), 0) << "no fallback to the window for a bad file:\n" << bad.out;
+}
+
 TEST(XrApp, DefaultModeIsTheHeadsetWhenARuntimeAnswers) {
   SimHeadset headset("app_default");
   SetUpHeadset(headset);
