@@ -454,17 +454,18 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   std::unique_ptr<sim::Solver> solver;
   if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) return Status::Error(options.scenePath + ": " + s.message());
 
-  if (paddles) {
-    if (Status s = paddles->Attach(solver.get()); !s) return s;
-    summary->paddles = paddles->Count();
-    for (int k = 0; k < paddles->Count(); ++k) summary->paddleParticles += paddles->ParticleCount(k);
-  }
   if (state) {
     if (Status s = RestoreState(*state, options.loadState, solver.get()); !s) return Status::Error("--load-state " + s.message());
     SPHXR_LOG_INFO("started from %s: t = %.6g s, %d fluid particles (saved from '%s')", options.loadState.c_str(),
                    state->clock.time, state->fluidCount, state->scene.c_str());
     state.reset();  // the solver has it now
   }
+  if (paddles) {
+    if (Status s = paddles->Attach(solver.get()); !s) return s;
+    summary->paddles = paddles->Count();
+    for (int k = 0; k < paddles->Count(); ++k) summary->paddleParticles += paddles->ParticleCount(k);
+  }
+
   summary->startTime = solver->Time();
   const float spacing = scene.setup.params.spacing;
   summary->fluid = solver->FluidCount();
@@ -574,7 +575,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
 
   double activeSum = 0.0;
   double forceSum = 0.0;
-  double nextFrame = 0.0;  // paddles: display frames at paddleFrameRate get new targets
+  double nextFrame = solver->Time();  // paddles: display frames at paddleFrameRate get new targets
   const auto begin = std::chrono::steady_clock::now();
   while (targetSteps > 0 ? solver->GetTotals().steps < targetSteps : solver->Time() < targetTime - 1e-9) {
     if (g_interrupt) break;

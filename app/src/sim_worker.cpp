@@ -59,9 +59,6 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
     (*paddles)->AddBodies(&setup);
   }
   if (Status s = sim::Solver::Create(setup, m_config, solver); !s) return s;
-  if (*paddles) {
-    if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
-  }
   if (scene.start) {
     // A mismatch here (the panel changed the spacing since) falls back to the scene's own start.
     if (Status s = RestoreState(*scene.start, scene.startPath, solver->get()); !s) {
@@ -69,6 +66,9 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
     } else {
       SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.startPath.c_str(), scene.start->clock.time);
     }
+  }
+  if (*paddles) {
+    if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
   }
   return Status::Ok();
 }

@@ -83,6 +83,13 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     w.Put(static_cast<int32_t>(solver.FluidCount()));
     w.Put(static_cast<int32_t>(solver.BoundaryCount()));
     w.String(sceneName);
+    w.Put(static_cast<uint32_t>(solver.BodyCount()));
+    for (int k = 0; k < solver.BodyCount(); ++k) {
+      const sim::RigidPose p = solver.BodyPose(k);
+      const float v[7] = {p.position.x, p.position.y, p.position.z, p.orientation.w, p.orientation.x, p.orientation.y,
+                          p.orientation.z};
+      w.Bytes(v, sizeof(v));
+    }
     uint32_t fields = 0;
 #define SPHXR_COUNT_FIELD(type, name) ++fields;
     SPHXR_FLUID_FIELDS(SPHXR_COUNT_FIELD)
@@ -131,6 +138,14 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
     return truncated();
   }
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
+  uint32_t bodies = 0;
+  if (!r.Get(&bodies)) return truncated();
+  if (bodies > 1024) return Status::Error(Format("%s: %u bodies: the file is damaged", path.c_str(), bodies));
+  for (uint32_t k = 0; k < bodies; ++k) {
+    float v[7];
+    if (!r.Bytes(v, sizeof(v))) return truncated();
+    out->bodies.push_back(sim::RigidPose{{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});
+  }
   out->fluidCount = fluid;
   out->boundaryCount = boundary;
   uint32_t fields = 0;
@@ -194,6 +209,14 @@ Status RestoreState(const StateFile& state, const std::string& path, sim::Solver
                                 solver->FluidCount(), solver->BoundaryCount(), spacing));
   }
   if (Status s = solver->Restore(state.fluid, state.clock); !s) return Status::Error(path + ": " + s.message());
+  if (static_cast<int>(state.bodies.size()) == solver->BodyCount()) {
+    for (int k = 0; k < solver->BodyCount(); ++k) {  // a target time not after now: relocated, at rest
+      if (Status s = solver->SetBodyTarget(k, state.bodies[k], solver->Time()); !s) return Status::Error(path + ": " + s.message());
+    }
+  } else {
+    SPHXR_LOG_INFO("%s: %zu paddle poses saved, %d paddles here: they start at the scene's poses", path.c_str(),
+                   state.bodies.size(), solver->BodyCount());
+  }
   return Status::Ok();
 }
 

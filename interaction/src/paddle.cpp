@@ -221,7 +221,13 @@ Status PaddleSystem::Attach(sim::Solver* solver) {
                                 solver->BodyCount(), m_firstBody + Count()));
   }
   m_solver = solver;
-  for (Paddle& p : m_paddles) p.lastFrame = solver->Time();
+  // The commanded pose starts where the solver's body is: the scene's start pose, or the pose a restart
+  // from a state file put it at (app/src/state_file.cpp).
+  for (int k = 0; k < Count(); ++k) {
+    Paddle& p = m_paddles[k];
+    p.lastFrame = solver->Time();
+    p.state.commanded = ToPose(solver->BodyPose(m_firstBody + k));
+  }
   return Status::Ok();
 }
 

@@ -684,6 +684,40 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
                      "cannot write into");
 }
 
+// With a paddle: the state file holds its pose, so the continued run picks the scripted stroke up
+// where it was instead of sweeping the paddle back from its start pose through the water (which, before
+// the poses were saved, threw the water about at 21 m/s). The paddle's motion is not bit-identical
+// (its frames restart at the saved time), so the continued run is held to the whole run's speeds.
+TEST(HeadlessTest, AStirredRunContinuesWithThePaddleWhereItWas) {
+  test::TempDir dir("state_paddle");
+  const std::string scene = SPHXR_SCENES_DIR "/stir.json";
+  const std::string state = dir.File("half.state"), whole = dir.File("whole.csv"), continued = dir.File("continued.csv");
+  const std::string common = " --threads 1 --no-progress --spacing 0.015 --scene " + Quote(scene);
+  const Result first = RunBinary("--headless --time 0.05 --save-state " + Quote(state) + common, dir);
+  ASSERT_TRUE(first.Exited() && first.Code() == 0) << first.err;
+  const Result second = RunBinary("--headless --time 0.1 --load-state " + Quote(state) + " --stats " + Quote(continued) + common, dir);
+  ASSERT_TRUE(second.Exited() && second.Code() == 0) << second.err;
+  EXPECT_NE(second.out.find(", 0 teleport(s)"), std::string::npos) << second.out;
+  const Result through = RunBinary("--headless --time 0.1 --stats " + Quote(whole) + common, dir);
+  ASSERT_TRUE(through.Exited() && through.Code() == 0) << through.err;
+  // Largest max_speed (column 4) after t = 0.05 s, and the last row's.
+  auto speeds = [](const std::string& csv, double* largest, double* last) {
+    *largest = 0.0;
+    for (const std::string& row : Lines(test::ReadFile(csv))) {
+      const std::vector<std::string> f = Split(row, ',');
+      if (f.size() < 4 || f[0] == "step" || std::stod(f[1]) <= 0.05) continue;
+      *largest = std::max(*largest, std::stod(f[3]));
+      *last = std::stod(f[3]);
+    }
+  };
+  double wholeMax = 0, wholeLast = 0, contMax = 0, contLast = 0;
+  speeds(whole, &wholeMax, &wholeLast);
+  speeds(continued, &contMax, &contLast);
+  ASSERT_GT(wholeMax, 0.3) << "the paddle should be stirring";
+  EXPECT_LT(contMax, 1.2 * wholeMax) << "the continued run jolts the water";
+  EXPECT_NEAR(contLast, wholeLast, 0.15 * wholeLast) << "the continued run's water moves as the whole run's";
+}
+
 // A signal during the settling stops it too, with the summary and the exit code of an interrupted run.
 TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
   test::TempDir dir("settle_interrupt");

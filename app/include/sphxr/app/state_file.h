@@ -7,9 +7,11 @@
 //   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
 //   f64 time  f32 last max speed  f32 last max |a|  f32 spacing  i32 fluid  i32 boundary
 //   u32 n + n bytes: the scene's name
+//   u32 bodies; per body 7 f32: position x y z, orientation w x y z (the paddles' poses)
 //   u32 fields; per field: u32 n + n bytes of name, u32 element bytes, fluid x element bytes
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
@@ -24,6 +26,7 @@ struct StateFile {
   int fluidCount = 0;
   int boundaryCount = 0;
   std::string scene;  // the name of the scene it was saved from (informational)
+  std::vector<sim::RigidPose> bodies;  // the moving bodies' (paddles') poses
 };
 
 /// Writes the solver's fluid and clock to `path`, through `path.tmp` and a rename, so that a failed
@@ -37,7 +40,10 @@ Status ReadStateFile(const std::string& path, StateFile* out);
 Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSetup* setup,
                       std::shared_ptr<const StateFile>* out);
 /// Checks that `state` fits `solver` (the same fluid and boundary counts and spacing: the same scene at
-/// the same spacing) and restores it (sim::Solver::Restore).
+/// the same spacing) and restores it (sim::Solver::Restore). With as many bodies as the file has poses,
+/// each body is put at its saved pose, at rest; otherwise (the window adds a paddle for the mouse) they
+/// stay at the scene's poses, logged. Call before interaction::PaddleSystem::Attach, which takes the
+/// bodies' poses as the paddles' commanded poses.
 Status RestoreState(const StateFile& state, const std::string& path, sim::Solver* solver);
 
 }  // namespace sphxr::app
