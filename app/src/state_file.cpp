@@ -150,6 +150,13 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   out->boundaryCount = boundary;
   uint32_t fields = 0;
   if (!r.Get(&fields)) return truncated();
+  // The fields' bytes must be there before anything is allocated (a damaged count must not ask for
+  // gigabytes).
+  uint64_t perParticle = 0;
+#define SPHXR_FIELD_BYTES(type, name) perParticle += sizeof(type);
+  SPHXR_FLUID_FIELDS(SPHXR_FIELD_BYTES)
+#undef SPHXR_FIELD_BYTES
+  if (static_cast<uint64_t>(fluid) * perParticle > r.Left()) return truncated();
   out->fluid.resize(static_cast<size_t>(fluid));
   uint32_t found = 0;
   for (uint32_t f = 0; f < fields; ++f) {

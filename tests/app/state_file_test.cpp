@@ -91,7 +91,13 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   Put(bad, bytes + "x");
   ExpectRefused(bad, "after the last field");
 
-  std::string other = bytes;  // the version (after 8 bytes of magic and 4 of byte order)
+  std::string other = bytes;  // a fluid count of 2^31 - 1 (after magic, order, version, time and 3 floats)
+  const int32_t huge = 0x7fffffff;
+  std::memcpy(&other[8 + 4 + 4 + 8 + 3 * 4], &huge, 4);
+  Put(bad, other);
+  ExpectRefused(bad, "truncated");  // refused from the file's size, before allocating for it
+
+  other = bytes;  // the version (after 8 bytes of magic and 4 of byte order)
   other[12] = 7;
   Put(bad, other);
   ExpectRefused(bad, "version 7");
