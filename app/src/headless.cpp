@@ -372,8 +372,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
   if (Status s = LoadSceneWithOptions(options, &scene); !s) return s;
-  // A state file is read before anything is allocated; it fixes the spacing (unless --spacing says
-  // otherwise, which RestoreState then refuses) and replaces the settle.
+  // A state file is read before anything is allocated; it fixes the spacing (ReadStartState refuses a
+  // --spacing that differs) and replaces the settle.
   if (!options.loadState.empty() && options.settle > 0.0) {
     return Status::Error("--settle and --load-state: the state file is the start; settle in the run that saves it");
   }
