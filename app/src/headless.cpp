@@ -368,6 +368,15 @@ std::string HeadlessOnlyOptions(const Options& options) {
   return out;
 }
 
+float ExplicitSpacing(const Options& options) {
+  if (options.spacing > 0.0f) return options.spacing;
+  float spacing = 0.0f;
+  for (const std::string& set : options.sets) {  // the last one wins, as in LoadSceneWithOptions
+    if (set.rfind("spacing=", 0) == 0) spacing = std::strtof(set.c_str() + 8, nullptr);
+  }
+  return spacing;
+}
+
 Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
@@ -378,7 +387,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     return Status::Error("--settle and --load-state: the state file is the start; settle in the run that saves it");
   }
   std::shared_ptr<const StateFile> state;
-  if (Status s = ReadStartState(options.loadState, options.spacing, &scene.setup, &state); !s) return s;
+  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), &scene.setup, &state); !s) return s;
   if (state && options.quality == 1 && options.spacing <= 0.0f) {
     SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", state->spacing);
   } else if (options.quality == 1 && options.spacing <= 0.0f) {
@@ -549,7 +558,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (Status s = exportSurface(0); !s) return s;
   }
 
-  double nextFrameTime = 0.0;
+  double nextFrameTime = solver->Time();  // a run from a state file draws from its time on
   // A picture is drawn from a snapshot, as in the window: in water mode from the extracted surface mesh
   // (the scene's "surface" section), with the paddles at their poses.
   SimSnapshot pictureSnap;

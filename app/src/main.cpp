@@ -36,8 +36,8 @@ int Main(int argc, char** argv) {
   }
   // Files only a headless run writes: asked for without a mode, they pick it.
   if (options.mode == Mode::kAuto && (!options.statsPath.empty() || options.exportEvery > 0 ||
-                                      options.exportSurfaceEvery > 0)) {
-    SPHXR_LOG_INFO("--stats/--export-every asked for without a mode: running headless");
+                                      options.exportSurfaceEvery > 0 || !options.saveState.empty())) {
+    SPHXR_LOG_INFO("--stats/--export-every/--save-state asked for without a mode: running headless");
     options.mode = Mode::kHeadless;
   }
   // The default: the headset when a runtime answers (asked without creating a session).

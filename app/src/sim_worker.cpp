@@ -51,7 +51,7 @@ SimWorker::SimWorker(const sim::SolverConfig& config) : m_config(config) {}
 SimWorker::~SimWorker() { Stop(); }
 
 Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-                        std::unique_ptr<interaction::PaddleSystem>* paddles) const {
+                        std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict) const {
   sim::SceneSetup setup = scene.setup;
   paddles->reset();
   if (!scene.paddles.empty()) {
@@ -60,9 +60,12 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
   }
   if (Status s = sim::Solver::Create(setup, m_config, solver); !s) return s;
   if (scene.start) {
-    // A mismatch here (the panel changed the spacing since) falls back to the scene's own start.
+    // On a reset, a mismatch (the panel changed the spacing since) falls back to the scene's own start,
+    // with a fresh solver: a refused restore may have changed nothing, but not provably so.
     if (Status s = RestoreState(*scene.start, scene.startPath, solver->get()); !s) {
+      if (strict) return Status::Error("--load-state " + s.message());
       SPHXR_LOG_WARN("%s; starting from the scene instead", s.message().c_str());
+      if (Status c = sim::Solver::Create(setup, m_config, solver); !c) return c;
     } else {
       SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.startPath.c_str(), scene.start->clock.time);
     }
@@ -74,7 +77,7 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
 }
 
 Status SimWorker::Start(const SimScene& scene) {
-  if (Status s = Build(scene, &m_solver, &m_paddles); !s) return s;
+  if (Status s = Build(scene, &m_solver, &m_paddles, true); !s) return s;
   m_path = ChooseSurfacePath(m_solver->ActiveDevice());
   if (m_path.load() == SurfacePath::kInterop) {
     LogOnce("surface-path", LogLevel::kInfo,
@@ -246,7 +249,7 @@ void SimWorker::Run() {
     if (reset) {
       std::unique_ptr<sim::Solver> fresh;
       std::unique_ptr<interaction::PaddleSystem> freshPaddles;
-      const Status s = Build(*reset, &fresh, &freshPaddles);
+      const Status s = Build(*reset, &fresh, &freshPaddles, false);
       if (!s) {
         SPHXR_LOG_WARN("scene rebuild refused: %s", s.message().c_str());
         std::lock_guard lock(m_mutex);
@@ -268,7 +271,8 @@ void SimWorker::Run() {
         anchorSim = m_solver->Time();
         published = m_solver->GetTotals();
         rateSteps0 = published.steps;
-        rateSim0 = 0.0;
+        rateSim0 = m_solver->Time();  // a state file's start is not 0
+        rateWindow = Clock::now();
         double zero[static_cast<int>(sim::Stage::kCount)] = {};
         Publish(zero, 0.0);
       }

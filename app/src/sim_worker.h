@@ -94,8 +94,10 @@ class SimWorker {
   std::unique_lock<std::mutex> LockSolver();
   void Run();
   void Publish(double stageMs[], double stepMs);
+  /// `strict` (the first build): a state file that does not fit is an error; on a reset it is a
+  /// logged fallback to the scene's own start.
   Status Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-               std::unique_ptr<interaction::PaddleSystem>* paddles) const;
+               std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict) const;
 
   sim::SolverConfig m_config;
   std::unique_ptr<sim::Solver> m_solver;

@@ -1,6 +1,11 @@
 #include "sphxr/app/state_file.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -9,6 +14,7 @@
 #include <vector>
 
 #include "sphxr/common/log.h"
+#include "sphxr/sim/params.h"
 
 namespace sphxr::app {
 namespace {
@@ -20,7 +26,9 @@ constexpr uint32_t kVersion = 1;
 class Writer {
  public:
   explicit Writer(std::ofstream* out) : m_out(out) {}
-  void Bytes(const void* p, size_t n) { m_out->write(static_cast<const char*>(p), static_cast<std::streamsize>(n)); }
+  void Bytes(const void* p, size_t n) {
+    if (n > 0) m_out->write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
+  }
   template <class T>
   void Put(const T& v) {
     Bytes(&v, sizeof(T));
@@ -38,6 +46,7 @@ class Reader {
  public:
   explicit Reader(std::vector<char> data) : m_data(std::move(data)) {}
   bool Bytes(void* p, size_t n) {
+    if (n == 0) return true;  // (no memcpy with an empty field's null pointer)
     if (n > m_data.size() - m_at) return false;
     std::memcpy(p, m_data.data() + m_at, n);
     m_at += n;
@@ -101,25 +110,54 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
   w.Bytes(fluid.name.data(), fluid.name.size() * sizeof(type));
     SPHXR_FLUID_FIELDS(SPHXR_WRITE_FIELD)
 #undef SPHXR_WRITE_FIELD
-    out.flush();
-    if (!out) {
-      out.close();
+    out.close();  // errors reported only at close (quota, network filesystems) count too
+    if (out.fail()) {
       std::error_code ignored;
       std::filesystem::remove(tmp, ignored);
       return Status::Error(path + ": write failed (disk full?); an earlier file there is unchanged");
     }
   }
+  // On the disk before it replaces an earlier file, so a crash after the rename cannot leave it empty.
+  const int fd = ::open(tmp.c_str(), O_RDONLY);
+  const bool synced = fd >= 0 && ::fsync(fd) == 0;
+  if (fd >= 0) ::close(fd);
   std::error_code ec;
+  if (!synced) {
+    std::filesystem::remove(tmp, ec);
+    return Status::Error(path + ": cannot sync " + tmp + " to the disk; an earlier file there is unchanged");
+  }
   std::filesystem::rename(tmp, path, ec);
-  if (ec) return Status::Error(path + ": cannot move " + tmp + " into place: " + ec.message());
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    return Status::Error(path + ": cannot move " + tmp + " into place: " + ec.message());
+  }
   return Status::Ok();
 }
 
 Status ReadStateFile(const std::string& path, StateFile* out) {
   *out = StateFile{};
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) return Status::Error(path + ": cannot open: no such file");
+  if (std::filesystem::is_directory(status)) return Status::Error(path + ": is a directory, not a state file");
+  if (!std::filesystem::is_regular_file(status)) return Status::Error(path + ": not a regular file, not a state file");
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Error(path + ": cannot open: " + std::strerror(errno));
-  std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The magic first, so that a large file given by mistake is not read whole.
+  char head[sizeof(kMagic)] = {};
+  in.read(head, sizeof(head));
+  if (in.gcount() != static_cast<std::streamsize>(sizeof(head)) || std::memcmp(head, kMagic, sizeof(kMagic)) != 0) {
+    return Status::Error(path + ": not an sphxr state file (written by sphxr --save-state)");
+  }
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return Status::Error(path + ": cannot read its size: " + ec.message());
+  std::vector<char> data(static_cast<size_t>(size));
+  std::memcpy(data.data(), head, sizeof(head));
+  in.read(data.data() + sizeof(head), static_cast<std::streamsize>(size - sizeof(head)));
+  if (in.gcount() != static_cast<std::streamsize>(size - sizeof(head))) {
+    return Status::Error(path + ": read failed: the file changed while it was read");
+  }
   Reader r(std::move(data));
   auto truncated = [&]() { return Status::Error(Format("%s: truncated at byte %zu: not a whole state file", path.c_str(), r.At())); };
   char magic[sizeof(kMagic)];
@@ -138,12 +176,20 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
     return truncated();
   }
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
+  const sim::ParamInfo* spacing = sim::FindSolverParam("spacing");
+  if (!std::isfinite(out->spacing) || out->spacing < spacing->min || out->spacing > spacing->max) {
+    return Status::Error(Format("%s: spacing %g m is outside %g to %g m: the file is damaged", path.c_str(), out->spacing,
+                                spacing->min, spacing->max));
+  }
   uint32_t bodies = 0;
   if (!r.Get(&bodies)) return truncated();
   if (bodies > 1024) return Status::Error(Format("%s: %u bodies: the file is damaged", path.c_str(), bodies));
   for (uint32_t k = 0; k < bodies; ++k) {
     float v[7];
     if (!r.Bytes(v, sizeof(v))) return truncated();
+    for (float x : v) {
+      if (!std::isfinite(x)) return Status::Error(Format("%s: body %u has a non-finite pose: the file is damaged", path.c_str(), k));
+    }
     out->bodies.push_back(sim::RigidPose{{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});
   }
   out->fluidCount = fluid;
@@ -158,11 +204,15 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
 #undef SPHXR_FIELD_BYTES
   if (static_cast<uint64_t>(fluid) * perParticle > r.Left()) return truncated();
   out->fluid.resize(static_cast<size_t>(fluid));
-  uint32_t found = 0;
+  std::vector<std::string> seen;
   for (uint32_t f = 0; f < fields; ++f) {
     std::string name;
     uint32_t element = 0;
     if (!r.String(&name, 256) || !r.Get(&element)) return truncated();
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+      return Status::Error(path + ": field '" + name + "' appears twice: the file is damaged");
+    }
+    seen.push_back(name);
     bool known = false;
 #define SPHXR_READ_FIELD(type, fieldName)                                                                       \
   if (name == #fieldName) {                                                                                     \
@@ -172,20 +222,17 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
                                   name.c_str(), element, sizeof(type)));                                        \
     }                                                                                                           \
     if (!r.Bytes(out->fluid.fieldName.data(), static_cast<size_t>(fluid) * sizeof(type))) return truncated();   \
-    ++found;                                                                                                    \
   }
     SPHXR_FLUID_FIELDS(SPHXR_READ_FIELD)
 #undef SPHXR_READ_FIELD
     if (!known) return Status::Error(path + ": field '" + name + "' is not one this build knows (saved by another version)");
   }
-  uint32_t expected = 0;
-#define SPHXR_COUNT_FIELD(type, name) ++expected;
-  SPHXR_FLUID_FIELDS(SPHXR_COUNT_FIELD)
-#undef SPHXR_COUNT_FIELD
-  if (found != expected) {
-    return Status::Error(Format("%s: %u of this build's %u fields are in the file (saved by another version)", path.c_str(),
-                                found, expected));
+#define SPHXR_CHECK_SEEN(type, name)                                                                        \
+  if (std::find(seen.begin(), seen.end(), #name) == seen.end()) {                                           \
+    return Status::Error(path + ": field '" #name "' of this build is not in the file (saved by another version)"); \
   }
+  SPHXR_FLUID_FIELDS(SPHXR_CHECK_SEEN)
+#undef SPHXR_CHECK_SEEN
   if (r.Left() != 0) return Status::Error(Format("%s: %zu bytes after the last field: the file is damaged", path.c_str(), r.Left()));
   return Status::Ok();
 }
@@ -197,8 +244,8 @@ Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSe
   auto state = std::make_shared<StateFile>();
   if (Status s = ReadStateFile(path, state.get()); !s) return Status::Error("--load-state " + s.message());
   if (spacingOption > 0.0f && spacingOption != state->spacing) {
-    return Status::Error(Format("--load-state %s: saved at spacing %g m; --spacing %g m is another particle count "
-                                "(another --spacing)",
+    return Status::Error(Format("--load-state %s: saved at spacing %g m; the command line asks for %g m, another "
+                                "particle count (another --spacing)",
                                 path.c_str(), state->spacing, spacingOption));
   }
   setup->params.spacing = state->spacing;
@@ -216,13 +263,16 @@ Status RestoreState(const StateFile& state, const std::string& path, sim::Solver
                                 solver->FluidCount(), solver->BoundaryCount(), spacing));
   }
   if (Status s = solver->Restore(state.fluid, state.clock); !s) return Status::Error(path + ": " + s.message());
-  if (static_cast<int>(state.bodies.size()) == solver->BodyCount()) {
-    for (int k = 0; k < solver->BodyCount(); ++k) {  // a target time not after now: relocated, at rest
-      if (Status s = solver->SetBodyTarget(k, state.bodies[k], solver->Time()); !s) return Status::Error(path + ": " + s.message());
-    }
-  } else {
-    SPHXR_LOG_INFO("%s: %zu paddle poses saved, %d paddles here: they start at the scene's poses", path.c_str(),
-                   state.bodies.size(), solver->BodyCount());
+  // The scene's paddles come first in every mode; the window and --xr append their hand paddles after
+  // them. So the file's poses belong to the first bodies, as many as both have.
+  const int common = std::min(static_cast<int>(state.bodies.size()), solver->BodyCount());
+  for (int k = 0; k < common; ++k) {  // a target time not after now: relocated, at rest (poses checked on reading)
+    if (Status s = solver->SetBodyTarget(k, state.bodies[k], solver->Time()); !s) return Status::Error(path + ": " + s.message());
+  }
+  if (static_cast<int>(state.bodies.size()) != solver->BodyCount()) {
+    SPHXR_LOG_INFO("%s: %zu paddle poses saved, %d paddles here: the first %d are put back, any others start at the "
+                   "scene's poses",
+                   path.c_str(), state.bodies.size(), solver->BodyCount(), common);
   }
   return Status::Ok();
 }

@@ -520,9 +520,13 @@ Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
   }
   // (sizes are checked by Upload below)
   for (size_t i = 0; i < std::min(fluid.position.size(), fluid.velocity.size()); ++i) {
-    if (!Finite(Xyz(fluid.position[i])) || !Finite(Xyz(fluid.velocity[i]))) {
-      return Status::Error(Format("restore: particle %zu (id %u) has a non-finite position or velocity", i,
-                                  i < fluid.id.size() ? fluid.id[i] : 0u));
+    const bool scalars = i >= fluid.density.size() || i >= fluid.pressure.size() || i >= fluid.acceleration.size() ||
+                         (std::isfinite(fluid.density[i]) && std::isfinite(fluid.pressure[i]) &&
+                          Finite(Xyz(fluid.acceleration[i])));
+    if (!Finite(Xyz(fluid.position[i])) || !Finite(Xyz(fluid.velocity[i])) || !scalars) {
+      return Status::Error(Format("restore: particle %zu (id %u) has a non-finite position, velocity, acceleration, "
+                                  "density or pressure",
+                                  i, i < fluid.id.size() ? fluid.id[i] : 0u));
     }
   }
   Status uploaded;

@@ -678,6 +678,19 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
   ExpectOneLineError(RunBinary("--headless --time 0.04 --load-state " + Quote(scene) + common, dir), "not an sphxr state file");
   ExpectOneLineError(RunBinary("--headless --time 0.04 --spacing 0.012 --load-state " + Quote(half) + common, dir),
                      "another --spacing");
+  ExpectOneLineError(RunBinary("--headless --time 0.04 --set spacing=0.012 --load-state " + Quote(half) + common, dir),
+                     "another --spacing");
+
+  // Pictures go on from the state's time: frames at 0.02, 0.03 and 0.04 s, not a burst for 0 to 0.02.
+  const std::string frames = dir.File("frames");
+  const Result pictures = RunBinary("--headless --time 0.04 --load-state " + Quote(half) + " --frames " + Quote(frames) +
+                                        " --fps 100 --image-size 64x48" + common,
+                                    dir);
+  ASSERT_TRUE(pictures.Exited() && pictures.Code() == 0) << pictures.err;
+  int pngs = 0;
+  for (const auto& e : std::filesystem::directory_iterator(frames)) pngs += e.path().extension() == ".png";
+  EXPECT_GE(pngs, 2);
+  EXPECT_LE(pngs, 4) << "a burst of frames for the time before the state";
   ExpectOneLineError(RunBinary("--headless --time 0.04 --save-state " + Quote(dir.path().string()) + common, dir),
                      "is a directory");
   ExpectOneLineError(RunBinary("--headless --time 0.04 --save-state /nonexistent/x.state" + common, dir),

@@ -4,6 +4,7 @@
 // end-to-end test ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -102,7 +103,7 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   Put(bad, other);
   ExpectRefused(bad, "version 7");
   other = bytes;
-  std::swap(other[8], other[11]);  // the byte-order mark reversed
+  std::reverse(&other[8], &other[12]);  // the byte-order mark as the other byte order writes it
   Put(bad, other);
   ExpectRefused(bad, "byte order");
   other = bytes;
@@ -111,6 +112,13 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   other.replace(at, 8, "velocitx");
   Put(bad, other);
   ExpectRefused(bad, "'velocitx' is not one this build knows");
+  other = bytes;  // "density" and "pressure" are both 4-byte fields of the same length: "pressure" twice
+  const size_t density = other.find("density");
+  ASSERT_NE(density, std::string::npos);
+  other.replace(density - 4, 4 + 7, std::string("\x08\0\0\0pressure", 12));
+  Put(bad, other.substr(0, other.size()));
+  ExpectRefused(bad, "appears twice");
+  ExpectRefused(dir.path().string(), "is a directory");
 }
 
 TEST(StateFile, AnotherSceneOrSpacingIsRefused) {

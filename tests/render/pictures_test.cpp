@@ -358,17 +358,27 @@ TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
     std::unique_ptr<app::DesktopApp> desktop;
     const Status s = app::DesktopApp::Create(options, &desktop);
     ASSERT_TRUE(s.ok()) << s.message();
-    ASSERT_TRUE(desktop->Frame());
-    desktop->OnKey(GLFW_KEY_SPACE);  // pause, then reset: the rebuilt solver's first snapshot is the start
-    desktop->OnKey(GLFW_KEY_R);
-    std::shared_ptr<const app::SimSnapshot> snap;
-    for (int i = 0; i < 200; ++i) {
+    // First the water runs on from the file's time; then pause and reset: the rebuilt solver's first
+    // snapshot (a new one, with no step) must be the file's state again, not the scene's lattice.
+    std::shared_ptr<const app::SimSnapshot> before;
+    for (int i = 0; i < 500; ++i) {
       ASSERT_TRUE(desktop->Frame());
-      snap = desktop->Snapshot();
-      if (desktop->SimSteps() == 0 && snap && snap->steps == 0) break;
+      before = desktop->Snapshot();
+      if (before && before->steps > 0 && before->last.time > state.clock.time) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    ASSERT_TRUE(snap);
+    ASSERT_TRUE(before && before->steps > 0) << "the window's simulation did not run";
+    EXPECT_GT(before->last.time, state.clock.time) << "it runs on from the file's time";
+    desktop->OnKey(GLFW_KEY_SPACE);
+    desktop->OnKey(GLFW_KEY_R);
+    std::shared_ptr<const app::SimSnapshot> snap;
+    for (int i = 0; i < 500; ++i) {
+      ASSERT_TRUE(desktop->Frame());
+      snap = desktop->Snapshot();
+      if (snap && snap != before && snap->steps == 0) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_TRUE(snap && snap != before);
     ASSERT_EQ(snap->steps, 0) << "the reset did not arrive";
     EXPECT_EQ(snap->last.time, state.clock.time) << "the clock starts at the state's time";
     ASSERT_EQ(snap->fluid.size(), state.fluid.size());
@@ -381,6 +391,19 @@ TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
     }
     EXPECT_EQ(differ, 0);
   }
+  // A file from another scene is an error at start-up (not a silent start from the scene).
+  app::Options other = headless;
+  other.scenePath = dir.Write("other.json", R"({ "name": "other", "solver": { "spacing": 0.01, "max_dt": 0.001 },
+    "tank": { "min": [0, 0, 0], "max": [0.2, 0.15, 0.1] },
+    "fluid": [ { "min": [0.0, 0.0, 0.0], "max": [0.1, 0.1, 0.1] } ], "run": { "steps": 2 } })");
+  other.saveState = dir.File("other.state");
+  ASSERT_TRUE(app::RunHeadless(other, &summary).ok());
+  options.loadState = other.saveState;
+  std::unique_ptr<app::DesktopApp> refused;
+  const Status s = app::DesktopApp::Create(options, &refused);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("another scene"), std::string::npos) << s.message();
+  EXPECT_EQ(s.message().find('\n'), std::string::npos) << s.message();
   EXPECT_TRUE(xvfb.Alive()) << "the X server died";
 }
 

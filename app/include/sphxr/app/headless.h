@@ -63,6 +63,8 @@ Status LoadSceneWithOptions(const Options& options, SceneFile* scene);
 /// --time, --steps), e.g. "--stats, --time"; empty when none. The desktop window and --xr warn with it
 /// once their window is open (a fallback to headless still honours them).
 std::string HeadlessOnlyOptions(const Options& options);
+/// The spacing the command line asks for (--spacing, else --set spacing=...), 0 when it asks for none.
+float ExplicitSpacing(const Options& options);
 
 /// What a headless run measured (also printed as the summary).
 struct RunSummary {
