@@ -219,6 +219,24 @@ struct DesktopApp::Impl {
   }
 
   void Panel(const SimSnapshot& snap);
+
+  /// The s key and the panel's button: the running state into --save-state's file, else
+  /// "<scene name>.state" in the working directory (docs/scenes.md "State files").
+  void SaveState() {
+    const std::string path = !options.saveState.empty() ? options.saveState
+                                                        : (scene.name.empty() ? std::string("sphxr") : scene.name) + ".state";
+    double t = 0.0;
+    const Status s = worker->SaveState(path, scene.name, &t);
+    if (s) {
+      saveMessage = Format("saved to %s (t = %.4g s): sphxr --load-state %s", path.c_str(), t, path.c_str());
+      SPHXR_LOG_INFO("state saved to %s at t = %.6g s (sphxr --load-state %s continues from there)", path.c_str(), t,
+                     path.c_str());
+    } else {
+      saveMessage = "save failed: " + s.message();
+      SPHXR_LOG_WARN("save state: %s", s.message().c_str());
+    }
+  }
+  std::string saveMessage;  // the last save, shown in the panel
 };
 
 DesktopApp::DesktopApp() : m_impl(std::make_unique<Impl>()) {}
@@ -251,7 +269,9 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   if (Status s = OpenGlWindow(request, &m.window); !s) return s;
   if (Status s = render::Renderer::Create(config, &m.renderer); !s) return s;
   SPHXR_LOG_INFO("desktop window %dx%d, %s", options.windowWidth, options.windowHeight, render::GlDescription());
-  if (const std::string ignored = HeadlessOnlyOptions(options); !ignored.empty()) {
+  Options notSaved = options;  // the window saves with its s key, into --save-state's file
+  notSaved.saveState.clear();
+  if (const std::string ignored = HeadlessOnlyOptions(notSaved); !ignored.empty()) {
     SPHXR_LOG_WARN("%s: honoured by --headless runs only; the window ignores them", ignored.c_str());
   }
 
@@ -362,6 +382,7 @@ void DesktopApp::OnKey(int key) {
       break;
     case GLFW_KEY_C: m.color = static_cast<render::ParticleColor>((static_cast<int>(m.color) + 1) % 3); break;
     case GLFW_KEY_F: m.FrameTank(); break;
+    case GLFW_KEY_S: m.SaveState(); break;
     case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(m.window, GLFW_TRUE); break;
     default: break;
   }
@@ -403,6 +424,9 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
   }
   ImGui::SameLine();
   if (ImGui::Button("reset (r)")) Rebuild();
+  ImGui::SameLine();
+  if (ImGui::Button("save state (s)")) SaveState();
+  if (!saveMessage.empty()) ImGui::TextWrapped("%s", saveMessage.c_str());
   const std::string error = worker->LastError();
   if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
 

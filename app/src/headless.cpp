@@ -169,7 +169,7 @@ std::string UsageText() {
          "                    minimisation on the solver's steps; the run then starts at t = 0 from that\n"
          "                    state; default: the scene's run.settle; 0: none)\n"
          "  --save-state FILE write the fluid and the clock to FILE at the end of the run (also when it is\n"
-         "                    stopped early), to start another run from (headless)\n"
+         "                    stopped early), to start another run from; in the window, where its s key saves\n"
          "  --load-state FILE start from a state file instead of the scene's fluid (the same scene; its\n"
          "                    spacing is the file's); --time is then the end time on the file's clock\n"
          "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda\n"

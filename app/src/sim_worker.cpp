@@ -342,6 +342,14 @@ std::unique_lock<std::mutex> SimWorker::LockSolver() {
   return std::unique_lock(m_solverMutex);
 }
 
+Status SimWorker::SaveState(const std::string& path, const std::string& sceneName, double* time) {
+  ++m_surfaceWriters;  // ahead of the worker's next step, as a surface writer
+  std::unique_lock solverLock(m_solverMutex);
+  --m_surfaceWriters;
+  *time = m_solver->Time();
+  return WriteStateFile(path, *m_solver, sceneName);
+}
+
 Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build) {
   *build = 0;
   if (m_path.load() != SurfacePath::kInterop) {

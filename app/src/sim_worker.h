@@ -73,6 +73,10 @@ class SimWorker {
   std::string LastError() const;
   void Stop();
 
+  /// Writes the running solver's fluid, clock and paddle poses to `path` (state_file.h) between two
+  /// steps: the window's "save state". Holds the solver lock meanwhile (a step in progress finishes first).
+  /// `*time`: the simulated time saved.
+  Status SaveState(const std::string& path, const std::string& sceneName, double* time);
   /// How the water surface reaches GL: ChooseSurfacePath of the solver's device (logged once at Start),
   /// kHostCopy after FallBackToHostCopy.
   SurfacePath Path() const { return m_path.load(); }

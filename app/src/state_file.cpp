@@ -269,10 +269,12 @@ Status RestoreState(const StateFile& state, const std::string& path, sim::Solver
   for (int k = 0; k < common; ++k) {  // a target time not after now: relocated, at rest (poses checked on reading)
     if (Status s = solver->SetBodyTarget(k, state.bodies[k], solver->Time()); !s) return Status::Error(path + ": " + s.message());
   }
-  if (static_cast<int>(state.bodies.size()) != solver->BodyCount()) {
-    SPHXR_LOG_INFO("%s: %zu paddle poses saved, %d paddles here: the first %d are put back, any others start at the "
-                   "scene's poses",
-                   path.c_str(), state.bodies.size(), solver->BodyCount(), common);
+  if (static_cast<int>(state.bodies.size()) < solver->BodyCount()) {
+    SPHXR_LOG_INFO("%s: %zu paddle pose(s) saved for %d paddles here: the others start at their scene poses", path.c_str(),
+                   state.bodies.size(), solver->BodyCount());
+  } else if (static_cast<int>(state.bodies.size()) > solver->BodyCount()) {
+    SPHXR_LOG_INFO("%s: %zu paddle poses saved, %d paddle(s) here: the first %d are used", path.c_str(),
+                   state.bodies.size(), solver->BodyCount(), common);
   }
   return Status::Ok();
 }

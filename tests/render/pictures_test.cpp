@@ -329,7 +329,7 @@ TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
 
 // --load-state in the window: the water starts where a headless run saved it (every particle, and the
 // clock), and a reset (r) returns there rather than to the scene's lattice.
-TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
+TEST(DesktopWindowTest, StartsFromAStateFileResetsToItAndSavesWithS) {
   Xvfb xvfb;
   ASSERT_FALSE(xvfb.Display().empty()) << "could not start Xvfb (install the xvfb package)";
   const DisplayScope display(xvfb.Display());
@@ -350,6 +350,7 @@ TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
   app::Options options;
   options.scenePath = headless.scenePath;
   options.loadState = headless.saveState;
+  options.saveState = dir.File("window.state");  // where the s key saves
   options.windowWidth = 640;
   options.windowHeight = 400;
   options.threads = 1;
@@ -390,6 +391,22 @@ TEST(DesktopWindowTest, StartsFromAStateFileAndAResetReturnsThere) {
       }
     }
     EXPECT_EQ(differ, 0);
+
+    // One step, then s: the window saves the running state, which a run can start from.
+    desktop->OnKey(GLFW_KEY_N);
+    for (int i = 0; i < 500 && !(desktop->Snapshot() && desktop->Snapshot()->steps == 1); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      ASSERT_TRUE(desktop->Frame());
+    }
+    const std::shared_ptr<const app::SimSnapshot> stepped = desktop->Snapshot();
+    ASSERT_EQ(stepped->steps, 1);
+    desktop->OnKey(GLFW_KEY_S);
+    app::StateFile fromWindow;
+    const Status read = app::ReadStateFile(options.saveState, &fromWindow);
+    ASSERT_TRUE(read.ok()) << read.message();
+    EXPECT_EQ(fromWindow.clock.time, stepped->last.time) << "the state of the paused window, one step on";
+    EXPECT_GT(fromWindow.clock.time, state.clock.time);
+    EXPECT_EQ(fromWindow.fluidCount, state.fluidCount);
   }
   // A file from another scene is an error at start-up (not a silent start from the scene).
   app::Options other = headless;
