@@ -328,7 +328,8 @@ TEST(DesktopWindowTest, OpensDrawsRespondsToScriptedInputAndClosesCleanly) {
 }
 
 // --load-state in the window: the water starts where a headless run saved it (every particle, and the
-// clock), and a reset (r) returns there rather than to the scene's lattice.
+// clock), and a reset (r) returns there rather than to the scene's lattice; the s key saves the running
+// state; a file from another scene is an error at start-up.
 TEST(DesktopWindowTest, StartsFromAStateFileResetsToItAndSavesWithS) {
   Xvfb xvfb;
   ASSERT_FALSE(xvfb.Display().empty()) << "could not start Xvfb (install the xvfb package)";
