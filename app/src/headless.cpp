@@ -467,13 +467,15 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (Status s = RestoreState(*state, options.loadState, solver.get()); !s) return Status::Error("--load-state " + s.message());
     SPHXR_LOG_INFO("started from %s: t = %.6g s, %d fluid particles (saved from '%s')", options.loadState.c_str(),
                    state->clock.time, state->fluidCount, state->scene.c_str());
-    state.reset();  // the solver has it now
   }
+  double paddleClock = solver->Time();  // paddles: display frames at paddleFrameRate get new targets
   if (paddles) {
     if (Status s = paddles->Attach(solver.get()); !s) return s;
     summary->paddles = paddles->Count();
     for (int k = 0; k < paddles->Count(); ++k) summary->paddleParticles += paddles->ParticleCount(k);
+    if (state) RestorePaddles(*state, *solver, paddles.get(), &paddleClock);
   }
+  state.reset();  // the solver and the paddles have it now
 
   summary->startTime = solver->Time();
   const float spacing = scene.setup.params.spacing;
@@ -584,7 +586,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
 
   double activeSum = 0.0;
   double forceSum = 0.0;
-  double nextFrame = solver->Time();  // paddles: display frames at paddleFrameRate get new targets
+  double nextFrame = paddleClock;  // paddles: the next display frame (a state file's, or now)
   const auto begin = std::chrono::steady_clock::now();
   while (targetSteps > 0 ? solver->GetTotals().steps < targetSteps : solver->Time() < targetTime - 1e-9) {
     if (g_interrupt) break;
@@ -659,7 +661,9 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
   }
   if (!options.saveState.empty()) {
-    if (Status s = WriteStateFile(options.saveState, *solver, scene.name); !s) return Status::Error("--save-state " + s.message());
+    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame); !s) {
+      return Status::Error("--save-state " + s.message());
+    }
     summary->stateSaved = options.saveState;
   }
   if (stats.is_open()) {

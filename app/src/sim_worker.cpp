@@ -51,7 +51,7 @@ SimWorker::SimWorker(const sim::SolverConfig& config) : m_config(config) {}
 SimWorker::~SimWorker() { Stop(); }
 
 Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-                        std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict) const {
+                        std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock) const {
   sim::SceneSetup setup = scene.setup;
   paddles->reset();
   if (!scene.paddles.empty()) {
@@ -59,6 +59,7 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
     (*paddles)->AddBodies(&setup);
   }
   if (Status s = sim::Solver::Create(setup, m_config, solver); !s) return s;
+  bool restored = false;
   if (scene.start) {
     // On a reset, a mismatch (the panel changed the spacing since) falls back to the scene's own start,
     // with a fresh solver: a refused restore may have changed nothing, but not provably so.
@@ -67,17 +68,21 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
       SPHXR_LOG_WARN("%s; starting from the scene instead", s.message().c_str());
       if (Status c = sim::Solver::Create(setup, m_config, solver); !c) return c;
     } else {
+      restored = true;
       SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.startPath.c_str(), scene.start->clock.time);
     }
   }
+  *paddleClock = (*solver)->Time();
   if (*paddles) {
     if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
+    if (restored) RestorePaddles(*scene.start, **solver, paddles->get(), paddleClock);
   }
   return Status::Ok();
 }
 
 Status SimWorker::Start(const SimScene& scene) {
-  if (Status s = Build(scene, &m_solver, &m_paddles, true); !s) return s;
+  double paddleClock = 0.0;
+  if (Status s = Build(scene, &m_solver, &m_paddles, true, &paddleClock); !s) return s;
   m_path = ChooseSurfacePath(m_solver->ActiveDevice());
   if (m_path.load() == SurfacePath::kInterop) {
     LogOnce("surface-path", LogLevel::kInfo,
@@ -87,7 +92,7 @@ Status SimWorker::Start(const SimScene& scene) {
     LogOnce("surface-path", LogLevel::kInfo,
             "surface: solver on the CPU: the mesh is copied into each snapshot and uploaded to GL (host path)");
   }
-  m_nextPaddleFrame = 0.0;
+  m_nextPaddleFrame = paddleClock;
   {
     std::lock_guard lock(m_mutex);
     m_scene = scene;
@@ -249,7 +254,8 @@ void SimWorker::Run() {
     if (reset) {
       std::unique_ptr<sim::Solver> fresh;
       std::unique_ptr<interaction::PaddleSystem> freshPaddles;
-      const Status s = Build(*reset, &fresh, &freshPaddles, false);
+      double paddleClock = 0.0;
+      const Status s = Build(*reset, &fresh, &freshPaddles, false, &paddleClock);
       if (!s) {
         SPHXR_LOG_WARN("scene rebuild refused: %s", s.message().c_str());
         std::lock_guard lock(m_mutex);
@@ -260,7 +266,7 @@ void SimWorker::Run() {
         m_solver = std::move(fresh);
         m_builtBuild = 0;  // the new solver has built no surface yet
         solverLock.unlock();
-        m_nextPaddleFrame = 0.0;
+        m_nextPaddleFrame = paddleClock;
         {
           std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
           m_scene = *reset;
@@ -347,7 +353,7 @@ Status SimWorker::SaveState(const std::string& path, const std::string& sceneNam
   std::unique_lock solverLock(m_solverMutex);
   --m_surfaceWriters;
   *time = m_solver->Time();
-  return WriteStateFile(path, *m_solver, sceneName);
+  return WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextPaddleFrame);
 }
 
 Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build) {

@@ -101,7 +101,7 @@ class SimWorker {
   /// `strict` (the first build): a state file that does not fit is an error; on a reset it is a
   /// logged fallback to the scene's own start.
   Status Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-               std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict) const;
+               std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock) const;
 
   sim::SolverConfig m_config;
   std::unique_ptr<sim::Solver> m_solver;

@@ -22,6 +22,9 @@ namespace {
 constexpr char kMagic[8] = {'S', 'P', 'H', 'X', 'R', 'S', 'T', '1'};
 constexpr uint32_t kByteOrder = 0x01020304u;
 constexpr uint32_t kVersion = 1;
+static_assert(sizeof(sim::Vec3) == 12 && sizeof(sim::Quat) == 16 && sizeof(sim::RigidPose) == 28 &&
+                  sizeof(interaction::Pose) == 28,
+              "state files write these structs as their bytes: they must have no padding");
 
 class Writer {
  public:
@@ -73,7 +76,8 @@ class Reader {
 
 }  // namespace
 
-Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName) {
+Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
+                      const interaction::PaddleSystem* paddles, double paddleClock) {
   sim::HostFluid fluid;
   solver.Download(&fluid);
   const sim::SolverClock clock = solver.Clock();
@@ -94,11 +98,30 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     w.String(sceneName);
     w.Put(static_cast<uint32_t>(solver.BodyCount()));
     for (int k = 0; k < solver.BodyCount(); ++k) {
-      const sim::RigidPose p = solver.BodyPose(k);
-      const float v[7] = {p.position.x, p.position.y, p.position.z, p.orientation.w, p.orientation.x, p.orientation.y,
-                          p.orientation.z};
-      w.Bytes(v, sizeof(v));
+      const sim::BodyMotionState m = solver.BodyMotionOf(k);
+      for (const sim::RigidPose& p : {m.pose, m.from, m.to}) w.Put(p);
+      w.Put(m.fromTime);
+      w.Put(m.toTime);
+      w.Put(m.velocity);
+      w.Put(m.angular);
     }
+    const int paddleCount = paddles ? paddles->Count() : 0;
+    w.Put(static_cast<uint32_t>(paddleCount));
+    for (int k = 0; k < paddleCount; ++k) {
+      const interaction::PaddleRestart r = paddles->Restart(k);
+      w.Put(static_cast<int32_t>(r.state.mode));
+      w.Put(r.state.commanded.position);
+      w.Put(r.state.commanded.orientation);
+      w.Put(r.state.force);
+      w.Put(r.state.torque);
+      w.Put(r.state.rawForce);
+      w.Put(r.state.haptic);
+      w.Put(r.state.teleports);
+      w.Put(static_cast<uint8_t>(r.lost ? 1 : 0));
+      w.Put(r.lostSince);
+      w.Put(r.lastFrame);
+    }
+    w.Put(paddleCount > 0 ? paddleClock : 0.0);  // only meaningful with paddles
     uint32_t fields = 0;
 #define SPHXR_COUNT_FIELD(type, name) ++fields;
     SPHXR_FLUID_FIELDS(SPHXR_COUNT_FIELD)
@@ -184,14 +207,48 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   uint32_t bodies = 0;
   if (!r.Get(&bodies)) return truncated();
   if (bodies > 1024) return Status::Error(Format("%s: %u bodies: the file is damaged", path.c_str(), bodies));
-  for (uint32_t k = 0; k < bodies; ++k) {
-    float v[7];
-    if (!r.Bytes(v, sizeof(v))) return truncated();
+  auto finite = [](std::initializer_list<float> v) {
     for (float x : v) {
-      if (!std::isfinite(x)) return Status::Error(Format("%s: body %u has a non-finite pose: the file is damaged", path.c_str(), k));
+      if (!std::isfinite(x)) return false;
     }
-    out->bodies.push_back(sim::RigidPose{{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});
+    return true;
+  };
+  auto finitePose = [&](const sim::RigidPose& p) {
+    return finite({p.position.x, p.position.y, p.position.z, p.orientation.w, p.orientation.x, p.orientation.y,
+                   p.orientation.z});
+  };
+  for (uint32_t k = 0; k < bodies; ++k) {
+    sim::BodyMotionState m;
+    if (!r.Get(&m.pose) || !r.Get(&m.from) || !r.Get(&m.to) || !r.Get(&m.fromTime) || !r.Get(&m.toTime) ||
+        !r.Get(&m.velocity) || !r.Get(&m.angular)) {
+      return truncated();
+    }
+    if (!finitePose(m.pose) || !finitePose(m.from) || !finitePose(m.to) || !std::isfinite(m.fromTime) ||
+        !std::isfinite(m.toTime) || !finite({m.velocity.x, m.velocity.y, m.velocity.z, m.angular.x, m.angular.y, m.angular.z})) {
+      return Status::Error(Format("%s: body %u has a non-finite motion: the file is damaged", path.c_str(), k));
+    }
+    out->bodies.push_back(m);
   }
+  uint32_t paddleCount = 0;
+  if (!r.Get(&paddleCount)) return truncated();
+  if (paddleCount > bodies) return Status::Error(Format("%s: %u paddles for %u bodies: the file is damaged", path.c_str(), paddleCount, bodies));
+  for (uint32_t k = 0; k < paddleCount; ++k) {
+    interaction::PaddleRestart p;
+    int32_t mode = 0;
+    uint8_t lost = 0;
+    if (!r.Get(&mode) || !r.Get(&p.state.commanded.position) || !r.Get(&p.state.commanded.orientation) ||
+        !r.Get(&p.state.force) || !r.Get(&p.state.torque) || !r.Get(&p.state.rawForce) || !r.Get(&p.state.haptic) ||
+        !r.Get(&p.state.teleports) || !r.Get(&lost) || !r.Get(&p.lostSince) || !r.Get(&p.lastFrame)) {
+      return truncated();
+    }
+    if (mode < 0 || mode > static_cast<int32_t>(interaction::PaddleMode::kWithdrawing)) {
+      return Status::Error(Format("%s: paddle %u has mode %d: the file is damaged", path.c_str(), k, mode));
+    }
+    p.state.mode = static_cast<interaction::PaddleMode>(mode);
+    p.lost = lost != 0;
+    out->paddles.push_back(p);
+  }
+  if (!r.Get(&out->paddleClock)) return truncated();
   out->fluidCount = fluid;
   out->boundaryCount = boundary;
   uint32_t fields = 0;
@@ -237,6 +294,17 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   return Status::Ok();
 }
 
+bool RestorePaddles(const StateFile& state, const sim::Solver& solver, interaction::PaddleSystem* paddles,
+                    double* paddleClock) {
+  if (!paddles || state.paddles.empty() || static_cast<int>(state.paddles.size()) != paddles->Count() ||
+      static_cast<int>(state.bodies.size()) != solver.BodyCount()) {
+    return false;
+  }
+  for (int k = 0; k < paddles->Count(); ++k) paddles->Restore(k, state.paddles[k]);
+  *paddleClock = state.paddleClock;
+  return true;
+}
+
 Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSetup* setup,
                       std::shared_ptr<const StateFile>* out) {
   out->reset();
@@ -263,11 +331,17 @@ Status RestoreState(const StateFile& state, const std::string& path, sim::Solver
                                 solver->FluidCount(), solver->BoundaryCount(), spacing));
   }
   if (Status s = solver->Restore(state.fluid, state.clock); !s) return Status::Error(path + ": " + s.message());
+  if (static_cast<int>(state.bodies.size()) == solver->BodyCount()) {  // the same bodies: their whole motion
+    for (int k = 0; k < solver->BodyCount(); ++k) {
+      if (Status s = solver->SetBodyMotion(k, state.bodies[k]); !s) return Status::Error(path + ": " + s.message());
+    }
+    return Status::Ok();
+  }
   // The scene's paddles come first in every mode; the window and --xr append their hand paddles after
   // them. So the file's poses belong to the first bodies, as many as both have.
   const int common = std::min(static_cast<int>(state.bodies.size()), solver->BodyCount());
   for (int k = 0; k < common; ++k) {  // a target time not after now: relocated, at rest (poses checked on reading)
-    if (Status s = solver->SetBodyTarget(k, state.bodies[k], solver->Time()); !s) return Status::Error(path + ": " + s.message());
+    if (Status s = solver->SetBodyTarget(k, state.bodies[k].pose, solver->Time()); !s) return Status::Error(path + ": " + s.message());
   }
   if (static_cast<int>(state.bodies.size()) < solver->BodyCount()) {
     SPHXR_LOG_INFO("%s: %zu paddle pose(s) saved for %d paddles here: the others start at their scene poses", path.c_str(),

@@ -695,6 +695,37 @@ float Solver::MaxBodySpeed() const {
   return speed;
 }
 
+BodyMotionState Solver::BodyMotionOf(int body) const {
+  const auto& b = m_bodies[body];
+  BodyMotionState m;
+  m.pose = b.pose;
+  m.from = b.from;
+  m.to = b.to;
+  m.fromTime = b.fromTime;
+  m.toTime = b.toTime;
+  m.velocity = b.velocity;
+  m.angular = b.angular;
+  return m;
+}
+
+Status Solver::SetBodyMotion(int body, const BodyMotionState& m) {
+  if (body < 0 || body >= BodyCount()) return Status::Error(Format("SetBodyMotion: no body %d (%d bodies)", body, BodyCount()));
+  if (m_totals.steps != 0) return Status::Error("SetBodyMotion: only before the first step (a restart)");
+  const bool finite = Finite(m.pose.position) && Finite(m.pose.orientation) && Finite(m.from.position) &&
+                      Finite(m.from.orientation) && Finite(m.to.position) && Finite(m.to.orientation) &&
+                      std::isfinite(m.fromTime) && std::isfinite(m.toTime) && Finite(m.velocity) && Finite(m.angular);
+  if (!finite) return Status::Error(Format("SetBodyMotion: non-finite motion for body %d", body));
+  auto& b = m_bodies[body];
+  b.pose = m.pose;
+  b.from = m.from;
+  b.to = m.to;
+  b.fromTime = m.fromTime;
+  b.toTime = m.toTime;
+  b.velocity = m.velocity;
+  b.angular = m.angular;
+  return Status::Ok();
+}
+
 Status Solver::SetBodyTarget(int body, const RigidPose& target, double targetTime) {
   if (body < 0 || body >= BodyCount()) return Status::Error(Format("SetBodyTarget: no body %d (%d bodies)", body, BodyCount()));
   if (!Finite(target.position) || !Finite(target.orientation) || !std::isfinite(targetTime)) {

@@ -2,6 +2,8 @@
 // substeps with position linear and rotation slerp, and every boundary particle carries v + w x r.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 
 #include "sphxr/interaction/paddle.h"
@@ -68,6 +70,60 @@ TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
   EXPECT_EQ(solver->BodyPose(0).position.x, from.x);
   EXPECT_FALSE(solver->SetBodyTarget(1, RigidPose{}, 1.0).ok());
   EXPECT_FALSE(solver->SetBodyTarget(0, RigidPose{Vec3{NAN, 0, 0}, Quat{}}, 1.0).ok());
+}
+
+// A restart (state files): a body's whole motion read mid-segment and set on a fresh solver of the same
+// scene gives the same next steps, body and water, bit for bit; bad motions and late calls are refused.
+TEST(BodyMotion, ARestartContinuesTheMotionExactly) {
+  SceneSetup scene = test::TankScene({0, 0, 0}, {0.3f, 0.2f, 0.2f}, 0.01f);
+  scene.fluid.push_back(test::Block({0, 0, 0}, {0.3f, 0.05f, 0.2f}));
+  RigidBodySetup body;
+  body.shapes = interaction::BladeOnHandle(0.05f, 0.01f, 0.06f, 0.05f, 0.012f);
+  body.points = interaction::SamplePaddle(body.shapes, scene.params.spacing);
+  body.pose.position = Vec3{0.1f, 0.08f, 0.1f};  // in the water
+  scene.bodies.push_back(body);
+  auto through = test::CreateOrFail(scene);
+  ASSERT_TRUE(through);
+  ASSERT_TRUE(through->SetBodyTarget(0, RigidPose{Vec3{0.2f, 0.08f, 0.1f}, body.pose.orientation}, 0.1).ok());
+  for (int k = 0; k < 15; ++k) ASSERT_TRUE(through->Step().ok());
+  const BodyMotionState motion = through->BodyMotionOf(0);
+  EXPECT_GT(Length(motion.velocity), 0.5f) << "saved while moving along its segment (1 m/s)";
+  HostFluid fluid;
+  through->Download(&fluid);
+  const SolverClock clock = through->Clock();
+
+  auto restored = test::CreateOrFail(scene);
+  ASSERT_TRUE(restored);
+  ASSERT_TRUE(restored->Restore(fluid, clock).ok());
+  ASSERT_TRUE(restored->SetBodyMotion(0, motion).ok());
+  for (int k = 0; k < 10; ++k) {
+    ASSERT_TRUE(through->Step().ok());
+    ASSERT_TRUE(restored->Step().ok());
+    ASSERT_EQ(through->LastStep().dt, restored->LastStep().dt) << "step " << k;
+  }
+  const RigidPose a = through->BodyPose(0), b = restored->BodyPose(0);
+  EXPECT_EQ(a.position.x, b.position.x);
+  EXPECT_EQ(a.orientation.w, b.orientation.w);
+  HostFluid fa, fb;
+  through->Download(&fa);
+  restored->Download(&fb);
+  ASSERT_EQ(fa.size(), fb.size());
+  for (size_t i = 0; i < fa.size(); ++i) {
+    ASSERT_EQ(fa.position[i].x, fb.position[i].x) << "particle " << i;
+    ASSERT_EQ(fa.velocity[i].y, fb.velocity[i].y) << "particle " << i;
+  }
+
+  BodyMotionState bad = motion;
+  bad.toTime = std::numeric_limits<double>::quiet_NaN();
+  auto fresh = test::CreateOrFail(scene);
+  ASSERT_TRUE(fresh);
+  Status s = fresh->SetBodyMotion(0, bad);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("non-finite"), std::string::npos) << s.message();
+  EXPECT_FALSE(fresh->SetBodyMotion(1, motion).ok()) << "no body 1";
+  s = restored->SetBodyMotion(0, motion);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("before the first step"), std::string::npos) << s.message();
 }
 
 TEST(BodyMotion, BadBodiesAreRefused) {

@@ -7,13 +7,18 @@
 //   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
 //   f64 time  f32 last max speed  f32 last max |a|  f32 spacing  i32 fluid  i32 boundary
 //   u32 n + n bytes: the scene's name
-//   u32 bodies; per body 7 f32: position x y z, orientation w x y z (the paddles' poses)
+//   u32 bodies; per body: pose, from, to (7 f32 each: position x y z, orientation w x y z),
+//     f64 fromTime, f64 toTime, 3 f32 velocity, 3 f32 angular velocity (sim::BodyMotionState)
+//   u32 paddles; per paddle: i32 mode, 7 f32 commanded pose, 3+3+3 f32 force, torque, raw force,
+//     f32 haptic, i64 teleports, u8 lost, f64 lostSince, f64 lastFrame (interaction::PaddleRestart);
+//     then f64 the next paddle frame's time (the runner's paddle clock)
 //   u32 fields; per field: u32 n + n bytes of name, u32 element bytes, fluid x element bytes
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "sphxr/common/status.h"
+#include "sphxr/interaction/paddle.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/solver.h"
 
@@ -26,12 +31,17 @@ struct StateFile {
   int fluidCount = 0;
   int boundaryCount = 0;
   std::string scene;  // the name of the scene it was saved from (informational)
-  std::vector<sim::RigidPose> bodies;  // the moving bodies' (paddles') poses
+  std::vector<sim::BodyMotionState> bodies;        // the moving bodies' (paddles') motion
+  std::vector<interaction::PaddleRestart> paddles;  // the paddle system's own state (may be empty)
+  double paddleClock = 0.0;                         // the next paddle frame's time (with `paddles`)
 };
 
 /// Writes the solver's fluid and clock to `path`, through `path.tmp` and a rename, so that a failed
 /// write leaves any earlier file at `path` as it was.
-Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName);
+/// With `paddles`, their own state and `paddleClock` (the runner's next paddle frame) are saved too, so
+/// that a restart continues their motion exactly.
+Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
+                      const interaction::PaddleSystem* paddles = nullptr, double paddleClock = 0.0);
 /// Reads a state file; a one-line error names the path and what is wrong (not a state file, another
 /// version or byte order, a field this build does not have or lacks, truncated).
 Status ReadStateFile(const std::string& path, StateFile* out);
@@ -40,10 +50,15 @@ Status ReadStateFile(const std::string& path, StateFile* out);
 Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSetup* setup,
                       std::shared_ptr<const StateFile>* out);
 /// Checks that `state` fits `solver` (the same fluid and boundary counts and spacing: the same scene at
-/// the same spacing) and restores it (sim::Solver::Restore). With as many bodies as the file has poses,
-/// each body is put at its saved pose, at rest; otherwise (the window adds a paddle for the mouse) they
-/// stay at the scene's poses, logged. Call before interaction::PaddleSystem::Attach, which takes the
-/// bodies' poses as the paddles' commanded poses.
+/// the same spacing) and restores it (sim::Solver::Restore). With as many bodies as the file has, each
+/// body's whole motion is restored; with fewer or more (the window and --xr add hand paddles after the
+/// scene's) the first bodies are put at their saved poses, at rest, logged. Call before
+/// interaction::PaddleSystem::Attach, which takes the bodies' poses as the paddles' commanded poses.
 Status RestoreState(const StateFile& state, const std::string& path, sim::Solver* solver);
+/// After Attach: when the file has the paddle system's state for exactly these paddles (and bodies),
+/// puts it back and sets `*paddleClock` to the saved next paddle frame (returns true); else changes
+/// nothing (false): the paddles start from their bodies' poses.
+bool RestorePaddles(const StateFile& state, const sim::Solver& solver, interaction::PaddleSystem* paddles,
+                    double* paddleClock);
 
 }  // namespace sphxr::app

@@ -85,6 +85,14 @@ struct PaddleState {
   int64_t teleports = 0;
 };
 
+/// A paddle's own state beyond its body's motion, for a restart (a state file).
+struct PaddleRestart {
+  PaddleState state;
+  bool lost = false;
+  double lostSince = 0.0;
+  double lastFrame = 0.0;
+};
+
 class PaddleSystem {
  public:
   /// Checks the descriptions against the scene (spacing, tank) and samples the shapes.
@@ -103,6 +111,19 @@ class PaddleSystem {
   void AfterStep();
   /// BeginFrame, then solver steps until the solver's time reaches displayTime.
   Status Advance(double displayTime, const std::vector<HandInput>& hands = {});
+
+  /// Paddle k's state for a restart, and setting it back (after Attach, which resets it).
+  PaddleRestart Restart(int k) const {
+    const Paddle& p = m_paddles[k];
+    return PaddleRestart{p.state, p.lost, p.lostSince, p.lastFrame};
+  }
+  void Restore(int k, const PaddleRestart& r) {
+    Paddle& p = m_paddles[k];
+    p.state = r.state;
+    p.lost = r.lost;
+    p.lostSince = r.lostSince;
+    p.lastFrame = r.lastFrame;
+  }
 
   int Count() const { return static_cast<int>(m_paddles.size()); }
   const PaddleDesc& Desc(int k) const { return m_paddles[k].desc; }

@@ -73,6 +73,14 @@ struct SolverClock {
   float lastMaxAccel = 0.0f;  // m/s^2, of the last step
 };
 
+/// A moving body's motion, for a restart: where it is, the target segment it is on, and the velocities
+/// of its last step (which the next step's time step depends on).
+struct BodyMotionState {
+  RigidPose pose, from, to;
+  double fromTime = 0.0, toTime = 0.0;
+  Vec3 velocity, angular;
+};
+
 /// Called after every step of a Settle with the simulated seconds done; returning false stops it there
 /// (a caller that draws a progress bar limits its own redraw rate).
 using SettleProgress = std::function<bool(double done)>;
@@ -142,6 +150,9 @@ class Solver {
   /// the body at once, at rest (no velocity from the jump). Errors: bad index, non-finite values.
   Status SetBodyTarget(int body, const RigidPose& target, double targetTime);
   RigidPose BodyPose(int body) const { return m_bodies[body].pose; }
+  /// The body's whole motion (a state file), and setting it back (before the first step, like Restore).
+  BodyMotionState BodyMotionOf(int body) const;
+  Status SetBodyMotion(int body, const BodyMotionState& motion);
   /// Linear velocity of the body origin and angular velocity during the last step.
   Vec3 BodyVelocity(int body) const { return m_bodies[body].velocity; }
   Vec3 BodyAngularVelocity(int body) const { return m_bodies[body].angular; }
