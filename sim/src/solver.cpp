@@ -489,17 +489,28 @@ Status Solver::Step() {
 void Solver::Download(HostFluid* out) const { m_backend->Download(out); }
 void Solver::DownloadBoundary(HostBoundary* out) const { m_backend->DownloadBoundary(out); }
 
-Status Solver::Upload(const HostFluid& fluid) {
+Status Solver::CheckFluidSizes(const HostFluid& fluid, const char* who) const {
   if (static_cast<int>(fluid.size()) != FluidCount()) {
-    return Status::Error(Format("Upload: %zu particles given, the solver has %d", fluid.size(), FluidCount()));
+    return Status::Error(Format("%s: %zu particles given, the solver has %d", who, fluid.size(), FluidCount()));
   }
 #define SPHXR_CHECK_SIZE(type, name)                                                  \
   if (fluid.name.size() != fluid.size())                                              \
-    return Status::Error("Upload: field '" #name "' has a different size than position");
+    return Status::Error(std::string(who) + ": field '" #name "' has a different size than position");
   SPHXR_FLUID_FIELDS(SPHXR_CHECK_SIZE)
 #undef SPHXR_CHECK_SIZE
+  return Status::Ok();
+}
+
+Status Solver::Upload(const HostFluid& fluid) {
+  if (Status s = CheckFluidSizes(fluid, "Upload"); !s) return s;
   m_backend->Upload(fluid);
   return Status::Ok();
+}
+
+void Solver::HoldBody(BodyMotion* b, const RigidPose& pose, double time) {
+  b->pose = b->from = b->to = pose;
+  b->fromTime = b->toTime = time;
+  b->velocity = b->angular = Vec3{};
 }
 
 SolverClock Solver::Clock() const {
@@ -518,44 +529,34 @@ Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
                                 "finite and not negative",
                                 clock.time, clock.lastMaxSpeed, clock.lastMaxAccel));
   }
-  // (sizes are checked by Upload below)
-  for (size_t i = 0; i < std::min(fluid.position.size(), fluid.velocity.size()); ++i) {
-    const bool scalars = i >= fluid.density.size() || i >= fluid.pressure.size() || i >= fluid.acceleration.size() ||
-                         (std::isfinite(fluid.density[i]) && std::isfinite(fluid.pressure[i]) &&
-                          Finite(Xyz(fluid.acceleration[i])));
-    if (!Finite(Xyz(fluid.position[i])) || !Finite(Xyz(fluid.velocity[i])) || !scalars) {
+  if (Status s = CheckFluidSizes(fluid, "restore"); !s) return s;
+  for (size_t i = 0; i < fluid.size(); ++i) {
+    if (!Finite(Xyz(fluid.position[i])) || !Finite(Xyz(fluid.velocity[i])) || !Finite(Xyz(fluid.acceleration[i])) ||
+        !std::isfinite(fluid.density[i]) || !std::isfinite(fluid.pressure[i])) {
       return Status::Error(Format("restore: particle %zu (id %u) has a non-finite position, velocity, acceleration, "
                                   "density or pressure",
-                                  i, i < fluid.id.size() ? fluid.id[i] : 0u));
+                                  i, fluid.id[i]));
     }
   }
-  Status uploaded;
-  const ReuseParams& reuse = m_scene.reuse;
-  const int32_t maxIdle = reuse.enabled ? reuse.idle : -1;
-  bool outOfRange = false;
-  for (int32_t ic : fluid.idle) outOfRange = outOfRange || ic > maxIdle || ic < -2 - maxIdle;
-  if (outOfRange && fluid.idle.size() == fluid.size()) {
-    // Saved under other reuse parameters (or with reuse on, now off): counts this run's IDLE does not
-    // allow start active, so that no particle reuses longer than IDLE steps.
+  // Idle counts saved under other reuse parameters (or with reuse on, now off) that this run's IDLE does
+  // not allow start active, so that no particle reuses longer than IDLE steps.
+  const int32_t maxIdle = m_scene.reuse.enabled ? m_scene.reuse.idle : -1;
+  auto allowed = [maxIdle](int32_t ic) { return ic <= maxIdle && ic >= -2 - maxIdle; };
+  if (std::all_of(fluid.idle.begin(), fluid.idle.end(), allowed)) {
+    m_backend->Upload(fluid);
+  } else {
     HostFluid clamped = fluid;
     for (int32_t& ic : clamped.idle) {
-      if (ic > maxIdle || ic < -2 - maxIdle) ic = -1;
+      if (!allowed(ic)) ic = -1;
     }
-    uploaded = Upload(clamped);
-  } else {
-    uploaded = Upload(fluid);
+    m_backend->Upload(clamped);
   }
-  if (!uploaded) return Status::Error("restore: " + uploaded.message());
   m_last = StepInfo{};
   m_last.time = clock.time;
   m_last.maxSpeed = clock.lastMaxSpeed;
   m_maxAccel = clock.lastMaxAccel;
   m_totals = Totals{};
-  for (BodyMotion& b : m_bodies) {  // a body stays where it is, at rest, on the restored clock
-    b.from = b.to = b.pose;
-    b.fromTime = b.toTime = clock.time;
-    b.velocity = b.angular = Vec3{};
-  }
+  for (BodyMotion& b : m_bodies) HoldBody(&b, b.pose, clock.time);  // where it is, at rest, on the restored clock
   return Status::Ok();
 }
 
@@ -602,11 +603,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
   }
   m_backend->FireMix(0.0f, 0.0f);
   r.time = m_last.time;
-  for (BodyMotion& b : m_bodies) {  // a body stays where it is, at rest, on the restarted clock
-    b.from = b.to = b.pose;
-    b.fromTime = b.toTime = 0.0;
-    b.velocity = b.angular = Vec3{};
-  }
+  for (BodyMotion& b : m_bodies) HoldBody(&b, b.pose, 0.0);  // where it is, at rest, on the restarted clock
   m_last = StepInfo{};
   m_totals = Totals{};
   m_maxAccel = 0.0f;
@@ -695,18 +692,7 @@ float Solver::MaxBodySpeed() const {
   return speed;
 }
 
-BodyMotionState Solver::BodyMotionOf(int body) const {
-  const auto& b = m_bodies[body];
-  BodyMotionState m;
-  m.pose = b.pose;
-  m.from = b.from;
-  m.to = b.to;
-  m.fromTime = b.fromTime;
-  m.toTime = b.toTime;
-  m.velocity = b.velocity;
-  m.angular = b.angular;
-  return m;
-}
+BodyMotionState Solver::BodyMotionOf(int body) const { return m_bodies[body]; }
 
 Status Solver::SetBodyMotion(int body, const BodyMotionState& m) {
   if (body < 0 || body >= BodyCount()) return Status::Error(Format("SetBodyMotion: no body %d (%d bodies)", body, BodyCount()));
@@ -715,14 +701,7 @@ Status Solver::SetBodyMotion(int body, const BodyMotionState& m) {
                       Finite(m.from.orientation) && Finite(m.to.position) && Finite(m.to.orientation) &&
                       std::isfinite(m.fromTime) && std::isfinite(m.toTime) && Finite(m.velocity) && Finite(m.angular);
   if (!finite) return Status::Error(Format("SetBodyMotion: non-finite motion for body %d", body));
-  auto& b = m_bodies[body];
-  b.pose = m.pose;
-  b.from = m.from;
-  b.to = m.to;
-  b.fromTime = m.fromTime;
-  b.toTime = m.toTime;
-  b.velocity = m.velocity;
-  b.angular = m.angular;
+  static_cast<BodyMotionState&>(m_bodies[body]) = m;
   return Status::Ok();
 }
 
@@ -734,9 +713,7 @@ Status Solver::SetBodyTarget(int body, const RigidPose& target, double targetTim
   BodyMotion& b = m_bodies[body];
   const RigidPose to{target.position, Normalized(target.orientation)};
   if (targetTime <= m_last.time) {  // relocate now, at rest
-    b.pose = b.from = b.to = to;
-    b.fromTime = b.toTime = m_last.time;
-    b.velocity = b.angular = Vec3{};
+    HoldBody(&b, to, m_last.time);
     return Status::Ok();
   }
   b.from = b.pose;

@@ -186,14 +186,16 @@ class Solver {
   StepInfo m_last;
   Totals m_totals;
   float m_maxAccel = 0.0f;
-  struct BodyMotion {
-    RigidPose pose;              // now
-    RigidPose from, to;          // the current target segment
-    double fromTime = 0.0, toTime = 0.0;
-    Vec3 velocity, angular;      // during the last step
+  // The motion (pose now, the target segment, the last step's velocities: BodyMotionState, which is what
+  // a restart saves) and the fixed shape.
+  struct BodyMotion : BodyMotionState {
     float boundRadius = 0.0f;
     std::vector<ShapePrimitive> shapes;
   };
+  /// Puts `b` at `pose`, at rest, on a segment that ends at `time` (a relocation; Settle; Restore).
+  static void HoldBody(BodyMotion* b, const RigidPose& pose, double time);
+  /// Every field of `fluid` has FluidCount() entries; else an error naming the first that does not.
+  Status CheckFluidSizes(const HostFluid& fluid, const char* who) const;
   std::vector<BodyMotion> m_bodies;
   std::vector<BodyLoad> m_bodyLoads;
   RigidPose BodyPoseAt(const BodyMotion& body, double time) const;
