@@ -370,9 +370,12 @@ std::string HeadlessOnlyOptions(const Options& options) {
 
 float ExplicitSpacing(const Options& options) {
   if (options.spacing > 0.0f) return options.spacing;
+  // --set spacing=...: parsed as LoadSceneWithOptions parses it (the last one wins).
   float spacing = 0.0f;
-  for (const std::string& set : options.sets) {  // the last one wins, as in LoadSceneWithOptions
-    if (set.rfind("spacing=", 0) == 0) spacing = std::strtof(set.c_str() + 8, nullptr);
+  for (const std::string& set : options.sets) {
+    sim::SceneSetup probe;
+    probe.params.spacing = 0.0f;
+    if (set.rfind("spacing=", 0) == 0 && SetSolverParam(&probe, set)) spacing = probe.params.spacing;
   }
   return spacing;
 }

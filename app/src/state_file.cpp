@@ -184,9 +184,7 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   Reader r(std::move(data));
   auto truncated = [&]() { return Status::Error(Format("%s: truncated at byte %zu: not a whole state file", path.c_str(), r.At())); };
   char magic[sizeof(kMagic)];
-  if (!r.Bytes(magic, sizeof(magic)) || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) {
-    return Status::Error(path + ": not an sphxr state file (written by sphxr --save-state)");
-  }
+  r.Bytes(magic, sizeof(magic));  // checked above, before the file was read whole
   uint32_t order = 0, version = 0;
   if (!r.Get(&order) || !r.Get(&version)) return truncated();
   if (order != kByteOrder) return Status::Error(path + ": written on a machine of the other byte order");
