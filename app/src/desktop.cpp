@@ -181,7 +181,6 @@ struct DesktopApp::Impl {
     simScene = SimSceneFromFile(scene);
     simScene.setup = setup;
     simScene.start = start;
-    simScene.startPath = options.loadState;
     hand.index = 1;
     bool handHeld = false;
     for (const interaction::PaddleDesc& d : simScene.paddles) {

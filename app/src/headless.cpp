@@ -467,7 +467,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) return Status::Error(options.scenePath + ": " + s.message());
 
   if (state) {
-    if (Status s = RestoreState(*state, options.loadState, solver.get()); !s) return Status::Error("--load-state " + s.message());
+    if (Status s = RestoreState(*state, solver.get()); !s) return Status::Error("--load-state " + s.message());
     SPHXR_LOG_INFO("started from %s: t = %.6g s, %d fluid particles (saved from '%s')", options.loadState.c_str(),
                    state->clock.time, state->fluidCount, state->scene.c_str());
   }

@@ -63,13 +63,13 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
   if (scene.start) {
     // On a reset, a mismatch (the panel changed the spacing since) falls back to the scene's own start,
     // with a fresh solver: a refused restore may have changed nothing, but not provably so.
-    if (Status s = RestoreState(*scene.start, scene.startPath, solver->get()); !s) {
+    if (Status s = RestoreState(*scene.start, solver->get()); !s) {
       if (strict) return Status::Error("--load-state " + s.message());
       SPHXR_LOG_WARN("%s; starting from the scene instead", s.message().c_str());
       if (Status c = sim::Solver::Create(setup, m_config, solver); !c) return c;
     } else {
       restored = true;
-      SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.startPath.c_str(), scene.start->clock.time);
+      SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.start->path.c_str(), scene.start->clock.time);
     }
   }
   *paddleClock = (*solver)->Time();

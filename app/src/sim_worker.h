@@ -36,7 +36,6 @@ struct SimScene {
   /// --load-state: the fluid and clock to start from instead of the scene's (every reset returns
   /// there); null: the scene's own start.
   std::shared_ptr<const StateFile> start;
-  std::string startPath;
 };
 
 /// The scene file's scene, with a default hand-held paddle (interaction::BladeOnHandle sized to the

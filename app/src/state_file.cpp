@@ -160,6 +160,7 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
 
 Status ReadStateFile(const std::string& path, StateFile* out) {
   *out = StateFile{};
+  out->path = path;
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) return Status::Error(path + ": cannot open: no such file");
@@ -319,7 +320,8 @@ Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSe
   return Status::Ok();
 }
 
-Status RestoreState(const StateFile& state, const std::string& path, sim::Solver* solver) {
+Status RestoreState(const StateFile& state, sim::Solver* solver) {
+  const std::string& path = state.path;
   const float spacing = solver->Scene().params.spacing;
   if (state.fluidCount != solver->FluidCount() || state.boundaryCount != solver->BoundaryCount() ||
       state.spacing != spacing) {

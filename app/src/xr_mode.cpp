@@ -220,7 +220,6 @@ Status StartSimulation(XrApp& app) {
   atSpacing.setup = app.setup;
   app.simScene = SimSceneFromFile(atSpacing, {0, 1});
   app.simScene.start = start;
-  app.simScene.startPath = options.loadState;
   app.simScene.surface.enabled = app.mode == render::RenderMode::kWater;
   app.worker = std::make_unique<SimWorker>(solverConfig);
   if (Status s = app.worker->Start(app.simScene); !s) return Status::Error(options.scenePath + ": " + s.message());

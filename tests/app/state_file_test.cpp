@@ -68,7 +68,7 @@ TEST(StateFile, WhatIsWrittenIsReadBackBitForBit) {
 
   // It restores into a fresh solver of the same scene, and the clock comes with it.
   auto fresh = test::CreateOrFail(test::SmallDamBreak(0.01f));
-  ASSERT_TRUE(RestoreState(state, path, fresh.get()).ok());
+  ASSERT_TRUE(RestoreState(state, fresh.get()).ok());
   EXPECT_EQ(fresh->Time(), solver->Time());
 }
 
@@ -131,7 +131,7 @@ TEST(StateFile, AnotherSceneOrSpacingIsRefused) {
   ASSERT_TRUE(ReadStateFile(path, &state).ok());
   auto coarser = test::CreateOrFail(test::SmallDamBreak(0.02f));
   ASSERT_TRUE(coarser);
-  const Status s = RestoreState(state, path, coarser.get());
+  const Status s = RestoreState(state, coarser.get());
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("saved from 'small'"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("another scene"), std::string::npos) << s.message();

@@ -31,6 +31,7 @@ struct StateFile {
   int fluidCount = 0;
   int boundaryCount = 0;
   std::string scene;  // the name of the scene it was saved from (informational)
+  std::string path;   // the file it was read from (for messages)
   std::vector<sim::BodyMotionState> bodies;        // the moving bodies' (paddles') motion
   std::vector<interaction::PaddleRestart> paddles;  // the paddle system's own state (may be empty)
   double paddleClock = 0.0;                         // the next paddle frame's time (with `paddles`)
@@ -54,7 +55,7 @@ Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSe
 /// body's whole motion is restored; with fewer or more (the window and --xr add hand paddles after the
 /// scene's) the first bodies are put at their saved poses, at rest, logged. Call before
 /// interaction::PaddleSystem::Attach, which takes the bodies' poses as the paddles' commanded poses.
-Status RestoreState(const StateFile& state, const std::string& path, sim::Solver* solver);
+Status RestoreState(const StateFile& state, sim::Solver* solver);
 /// After Attach: when the file has the paddle system's state for exactly these paddles (and bodies),
 /// puts it back and sets `*paddleClock` to the saved next paddle frame (returns true); else changes
 /// nothing (false): the paddles start from their bodies' poses.

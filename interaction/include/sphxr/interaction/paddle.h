@@ -89,8 +89,8 @@ struct PaddleState {
 struct PaddleRestart {
   PaddleState state;
   bool lost = false;
-  double lostSince = 0.0;
-  double lastFrame = 0.0;
+  double lostSince = 0.0;     // while lost: the time tracking was last seen
+  double lastFrame = 0.0;     // the display time of the last frame that drove it
 };
 
 class PaddleSystem {
@@ -113,17 +113,8 @@ class PaddleSystem {
   Status Advance(double displayTime, const std::vector<HandInput>& hands = {});
 
   /// Paddle k's state for a restart, and setting it back (after Attach, which resets it).
-  PaddleRestart Restart(int k) const {
-    const Paddle& p = m_paddles[k];
-    return PaddleRestart{p.state, p.lost, p.lostSince, p.lastFrame};
-  }
-  void Restore(int k, const PaddleRestart& r) {
-    Paddle& p = m_paddles[k];
-    p.state = r.state;
-    p.lost = r.lost;
-    p.lostSince = r.lostSince;
-    p.lastFrame = r.lastFrame;
-  }
+  PaddleRestart Restart(int k) const { return m_paddles[k]; }
+  void Restore(int k, const PaddleRestart& r) { static_cast<PaddleRestart&>(m_paddles[k]) = r; }
 
   int Count() const { return static_cast<int>(m_paddles.size()); }
   const PaddleDesc& Desc(int k) const { return m_paddles[k].desc; }
@@ -135,14 +126,11 @@ class PaddleSystem {
   int ParticleCount(int k) const { return static_cast<int>(m_paddles[k].points.size()); }
 
  private:
-  struct Paddle {
+  // The state that changes (PaddleRestart: what a restart saves) and the fixed description.
+  struct Paddle : PaddleRestart {
     PaddleDesc desc;
     std::vector<sim::Vec3> points;
     float lowest = 0.0f;        // lowest body-frame y of the solid (for the withdraw height)
-    PaddleState state;
-    bool lost = false;
-    double lostSince = 0.0;     // while lost: the time tracking was last seen
-    double lastFrame = 0.0;
   };
   Pose Withdrawn(const Paddle& p, const Pose& from) const;
   Status Drive(Paddle& p, int body, const HandInput& hand, double displayTime);
