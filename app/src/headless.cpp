@@ -468,9 +468,18 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
 
   if (state) {
     if (Status s = RestoreState(*state, solver.get()); !s) return Status::Error("--load-state " + s.message());
-    SPHXR_LOG_INFO("started from %s: t = %.6g s, %d fluid particles (saved from '%s')", options.loadState.c_str(),
-                   state->clock.time, state->fluidCount, state->scene.c_str());
+    SPHXR_LOG_INFO("started from %s: t = %.6g s, step %lld, %d fluid particles (saved from '%s')",
+                   options.loadState.c_str(), state->clock.time, static_cast<long long>(std::max<int64_t>(state->step, 0)),
+                   state->fluidCount, state->scene.c_str());
+    if (state->step < 0) {
+      SPHXR_LOG_INFO("%s is a version-1 state file, without the step count: steps, exports and CSV rows are numbered "
+                     "from 0 again", options.loadState.c_str());
+    }
+    summary->stepsBefore = std::max<int64_t>(state->step, 0);
   }
+  // Steps count on from the state's (the whole run's numbering): the CSV's step column, the export files'
+  // numbers and the state saved at the end.
+  const int64_t stepsBefore = summary->stepsBefore;
   double paddleClock = solver->Time();  // paddles: display frames at paddleFrameRate get new targets
   if (paddles) {
     if (Status s = paddles->Attach(solver.get()); !s) return s;
@@ -537,8 +546,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (s) ++summary->exports;
     return s;
   };
-  if (options.exportEvery > 0) {
-    if (Status s = exportNow(0); !s) return s;
+  // The start is exported when its step is one of the exports' (a fresh run's step 0): a continued
+  // run then writes the files the whole run writes.
+  if (options.exportEvery > 0 && stepsBefore % options.exportEvery == 0) {
+    if (Status s = exportNow(stepsBefore); !s) return s;
   }
   sim::SurfaceMesh surfaceMesh;
   double surfaceSeconds = 0.0;
@@ -559,11 +570,19 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
     return s;
   };
-  if (options.exportSurfaceEvery > 0) {
-    if (Status s = exportSurface(0); !s) return s;
+  if (options.exportSurfaceEvery > 0 && stepsBefore % options.exportSurfaceEvery == 0) {
+    if (Status s = exportSurface(stepsBefore); !s) return s;
   }
 
-  double nextFrameTime = solver->Time();  // a run from a state file draws from its time on
+  // Frame k shows the state after the first step at or past t = k / fps. A run from a state file goes on
+  // with the first frame after the state's time (the earlier run drew those up to it), so continued
+  // runs number and draw their frames as the whole run does.
+  int64_t frameIndex = 0;
+  if (summary->startTime > 0.0) {
+    frameIndex = static_cast<int64_t>(std::floor(summary->startTime * options.fps));
+    while (static_cast<double>(frameIndex) / options.fps - 1e-9 <= summary->startTime) ++frameIndex;
+  }
+  const int64_t firstFrame = frameIndex;
   // A picture is drawn from a snapshot, as in the window: in water mode from the extracted surface mesh
   // (the scene's "surface" section), with the paddles at their poses.
   SimSnapshot pictureSnap;
@@ -578,14 +597,19 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   auto frameNow = [&]() -> Status {
     if (options.framesDir.empty()) return Status::Ok();
     char name[64];
-    std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(summary->frames));
+    std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(frameIndex));
     const std::string path = (std::filesystem::path(options.framesDir) / name).string();
     if (Status s = picture(path); !s) return s;
     ++summary->frames;
-    nextFrameTime += 1.0 / options.fps;
+    ++frameIndex;
     return Status::Ok();
   };
-  if (Status s = frameNow(); !s) return s;
+  auto frameDue = [&]() {
+    return !options.framesDir.empty() && solver->Time() >= static_cast<double>(frameIndex) / options.fps - 1e-9;
+  };
+  while (frameDue()) {
+    if (Status s = frameNow(); !s) return s;
+  }
 
   double activeSum = 0.0;
   double forceSum = 0.0;
@@ -606,7 +630,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       }
     }
     const sim::StepInfo& info = solver->LastStep();
-    const int64_t step = solver->GetTotals().steps;
+    const int64_t step = solver->GetTotals().steps;  // this run's
+    const int64_t wholeStep = stepsBefore + step;    // the whole run's (files and CSV rows)
     summary->peakMeanDensityError = std::max(summary->peakMeanDensityError, info.meanDensityError);
     summary->maxSpeed = std::max(summary->maxSpeed, info.maxSpeed);
     activeSum += info.activeFraction;
@@ -616,7 +641,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                                   static_cast<long long>(step), info.time));
     }
     if (stats) {
-      stats << step << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
+      stats << wholeStep << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
             << info.maxDensityError << ',' << info.clamped << ',' << info.activeFraction;
       if (probeEveryStep) {
         solver->Download(&host);
@@ -631,15 +656,15 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
         }
       }
       stats << '\n';
-      if (!stats) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?) at step " + std::to_string(step));
+      if (!stats) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?) at step " + std::to_string(wholeStep));
     }
-    if (options.exportEvery > 0 && step % options.exportEvery == 0) {
-      if (Status s = exportNow(step); !s) return s;
+    if (options.exportEvery > 0 && wholeStep % options.exportEvery == 0) {
+      if (Status s = exportNow(wholeStep); !s) return s;
     }
-    if (options.exportSurfaceEvery > 0 && step % options.exportSurfaceEvery == 0) {
-      if (Status s = exportSurface(step); !s) return s;
+    if (options.exportSurfaceEvery > 0 && wholeStep % options.exportSurfaceEvery == 0) {
+      if (Status s = exportSurface(wholeStep); !s) return s;
     }
-    while (!options.framesDir.empty() && solver->Time() >= nextFrameTime - 1e-9) {
+    while (frameDue()) {
       if (Status s = frameNow(); !s) return s;
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
@@ -650,7 +675,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   summary->wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   summary->interrupted = g_interrupt;  // also a signal during the last step
   if (summary->interrupted) {
-    const int64_t step = solver->GetTotals().steps;
+    const int64_t step = stepsBefore + solver->GetTotals().steps;
     progress.Finish();
     SPHXR_LOG_WARN("%s at step %lld (t = %.4f s): stopping; the summary and the files cover the run so far",
                    summary->interrupted == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)",
@@ -664,7 +689,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
   }
   if (!options.saveState.empty()) {
-    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame); !s) {
+    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame, stepsBefore); !s) {
       return Status::Error("--save-state " + s.message());
     }
     summary->stateSaved = options.saveState;
@@ -702,9 +727,20 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       SPHXR_LOG_INFO("ffmpeg is not on the PATH: the frames stay a PNG sequence");
     } else {
       movie = (std::filesystem::path(options.framesDir) / "movie.mp4").string();
-      const std::string command = Format("'%s' -y -loglevel error -framerate %g -i '%s/frame_%%05d.png' -pix_fmt yuv420p "
-                                         "-vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' '%s'",
-                                         ffmpeg.c_str(), options.fps, options.framesDir.c_str(), movie.c_str());
+      // From the earliest frame of the unbroken sequence ending in this run's: a run continued into its
+      // first run's directory makes the whole run's movie.
+      int64_t movieStart = firstFrame;
+      while (movieStart > 0) {
+        char name[64];
+        std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(movieStart - 1));
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(std::filesystem::path(options.framesDir) / name, ec)) break;
+        --movieStart;
+      }
+      const std::string command = Format("'%s' -y -loglevel error -framerate %g -start_number %lld -i '%s/frame_%%05d.png' "
+                                         "-pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' '%s'",
+                                         ffmpeg.c_str(), options.fps, static_cast<long long>(movieStart),
+                                         options.framesDir.c_str(), movie.c_str());
       if (std::system(command.c_str()) != 0) {
         SPHXR_LOG_WARN("ffmpeg could not make %s; the PNG frames are there", movie.c_str());
         movie.clear();
@@ -718,8 +754,13 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   std::printf("sphxr summary: %s\n", scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str());
   std::printf("  particles       %d fluid, %d boundary\n", summary->fluid, summary->boundary);
   std::printf("  device          %s\n", sim::DeviceName(solver->ActiveDevice()));
-  std::printf("  steps           %lld (%lld with dt clamped to the stability limit)\n",
-              static_cast<long long>(summary->steps), static_cast<long long>(totals.dtClampedSteps));
+  std::printf("  steps           %lld (%lld with dt clamped to the stability limit)%s\n",
+              static_cast<long long>(summary->steps), static_cast<long long>(totals.dtClampedSteps),
+              summary->stepsBefore > 0 ? Format("; steps %lld to %lld of the whole run",
+                                                static_cast<long long>(summary->stepsBefore + 1),
+                                                static_cast<long long>(summary->stepsBefore + summary->steps))
+                                             .c_str()
+                                       : "");
   const double ran = summary->simulatedTime - summary->startTime;
   if (summary->startTime > 0.0) {
     std::printf("  simulated time  %.4f s to %.4f s (from the state file) in %.2f s wall (%.3f simulated s per wall s)\n",

@@ -51,7 +51,8 @@ SimWorker::SimWorker(const sim::SolverConfig& config) : m_config(config) {}
 SimWorker::~SimWorker() { Stop(); }
 
 Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-                        std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock) const {
+                        std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock,
+                        int64_t* stepsBefore) const {
   sim::SceneSetup setup = scene.setup;
   paddles->reset();
   if (!scene.paddles.empty()) {
@@ -73,6 +74,7 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
     }
   }
   *paddleClock = (*solver)->Time();
+  *stepsBefore = restored ? std::max<int64_t>(scene.start->step, 0) : 0;
   if (*paddles) {
     if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
     if (restored) RestorePaddles(*scene.start, **solver, paddles->get(), paddleClock);
@@ -82,7 +84,7 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
 
 Status SimWorker::Start(const SimScene& scene) {
   double paddleClock = 0.0;
-  if (Status s = Build(scene, &m_solver, &m_paddles, true, &paddleClock); !s) return s;
+  if (Status s = Build(scene, &m_solver, &m_paddles, true, &paddleClock, &m_stepsBefore); !s) return s;
   m_path = ChooseSurfacePath(m_solver->ActiveDevice());
   if (m_path.load() == SurfacePath::kInterop) {
     LogOnce("surface-path", LogLevel::kInfo,
@@ -255,7 +257,8 @@ void SimWorker::Run() {
       std::unique_ptr<sim::Solver> fresh;
       std::unique_ptr<interaction::PaddleSystem> freshPaddles;
       double paddleClock = 0.0;
-      const Status s = Build(*reset, &fresh, &freshPaddles, false, &paddleClock);
+      int64_t stepsBefore = 0;
+      const Status s = Build(*reset, &fresh, &freshPaddles, false, &paddleClock, &stepsBefore);
       if (!s) {
         SPHXR_LOG_WARN("scene rebuild refused: %s", s.message().c_str());
         std::lock_guard lock(m_mutex);
@@ -265,8 +268,9 @@ void SimWorker::Run() {
         m_paddles = std::move(freshPaddles);  // bound to the old solver: replaced first
         m_solver = std::move(fresh);
         m_builtBuild = 0;  // the new solver has built no surface yet
+        m_nextPaddleFrame = paddleClock;  // (under the solver lock: SaveState reads both)
+        m_stepsBefore = stepsBefore;
         solverLock.unlock();
-        m_nextPaddleFrame = paddleClock;
         {
           std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
           m_scene = *reset;
@@ -353,7 +357,7 @@ Status SimWorker::SaveState(const std::string& path, const std::string& sceneNam
   std::unique_lock solverLock(m_solverMutex);
   --m_surfaceWriters;
   *time = m_solver->Time();
-  return WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextPaddleFrame);
+  return WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextPaddleFrame, m_stepsBefore);
 }
 
 Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build) {

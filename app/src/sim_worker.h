@@ -100,13 +100,15 @@ class SimWorker {
   /// `strict` (the first build): a state file that does not fit is an error; on a reset it is a
   /// logged fallback to the scene's own start.
   Status Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-               std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock) const;
+               std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock,
+               int64_t* stepsBefore) const;
 
   sim::SolverConfig m_config;
   std::unique_ptr<sim::Solver> m_solver;
   std::unique_ptr<interaction::PaddleSystem> m_paddles;
   SimScene m_scene;
   double m_nextPaddleFrame = 0.0;
+  int64_t m_stepsBefore = 0;  // the state file's step count when the solver started from one
   std::thread m_thread;
   mutable std::mutex m_mutex;
   std::condition_variable m_wake;

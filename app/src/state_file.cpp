@@ -21,7 +21,8 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'H', 'X', 'R', 'S', 'T', '1'};
 constexpr uint32_t kByteOrder = 0x01020304u;
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2: the step count after the clock
+constexpr uint32_t kOldestVersion = 1;
 static_assert(sizeof(sim::Vec3) == 12 && sizeof(sim::Quat) == 16 && sizeof(sim::RigidPose) == 28 &&
                   sizeof(interaction::Pose) == 28,
               "state files write these structs as their bytes: they must have no padding");
@@ -77,7 +78,7 @@ class Reader {
 }  // namespace
 
 Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
-                      const interaction::PaddleSystem* paddles, double paddleClock) {
+                      const interaction::PaddleSystem* paddles, double paddleClock, int64_t stepsBefore) {
   sim::HostFluid fluid;
   solver.Download(&fluid);
   const sim::SolverClock clock = solver.Clock();
@@ -92,6 +93,7 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     w.Put(clock.time);
     w.Put(clock.lastMaxSpeed);
     w.Put(clock.lastMaxAccel);
+    w.Put(static_cast<int64_t>(stepsBefore + solver.GetTotals().steps));
     w.Put(solver.Scene().params.spacing);
     w.Put(static_cast<int32_t>(solver.FluidCount()));
     w.Put(static_cast<int32_t>(solver.BoundaryCount()));
@@ -189,14 +191,18 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   uint32_t order = 0, version = 0;
   if (!r.Get(&order) || !r.Get(&version)) return truncated();
   if (order != kByteOrder) return Status::Error(path + ": written on a machine of the other byte order");
-  if (version != kVersion) {
-    return Status::Error(Format("%s: state file version %u; this build reads version %u", path.c_str(), version, kVersion));
+  if (version < kOldestVersion || version > kVersion) {
+    return Status::Error(Format("%s: state file version %u; this build reads versions %u to %u", path.c_str(), version,
+                                kOldestVersion, kVersion));
   }
   int32_t fluid = 0, boundary = 0;
-  if (!r.Get(&out->clock.time) || !r.Get(&out->clock.lastMaxSpeed) || !r.Get(&out->clock.lastMaxAccel) ||
-      !r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) {
-    return truncated();
+  if (!r.Get(&out->clock.time) || !r.Get(&out->clock.lastMaxSpeed) || !r.Get(&out->clock.lastMaxAccel)) return truncated();
+  out->step = -1;  // version 1 has no step count
+  if (version >= 2) {
+    if (!r.Get(&out->step)) return truncated();
+    if (out->step < 0) return Status::Error(Format("%s: step count %lld: the file is damaged", path.c_str(), static_cast<long long>(out->step)));
   }
+  if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return truncated();
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
   const sim::ParamInfo* spacing = sim::FindSolverParam("spacing");
   if (!std::isfinite(out->spacing) || out->spacing < spacing->min || out->spacing > spacing->max) {

@@ -43,7 +43,8 @@ TEST(StateFile, WhatIsWrittenIsReadBackBitForBit) {
   auto solver = SteppedSolver(25);
   ASSERT_TRUE(solver);
   const std::string path = dir.File("a.state");
-  ASSERT_TRUE(WriteStateFile(path, *solver, "small dam break").ok());
+  // As a run continued from a file saved at step 1000 saves it: its own 25 steps counted on from there.
+  ASSERT_TRUE(WriteStateFile(path, *solver, "small dam break", nullptr, 0.0, 1000).ok());
   EXPECT_FALSE(std::filesystem::exists(path + ".tmp")) << "the temporary file is renamed into place";
 
   StateFile state;
@@ -56,6 +57,7 @@ TEST(StateFile, WhatIsWrittenIsReadBackBitForBit) {
   EXPECT_EQ(state.boundaryCount, solver->BoundaryCount());
   EXPECT_EQ(state.spacing, 0.01f);
   EXPECT_EQ(state.clock.time, solver->Time());
+  EXPECT_EQ(state.step, 1025);
   EXPECT_EQ(state.clock.lastMaxSpeed, solver->Clock().lastMaxSpeed);
   EXPECT_EQ(state.clock.lastMaxAccel, solver->Clock().lastMaxAccel);
   EXPECT_GT(state.clock.lastMaxSpeed, 0.0f);
@@ -92,9 +94,11 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   Put(bad, bytes + "x");
   ExpectRefused(bad, "after the last field");
 
-  std::string other = bytes;  // a fluid count of 2^31 - 1 (after magic, order, version, time and 3 floats)
+  // Offsets: magic 8, byte order 4, version 4, time 8, max speed and |a| 4 + 4, step 8, spacing 4.
+  constexpr size_t kStepAt = 8 + 4 + 4 + 8 + 2 * 4, kFluidAt = kStepAt + 8 + 4;
+  std::string other = bytes;  // a fluid count of 2^31 - 1
   const int32_t huge = 0x7fffffff;
-  std::memcpy(&other[8 + 4 + 4 + 8 + 3 * 4], &huge, 4);
+  std::memcpy(&other[kFluidAt], &huge, 4);
   Put(bad, other);
   ExpectRefused(bad, "truncated");  // refused from the file's size, before allocating for it
 
@@ -102,6 +106,11 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   other[12] = 7;
   Put(bad, other);
   ExpectRefused(bad, "version 7");
+  other = bytes;
+  const int64_t negative = -5;
+  std::memcpy(&other[kStepAt], &negative, 8);
+  Put(bad, other);
+  ExpectRefused(bad, "step count -5");
   other = bytes;
   std::reverse(&other[8], &other[12]);  // the byte-order mark as the other byte order writes it
   Put(bad, other);
@@ -119,6 +128,30 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   Put(bad, other.substr(0, other.size()));
   ExpectRefused(bad, "appears twice");
   ExpectRefused(dir.path().string(), "is a directory");
+}
+
+// Version 1 (the first session's files) had no step count: it is still read, with the step unknown
+// (-1: a continued run numbers from 0), and the fluid as saved.
+TEST(StateFile, AVersionOneFileIsReadWithoutItsStepCount) {
+  test::TempDir dir("state_v1");
+  auto solver = SteppedSolver(4);
+  ASSERT_TRUE(solver);
+  const std::string v2 = dir.File("v2.state"), v1 = dir.File("v1.state");
+  ASSERT_TRUE(WriteStateFile(v2, *solver, "s").ok());
+  std::string bytes = Bytes(v2);
+  bytes[12] = 1;                            // the version
+  bytes.erase(8 + 4 + 4 + 8 + 2 * 4, 8);    // and no step count after the clock
+  Put(v1, bytes);
+  StateFile a, b;
+  ASSERT_TRUE(ReadStateFile(v2, &a).ok());
+  const Status s = ReadStateFile(v1, &b);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(a.step, 4);
+  EXPECT_EQ(b.step, -1);
+  EXPECT_EQ(b.clock.time, a.clock.time);
+  EXPECT_EQ(b.spacing, a.spacing);
+  ASSERT_EQ(b.fluid.size(), a.fluid.size());
+  EXPECT_EQ(std::memcmp(b.fluid.position.data(), a.fluid.position.data(), a.fluid.position.size() * sizeof(a.fluid.position[0])), 0);
 }
 
 TEST(StateFile, AnotherSceneOrSpacingIsRefused) {

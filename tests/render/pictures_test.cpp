@@ -408,6 +408,7 @@ TEST(DesktopWindowTest, StartsFromAStateFileResetsToItAndSavesWithS) {
     EXPECT_EQ(fromWindow.clock.time, stepped->last.time) << "the state of the paused window, one step on";
     EXPECT_GT(fromWindow.clock.time, state.clock.time);
     EXPECT_EQ(fromWindow.fluidCount, state.fluidCount);
+    EXPECT_EQ(fromWindow.step, state.step + 1) << "the window's steps count on from the file's";
   }
   // A file from another scene is an error at start-up (not a silent start from the scene).
   app::Options other = headless;

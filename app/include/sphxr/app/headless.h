@@ -97,6 +97,7 @@ struct RunSummary {
   int interrupted = 0;               // the signal (SIGINT, SIGTERM) that stopped the run early, else 0
   sim::SettleReport settle;          // --settle / run.settle (time 0: not settled)
   double startTime = 0.0;            // s on the clock at the first step (a --load-state's time, else 0)
+  int64_t stepsBefore = 0;           // the --load-state's step count (steps, exports and CSV rows number on from it)
   std::string stateSaved;            // --save-state: the file written
 };
 

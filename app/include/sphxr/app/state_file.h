@@ -2,10 +2,11 @@
 // State files: the fluid and the clock of a run, to restart from (`sphxr --save-state FILE`,
 // `--load-state FILE`; docs/scenes.md "State files"). Every field of the one field list
 // (sim/fields.h) is stored with its name and element size, so a file from a build with other fields
-// is refused by name instead of being misread. Binary, little-endian, version 1:
+// is refused by name instead of being misread. Binary, little-endian, version 2 (version 1, read
+// too, lacks the step count):
 //
 //   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
-//   f64 time  f32 last max speed  f32 last max |a|  f32 spacing  i32 fluid  i32 boundary
+//   f64 time  f32 last max speed  f32 last max |a|  i64 step  f32 spacing  i32 fluid  i32 boundary
 //   u32 n + n bytes: the scene's name
 //   u32 bodies; per body: pose, from, to (7 f32 each: position x y z, orientation w x y z),
 //     f64 fromTime, f64 toTime, 3 f32 velocity, 3 f32 angular velocity (sim::BodyMotionState)
@@ -13,6 +14,7 @@
 //     f32 haptic, i64 teleports, u8 lost, f64 lostSince, f64 lastFrame (interaction::PaddleRestart);
 //     then f64 the next paddle frame's time (the runner's paddle clock)
 //   u32 fields; per field: u32 n + n bytes of name, u32 element bytes, fluid x element bytes
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,6 +29,10 @@ namespace sphxr::app {
 struct StateFile {
   sim::HostFluid fluid;
   sim::SolverClock clock;
+  /// Steps from the saved run's t = 0 (its first run's step 0, across continued runs), so that a run
+  /// continued from the file numbers its steps, exports and CSV rows on as the whole run would; -1 in
+  /// a version-1 file (unknown: numbered from 0).
+  int64_t step = 0;
   float spacing = 0.0f;
   int fluidCount = 0;
   int boundaryCount = 0;
@@ -40,9 +46,11 @@ struct StateFile {
 /// Writes the solver's fluid and clock to `path`, through `path.tmp` and a rename, so that a failed
 /// write leaves any earlier file at `path` as it was.
 /// With `paddles`, their own state and `paddleClock` (the runner's next paddle frame) are saved too, so
-/// that a restart continues their motion exactly.
+/// that a restart continues their motion exactly. The step count saved is `stepsBefore` (the steps
+/// before this solver's first: a continued run's StateFile::step) plus the solver's own.
 Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
-                      const interaction::PaddleSystem* paddles = nullptr, double paddleClock = 0.0);
+                      const interaction::PaddleSystem* paddles = nullptr, double paddleClock = 0.0,
+                      int64_t stepsBefore = 0);
 /// Reads a state file; a one-line error names the path and what is wrong (not a state file, another
 /// version or byte order, a field this build does not have or lacks, truncated).
 Status ReadStateFile(const std::string& path, StateFile* out);
