@@ -221,20 +221,7 @@ struct DesktopApp::Impl {
 
   /// The s key and the panel's button: the running state into --save-state's file, else
   /// "<scene name>.state" in the working directory (docs/scenes.md "State files").
-  void SaveState() {
-    const std::string path = !options.saveState.empty() ? options.saveState
-                                                        : (scene.name.empty() ? std::string("sphxr") : scene.name) + ".state";
-    double t = 0.0;
-    const Status s = worker->SaveState(path, scene.name, &t);
-    if (s) {
-      saveMessage = Format("saved to %s (t = %.4g s): sphxr --load-state %s", path.c_str(), t, path.c_str());
-      SPHXR_LOG_INFO("state saved to %s at t = %.6g s (sphxr --load-state %s continues from there)", path.c_str(), t,
-                     path.c_str());
-    } else {
-      saveMessage = "save failed: " + s.message();
-      SPHXR_LOG_WARN("save state: %s", s.message().c_str());
-    }
-  }
+  void SaveState() { saveMessage = worker->SaveStateLogged(options.saveState, scene.name); }
   std::string saveMessage;  // the last save, shown in the panel
 };
 

@@ -360,6 +360,18 @@ Status SimWorker::SaveState(const std::string& path, const std::string& sceneNam
   return WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextPaddleFrame, m_stepsBefore);
 }
 
+std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::string& sceneName) {
+  const std::string path = !savePath.empty() ? savePath : (sceneName.empty() ? std::string("sphxr") : sceneName) + ".state";
+  double t = 0.0;
+  if (const Status s = SaveState(path, sceneName, &t); !s) {
+    SPHXR_LOG_WARN("save state: %s", s.message().c_str());
+    return "save failed: " + s.message();
+  }
+  SPHXR_LOG_INFO("state saved to %s at t = %.6g s (sphxr --load-state %s continues from there)", path.c_str(), t,
+                 path.c_str());
+  return Format("saved to %s (t = %.4g s): sphxr --load-state %s", path.c_str(), t, path.c_str());
+}
+
 Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build) {
   *build = 0;
   if (m_path.load() != SurfacePath::kInterop) {

@@ -76,6 +76,10 @@ class SimWorker {
   /// steps: the window's "save state". Holds the solver lock meanwhile (a step in progress finishes first).
   /// `*time`: the simulated time saved.
   Status SaveState(const std::string& path, const std::string& sceneName, double* time);
+  /// "save state" in the window and in --xr (the s key, the panel's button, the controller's save
+  /// button): SaveState into `savePath` (--save-state's file), else "<scene name>.state" in the working
+  /// directory; logged either way. Returns the line the panel shows.
+  std::string SaveStateLogged(const std::string& savePath, const std::string& sceneName);
   /// How the water surface reaches GL: ChooseSurfacePath of the solver's device (logged once at Start),
   /// kHostCopy after FallBackToHostCopy.
   SurfacePath Path() const { return m_path.load(); }

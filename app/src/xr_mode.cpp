@@ -102,6 +102,7 @@ struct XrApp {
   render::ParticleColor color = render::ParticleColor::kSpeed;
   float lastHaptic[xr::kHandCount] = {0, 0};
   bool exitRequested = false;
+  std::string saveMessage;  // the last save (the panel's button or the controller's), shown in the panel
 
   ~XrApp() {
     if (worker) worker->Stop();
@@ -123,6 +124,8 @@ struct XrApp {
     if (ImGui::Button("reset")) worker->Reset(simScene);
     ImGui::SameLine();
     if (ImGui::Button("end session")) RequestExit();
+    if (ImGui::Button("save state")) saveMessage = worker->SaveStateLogged(options.saveState, scene.name);
+    if (!saveMessage.empty()) ImGui::TextWrapped("%s", saveMessage.c_str());
     ImGui::Text("%d fluid + %d boundary particles", snap.fluidCount, snap.boundaryCount);
     ImGui::Text("t = %.3f s, %.3g simulated s per wall s", snap.last.time, snap.simSecondsPerWallSecond);
     const xr::FrameTimings& t = session->lastFrameTimings();
@@ -328,6 +331,10 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
           if (info.resetRequested) {
             SPHXR_LOG_INFO("reset button: the scene starts again");
             app.worker->Reset(app.simScene);
+          }
+          if (info.saveRequested) {  // between two steps; a few ms for a pool of thousands
+            SPHXR_LOG_INFO("save button: saving the water");
+            app.saveMessage = app.worker->SaveStateLogged(app.options.saveState, app.scene.name);
           }
           // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
           frame = MakeFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));

@@ -330,6 +330,27 @@ TEST(XrApp, StartsFromAStateFile) {
   EXPECT_EQ(CountOf(bad.out, "desktop"), 0) << "no fallback to the window for a bad file:\n" << bad.out;
 }
 
+// The save button (Touch: right B) writes the running water to --save-state's file between two steps,
+// once per press, and a headless run continues from it.
+TEST(XrApp, SaveButtonSavesTheWaterAndARunContinuesFromIt) {
+  SimHeadset headset("app_save");
+  headset.env.Set("SPHXR_SIM_XR_PROFILE", "oculus/touch_controller");
+  SetUpHeadset(headset, "0 right 0.3 0.8 0.1 0 0 0 1\n0.1 right 0.3 0.8 0.1 0 0 0 1 b=1\n");
+  const std::string scene = WriteScene(headset.dir).string();
+  const std::string state = (headset.dir / "saved.state").string();
+  const AppRun r = RunSphxr("--xr --scene " + scene + " --frame-limit 20 --save-state " + state + kCommon, headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "save button: saving the water"), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "state saved to " + state), 1) << r.out;
+  EXPECT_EQ(CountOf(r.out, "reset button"), 0) << "B is not the reset (A):\n" << r.out;
+  ASSERT_TRUE(std::filesystem::exists(state));
+  ExpectNoValidationErrors(headset);
+  const AppRun next = RunSphxr("--headless --scene " + scene + " --steps 3 --threads 1 --no-progress --load-state " + state,
+                               headset.dir);
+  ASSERT_EQ(next.code, 0) << next.out;
+  EXPECT_EQ(CountOf(next.out, "started from " + state), 1) << next.out;
+}
+
 TEST(XrApp, DefaultModeIsTheHeadsetWhenARuntimeAnswers) {
   SimHeadset headset("app_default");
   SetUpHeadset(headset);

@@ -77,7 +77,7 @@ TEST(XrMath, ProjectionMapsTheFovEdgesToTheClipEdges) {
   EXPECT_NEAR(ndc({0, 0, -far}).z, 1.0f, 1e-4f);
 }
 
-TEST(XrBindings, EveryProfileBindsGripTriggerAndHapticsOnBothHands) {
+TEST(XrBindings, EveryProfileBindsGripTriggerAndHapticsOnBothHandsAndSaveOnAFreeButton) {
   std::set<std::string> profiles;
   for (const auto& b : SuggestedBindings()) profiles.insert(b.profile);
   EXPECT_EQ(profiles.size(), 5u);
@@ -95,6 +95,18 @@ TEST(XrBindings, EveryProfileBindsGripTriggerAndHapticsOnBothHands) {
       uint8_t want = a == ActionId::kRecentre ? kLeftHand : a == ActionId::kReset ? kRightHand : kBothHands;
       EXPECT_EQ(hands, want) << p << " action " << int(a);
     }
+    // Saving: the right B where the controller has one (Touch, Index), nowhere else (the mirror
+    // window's panel saves for those), and never on a path another action of the hand uses.
+    std::string save;
+    for (const auto& b : SuggestedBindings())
+      if (b.profile == p && b.action == ActionId::kSaveState) {
+        EXPECT_EQ(b.hands, kRightHand) << p;
+        save = b.suffix;
+      }
+    const bool hasB = p.find("touch") != std::string::npos || p.find("index") != std::string::npos;
+    EXPECT_EQ(save, hasB ? "/input/b/click" : "") << p;
+    for (const auto& b : SuggestedBindings())
+      if (b.profile == p && b.action != ActionId::kSaveState && (b.hands & kRightHand)) EXPECT_NE(std::string(b.suffix), save) << p;
   }
 }
 

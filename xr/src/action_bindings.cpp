@@ -10,6 +10,7 @@ constexpr ActionInfo kActions[] = {
     {ActionId::kHaptic, "haptic", "Paddle feedback"},
     {ActionId::kRecentre, "recentre", "Recentre view"},
     {ActionId::kReset, "reset", "Reset scene"},
+    {ActionId::kSaveState, "save_state", "Save the water"},
 };
 static_assert(std::size(kActions) == size_t(ActionId::kCount));
 
@@ -21,7 +22,9 @@ constexpr const char* kWmr = "/interaction_profiles/microsoft/motion_controller"
 
 // Paths from the OpenXR 1.0 specification, section 6.4 "Interaction Profile Paths". The simple
 // controller has no squeeze; Touch has a menu button on the left hand only (the right one is the
-// reserved system button), so reset sits on A; Index has no menu button: recentre on left B.
+// reserved system button), so reset sits on A; Index has no menu button: recentre on left B. Saving
+// the state takes the right B where there is one (Touch, Index); the simple, Vive and WMR controllers
+// have no spare button, and their users save from the mirror window's panel.
 constexpr SuggestedBinding kBindings[] = {
     {kSimple, ActionId::kGripPose, kBothHands, "/input/grip/pose"},
     {kSimple, ActionId::kTrigger, kBothHands, "/input/select/click"},
@@ -35,6 +38,7 @@ constexpr SuggestedBinding kBindings[] = {
     {kTouch, ActionId::kHaptic, kBothHands, "/output/haptic"},
     {kTouch, ActionId::kRecentre, kLeftHand, "/input/menu/click"},
     {kTouch, ActionId::kReset, kRightHand, "/input/a/click"},
+    {kTouch, ActionId::kSaveState, kRightHand, "/input/b/click"},
 
     {kIndex, ActionId::kGripPose, kBothHands, "/input/grip/pose"},
     {kIndex, ActionId::kTrigger, kBothHands, "/input/trigger/value"},
@@ -42,6 +46,7 @@ constexpr SuggestedBinding kBindings[] = {
     {kIndex, ActionId::kHaptic, kBothHands, "/output/haptic"},
     {kIndex, ActionId::kRecentre, kLeftHand, "/input/b/click"},
     {kIndex, ActionId::kReset, kRightHand, "/input/a/click"},
+    {kIndex, ActionId::kSaveState, kRightHand, "/input/b/click"},
 
     {kVive, ActionId::kGripPose, kBothHands, "/input/grip/pose"},
     {kVive, ActionId::kTrigger, kBothHands, "/input/trigger/value"},

@@ -5,7 +5,7 @@
 
 namespace sphxr::xr {
 
-enum class ActionId { kGripPose, kTrigger, kSqueeze, kHaptic, kRecentre, kReset, kCount };
+enum class ActionId { kGripPose, kTrigger, kSqueeze, kHaptic, kRecentre, kReset, kSaveState, kCount };
 
 struct ActionInfo {
   ActionId id;

@@ -574,6 +574,7 @@ Status Session::Impl::SyncHands(FrameInfo* info, bool* recentre) {
   for (int h = 0; h < kHandCount; ++h) {
     if (Status s = pressed(ActionId::kRecentre, h, recentre); !s) return s;
     if (Status s = pressed(ActionId::kReset, h, &info->resetRequested); !s) return s;
+    if (Status s = pressed(ActionId::kSaveState, h, &info->saveRequested); !s) return s;
   }
   if (*recentre) {
     if (Status s = RecentreAt(info->predictedDisplayTimeNs); !s) return s;

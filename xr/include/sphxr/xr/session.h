@@ -78,6 +78,7 @@ struct FrameInfo {
   std::array<HandState, kHandCount> hands;
   bool recentred = false;       // the recentre button was pressed: the play space moved this frame
   bool resetRequested = false;  // the reset button was pressed (the application resets its scene)
+  bool saveRequested = false;   // the save button was pressed (the application saves its state)
 };
 
 /// One eye to draw: the framebuffer is bound and the viewport set when the callback runs.
