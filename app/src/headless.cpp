@@ -169,7 +169,8 @@ std::string UsageText() {
          "                    minimisation on the solver's steps; the run then starts at t = 0 from that\n"
          "                    state; default: the scene's run.settle; 0: none)\n"
          "  --save-state FILE write the fluid and the clock to FILE at the end of the run (also when it is\n"
-         "                    stopped early), to start another run from; in the window, where its s key saves\n"
+         "                    stopped early), to start another run from; in the window and --xr, where\n"
+         "                    their save (the s key, the panel, the right B in the headset) writes\n"
          "  --load-state FILE start from a state file instead of the scene's fluid (the same scene; its\n"
          "                    spacing is the file's); --time is then the end time on the file's clock\n"
          "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda\n"
@@ -466,16 +467,20 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   std::unique_ptr<sim::Solver> solver;
   if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) return Status::Error(options.scenePath + ": " + s.message());
 
+  bool stepCountKnown = true;  // false from a state file without one: saved as unknown again
   if (state) {
     if (Status s = RestoreState(*state, solver.get()); !s) return Status::Error("--load-state " + s.message());
-    SPHXR_LOG_INFO("started from %s: t = %.6g s, step %lld, %d fluid particles (saved from '%s')",
-                   options.loadState.c_str(), state->clock.time, static_cast<long long>(std::max<int64_t>(state->step, 0)),
-                   state->fluidCount, state->scene.c_str());
+    SPHXR_LOG_INFO("started from %s: t = %.6g s, step %s, %d fluid particles (saved from '%s')",
+                   options.loadState.c_str(), state->clock.time,
+                   state->step < 0 ? "unknown" : std::to_string(state->step).c_str(), state->fluidCount,
+                   state->scene.c_str());
     if (state->step < 0) {
-      SPHXR_LOG_INFO("%s is a version-1 state file, without the step count: steps, exports and CSV rows are numbered "
-                     "from 0 again", options.loadState.c_str());
+      SPHXR_LOG_INFO("%s has no step count (a version-1 file, or continued from one): steps, exports and CSV rows "
+                     "are numbered from 0 again, and a state saved from this run has no count either",
+                     options.loadState.c_str());
     }
     summary->stepsBefore = std::max<int64_t>(state->step, 0);
+    stepCountKnown = state->step >= 0;
   }
   // Steps count on from the state's (the whole run's numbering): the CSV's step column, the export files'
   // numbers and the state saved at the end.
@@ -638,7 +643,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (!std::isfinite(info.maxSpeed)) {
       return Status::Error(Format("the simulation became non-finite at step %lld (t = %.4g s); rerun with --validate "
                                   "to find the stage and particle, and lower solver.fixed_dt or raise solver.stiffness",
-                                  static_cast<long long>(step), info.time));
+                                  static_cast<long long>(wholeStep), info.time));
     }
     if (stats) {
       stats << wholeStep << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
@@ -670,7 +675,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     const double fraction = targetSteps > 0 ? static_cast<double>(step) / targetSteps
                                             : (solver->Time() - summary->startTime) / (targetTime - summary->startTime);
-    progress.Update(std::min(1.0, fraction), solver->Time(), step, 1e3 * wall / step);
+    progress.Update(std::min(1.0, fraction), solver->Time(), wholeStep, 1e3 * wall / step);
   }
   summary->wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   summary->interrupted = g_interrupt;  // also a signal during the last step
@@ -689,7 +694,9 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
   }
   if (!options.saveState.empty()) {
-    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame, stepsBefore); !s) {
+    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame,
+                                  stepCountKnown ? stepsBefore : -1);
+        !s) {
       return Status::Error("--save-state " + s.message());
     }
     summary->stateSaved = options.saveState;
@@ -737,10 +744,12 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
         if (!std::filesystem::is_regular_file(std::filesystem::path(options.framesDir) / name, ec)) break;
         --movieStart;
       }
+      // ... and ending at this run's last frame (not at older, higher-numbered files in the directory).
       const std::string command = Format("'%s' -y -loglevel error -framerate %g -start_number %lld -i '%s/frame_%%05d.png' "
-                                         "-pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' '%s'",
+                                         "-frames:v %lld -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' '%s'",
                                          ffmpeg.c_str(), options.fps, static_cast<long long>(movieStart),
-                                         options.framesDir.c_str(), movie.c_str());
+                                         options.framesDir.c_str(), static_cast<long long>(frameIndex - movieStart),
+                                         movie.c_str());
       if (std::system(command.c_str()) != 0) {
         SPHXR_LOG_WARN("ffmpeg could not make %s; the PNG frames are there", movie.c_str());
         movie.clear();
@@ -756,7 +765,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   std::printf("  device          %s\n", sim::DeviceName(solver->ActiveDevice()));
   std::printf("  steps           %lld (%lld with dt clamped to the stability limit)%s\n",
               static_cast<long long>(summary->steps), static_cast<long long>(totals.dtClampedSteps),
-              summary->stepsBefore > 0 ? Format("; steps %lld to %lld of the whole run",
+              summary->stepsBefore > 0 && summary->steps > 0 ? Format("; steps %lld to %lld of the whole run",
                                                 static_cast<long long>(summary->stepsBefore + 1),
                                                 static_cast<long long>(summary->stepsBefore + summary->steps))
                                              .c_str()

@@ -74,7 +74,7 @@ Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* sol
     }
   }
   *paddleClock = (*solver)->Time();
-  *stepsBefore = restored ? std::max<int64_t>(scene.start->step, 0) : 0;
+  *stepsBefore = restored ? scene.start->step : 0;  // -1 (unknown) stays unknown in what it saves
   if (*paddles) {
     if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
     if (restored) RestorePaddles(*scene.start, **solver, paddles->get(), paddleClock);
@@ -247,6 +247,17 @@ void SimWorker::Run() {
     lastPublish = now;
     dirty = false;
   };
+  auto saveIfAsked = [this]() {
+    std::unique_ptr<std::pair<std::string, std::string>> save;
+    {
+      std::lock_guard lock(m_mutex);
+      save = std::move(m_pendingSave);
+    }
+    if (!save) return;
+    const std::string message = SaveStateLogged(save->first, save->second);
+    std::lock_guard lock(m_mutex);
+    m_saveMessage = message;
+  };
   while (!m_stop) {
     std::unique_ptr<SimScene> reset;
     {
@@ -287,6 +298,7 @@ void SimWorker::Run() {
         Publish(zero, 0.0);
       }
     }
+    saveIfAsked();  // between two steps, after a reset asked for before it
     const bool stepRequested = m_stepRequests.load() > 0;
     bool surfaceChanged;
     {
@@ -343,6 +355,7 @@ void SimWorker::Run() {
     }
     if (dirty && (Seconds(now - lastPublish) >= 1.0 / 60.0 || m_paused)) publishNow(now);
   }
+  saveIfAsked();  // a save asked for just before the end is not lost
 }
 
 std::unique_lock<std::mutex> SimWorker::LockSolver() {
@@ -370,6 +383,19 @@ std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::s
   SPHXR_LOG_INFO("state saved to %s at t = %.6g s (sphxr --load-state %s continues from there)", path.c_str(), t,
                  path.c_str());
   return Format("saved to %s (t = %.4g s): sphxr --load-state %s", path.c_str(), t, path.c_str());
+}
+
+void SimWorker::RequestSave(const std::string& savePath, const std::string& sceneName) {
+  {
+    std::lock_guard lock(m_mutex);
+    m_pendingSave = std::make_unique<std::pair<std::string, std::string>>(savePath, sceneName);
+  }
+  m_wake.notify_all();
+}
+
+std::string SimWorker::SaveMessage() const {
+  std::lock_guard lock(m_mutex);
+  return m_saveMessage;
 }
 
 Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build) {

@@ -80,6 +80,11 @@ class SimWorker {
   /// button): SaveState into `savePath` (--save-state's file), else "<scene name>.state" in the working
   /// directory; logged either way. Returns the line the panel shows.
   std::string SaveStateLogged(const std::string& savePath, const std::string& sceneName);
+  /// The same save done by the worker thread between its next two steps (paused or not), for a caller
+  /// that must not wait for a step and a disk sync: the headset's frame loop. A reset asked for before
+  /// it is done first. SaveMessage() then returns the line the panel shows.
+  void RequestSave(const std::string& savePath, const std::string& sceneName);
+  std::string SaveMessage() const;
   /// How the water surface reaches GL: ChooseSurfacePath of the solver's device (logged once at Start),
   /// kHostCopy after FallBackToHostCopy.
   SurfacePath Path() const { return m_path.load(); }
@@ -112,12 +117,14 @@ class SimWorker {
   std::unique_ptr<interaction::PaddleSystem> m_paddles;
   SimScene m_scene;
   double m_nextPaddleFrame = 0.0;
-  int64_t m_stepsBefore = 0;  // the state file's step count when the solver started from one
+  int64_t m_stepsBefore = 0;  // the state file's step count when the solver started from one (-1: unknown)
   std::thread m_thread;
   mutable std::mutex m_mutex;
   std::condition_variable m_wake;
   std::shared_ptr<const SimSnapshot> m_latest;
   std::unique_ptr<SimScene> m_pendingReset;
+  std::unique_ptr<std::pair<std::string, std::string>> m_pendingSave;  // path option, scene name; by m_mutex
+  std::string m_saveMessage;                                            // guarded by m_mutex
   std::vector<interaction::HandInput> m_hands;  // guarded by m_mutex
   SurfaceRequest m_surface;                     // guarded by m_mutex
   bool m_surfaceChanged = false;                // guarded by m_mutex

@@ -93,7 +93,7 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     w.Put(clock.time);
     w.Put(clock.lastMaxSpeed);
     w.Put(clock.lastMaxAccel);
-    w.Put(static_cast<int64_t>(stepsBefore + solver.GetTotals().steps));
+    w.Put(static_cast<int64_t>(stepsBefore < 0 ? -1 : stepsBefore + solver.GetTotals().steps));  // -1: unknown
     w.Put(solver.Scene().params.spacing);
     w.Put(static_cast<int32_t>(solver.FluidCount()));
     w.Put(static_cast<int32_t>(solver.BoundaryCount()));
@@ -200,7 +200,7 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   out->step = -1;  // version 1 has no step count
   if (version >= 2) {
     if (!r.Get(&out->step)) return truncated();
-    if (out->step < 0) return Status::Error(Format("%s: step count %lld: the file is damaged", path.c_str(), static_cast<long long>(out->step)));
+    if (out->step < -1) return Status::Error(Format("%s: step count %lld: the file is damaged", path.c_str(), static_cast<long long>(out->step)));
   }
   if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return truncated();
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");

@@ -102,7 +102,6 @@ struct XrApp {
   render::ParticleColor color = render::ParticleColor::kSpeed;
   float lastHaptic[xr::kHandCount] = {0, 0};
   bool exitRequested = false;
-  std::string saveMessage;  // the last save (the panel's button or the controller's), shown in the panel
 
   ~XrApp() {
     if (worker) worker->Stop();
@@ -124,8 +123,8 @@ struct XrApp {
     if (ImGui::Button("reset")) worker->Reset(simScene);
     ImGui::SameLine();
     if (ImGui::Button("end session")) RequestExit();
-    if (ImGui::Button("save state")) saveMessage = worker->SaveStateLogged(options.saveState, scene.name);
-    if (!saveMessage.empty()) ImGui::TextWrapped("%s", saveMessage.c_str());
+    if (ImGui::Button("save state")) worker->RequestSave(options.saveState, scene.name);
+    if (const std::string saved = worker->SaveMessage(); !saved.empty()) ImGui::TextWrapped("%s", saved.c_str());
     ImGui::Text("%d fluid + %d boundary particles", snap.fluidCount, snap.boundaryCount);
     ImGui::Text("t = %.3f s, %.3g simulated s per wall s", snap.last.time, snap.simSecondsPerWallSecond);
     const xr::FrameTimings& t = session->lastFrameTimings();
@@ -265,7 +264,9 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     outcome->fallback = true;
     return s;
   }
-  if (const std::string ignored = HeadlessOnlyOptions(options); !ignored.empty()) {
+  Options notSaved = options;  // the save button and the panel save into --save-state's file
+  notSaved.saveState.clear();
+  if (const std::string ignored = HeadlessOnlyOptions(notSaved); !ignored.empty()) {
     SPHXR_LOG_WARN("%s: honoured by --headless runs only; the headset session ignores them", ignored.c_str());
   }
   if (Status s = StartSimulation(app); !s) return s;
@@ -332,9 +333,9 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
             SPHXR_LOG_INFO("reset button: the scene starts again");
             app.worker->Reset(app.simScene);
           }
-          if (info.saveRequested) {  // between two steps; a few ms for a pool of thousands
+          if (info.saveRequested) {  // the worker saves between two steps: the frame does not wait for it
             SPHXR_LOG_INFO("save button: saving the water");
-            app.saveMessage = app.worker->SaveStateLogged(app.options.saveState, app.scene.name);
+            app.worker->RequestSave(app.options.saveState, app.scene.name);
           }
           // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
           frame = MakeFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "sphxr/app/headless.h"
+#include "sphxr/common/log.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/app/scene_file.h"
 #include "support.h"
@@ -640,9 +641,6 @@ TEST(HeadlessTest, SettleRunsBeforeTheRunAndRestartsTheClock) {
   EXPECT_EQ(ply.vertices, static_cast<size_t>(kSmallSceneParticles));
 }
 
-// --save-state and --load-state: a run stopped half way and continued from its state file ends where
-// the run that went through ends, byte for byte (the CPU backend is deterministic); the continued run's
-// CSV starts at the saved time. Then the refusals, each one line before anything runs.
 /// The regular files of `dir` by name (movie.mp4 aside: ffmpeg's container is not ours to compare).
 std::map<std::string, std::string> FilesOf(const std::string& dir) {
   std::map<std::string, std::string> files;
@@ -660,12 +658,14 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
   const std::string scene = dir.Write("scene.json", kSmallScene);
   const std::string half = dir.File("half.state"), continued = dir.File("continued.state"), whole = dir.File("whole.state");
   const std::string common = " --threads 1 --no-progress --scene " + Quote(scene);
-  // Particles every 7 steps and a 64 x 48 picture every 10 ms, each run into its own directories.
+  // Particles every 5 steps, surfaces every 10 and a 64 x 48 picture every 10 ms, each run into its own
+  // directories. The first half stops at step 90, an export step: the continued run exports its start
+  // again (the same bytes), as the whole run does at step 90.
   auto files = [&](const std::string& parts, const std::string& frames) {
-    return " --export-every 7 --out " + Quote(dir.File(parts)) + " --frames " + Quote(dir.File(frames)) +
-           " --fps 100 --image-size 64x48";
+    return " --export-every 5 --export-surface-every 10 --out " + Quote(dir.File(parts)) + " --frames " +
+           Quote(dir.File(frames)) + " --fps 100 --image-size 64x48";
   };
-  const Result first = RunBinary("--headless --time 0.02 --save-state " + Quote(half) + " --stats " +
+  const Result first = RunBinary("--headless --steps 90 --save-state " + Quote(half) + " --stats " +
                                      Quote(dir.File("half.csv")) + files("parts", "frames") + common,
                                  dir);
   ASSERT_TRUE(first.Exited() && first.Code() == 0) << first.err;
@@ -699,12 +699,16 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
   const std::vector<std::string> firstRow = Split(restRows[1], ',');
   EXPECT_EQ(std::stoll(firstRow[0]), static_cast<long long>(halfRows.size()))  // header + N rows: step N + 1
       << "the continued run numbers its steps on from the saved one";
+  ASSERT_EQ(halfRows.size(), 91u);
+  const long long lastStep = std::stoll(Split(wholeRows.back(), ',')[0]);
+  EXPECT_NE(second.out.find(Format("exported        %lld files", 1 + (lastStep - 90) / 5)), std::string::npos)
+      << "the start (step 90) and every fifth step after it:\n" << second.out;
 
   // Both halves' exports and frames in one directory are the whole run's, file for file and byte for byte
   // (before, the continued run wrote particles_000000 and frame_00000 again, over the first run's).
   const std::map<std::string, std::string> parts = FilesOf(dir.File("parts")), partsWhole = FilesOf(dir.File("parts_whole"));
   const std::map<std::string, std::string> frames = FilesOf(dir.File("frames")), framesWhole = FilesOf(dir.File("frames_whole"));
-  EXPECT_GE(partsWhole.size(), 4u);
+  EXPECT_GE(partsWhole.size(), 30u);  // particles and surfaces
   EXPECT_GE(framesWhole.size(), 5u);  // t = 0, 0.01, ..., 0.04
   std::vector<std::string> names, namesWhole;
   for (const auto& [name, bytes] : parts) names.push_back(name);

@@ -152,6 +152,12 @@ TEST(StateFile, AVersionOneFileIsReadWithoutItsStepCount) {
   EXPECT_EQ(b.spacing, a.spacing);
   ASSERT_EQ(b.fluid.size(), a.fluid.size());
   EXPECT_EQ(std::memcmp(b.fluid.position.data(), a.fluid.position.data(), a.fluid.position.size() * sizeof(a.fluid.position[0])), 0);
+  // A run continued from it saves the count as unknown again, not its own steps as the whole run's.
+  const std::string again = dir.File("again.state");
+  ASSERT_TRUE(WriteStateFile(again, *solver, "s", nullptr, 0.0, b.step).ok());
+  StateFile c;
+  ASSERT_TRUE(ReadStateFile(again, &c).ok());
+  EXPECT_EQ(c.step, -1);
 }
 
 TEST(StateFile, AnotherSceneOrSpacingIsRefused) {

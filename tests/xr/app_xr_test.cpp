@@ -343,12 +343,14 @@ TEST(XrApp, SaveButtonSavesTheWaterAndARunContinuesFromIt) {
   EXPECT_EQ(CountOf(r.out, "save button: saving the water"), 1) << r.out;
   EXPECT_EQ(CountOf(r.out, "state saved to " + state), 1) << r.out;
   EXPECT_EQ(CountOf(r.out, "reset button"), 0) << "B is not the reset (A):\n" << r.out;
+  EXPECT_EQ(CountOf(r.out, "honoured by"), 0) << "--xr honours --save-state:\n" << r.out;
   ASSERT_TRUE(std::filesystem::exists(state));
   ExpectNoValidationErrors(headset);
   const AppRun next = RunSphxr("--headless --scene " + scene + " --steps 3 --threads 1 --no-progress --load-state " + state,
                                headset.dir);
   ASSERT_EQ(next.code, 0) << next.out;
   EXPECT_EQ(CountOf(next.out, "started from " + state), 1) << next.out;
+  EXPECT_EQ(CountOf(next.out, "of the whole run"), 1) << "the file has the headset run's step count:\n" << next.out;
 }
 
 TEST(XrApp, DefaultModeIsTheHeadsetWhenARuntimeAnswers) {

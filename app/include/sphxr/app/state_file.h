@@ -30,8 +30,8 @@ struct StateFile {
   sim::HostFluid fluid;
   sim::SolverClock clock;
   /// Steps from the saved run's t = 0 (its first run's step 0, across continued runs), so that a run
-  /// continued from the file numbers its steps, exports and CSV rows on as the whole run would; -1 in
-  /// a version-1 file (unknown: numbered from 0).
+  /// continued from the file numbers its steps, exports and CSV rows on as the whole run would; -1:
+  /// unknown (a version-1 file, or a run continued from one; such a run numbers from 0).
   int64_t step = 0;
   float spacing = 0.0f;
   int fluidCount = 0;
@@ -47,7 +47,8 @@ struct StateFile {
 /// write leaves any earlier file at `path` as it was.
 /// With `paddles`, their own state and `paddleClock` (the runner's next paddle frame) are saved too, so
 /// that a restart continues their motion exactly. The step count saved is `stepsBefore` (the steps
-/// before this solver's first: a continued run's StateFile::step) plus the solver's own.
+/// before this solver's first: a continued run's StateFile::step) plus the solver's own; a negative
+/// `stepsBefore` (unknown) saves -1.
 Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
                       const interaction::PaddleSystem* paddles = nullptr, double paddleClock = 0.0,
                       int64_t stepsBefore = 0);
