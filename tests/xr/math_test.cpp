@@ -95,8 +95,9 @@ TEST(XrBindings, EveryProfileBindsGripTriggerAndHapticsOnBothHandsAndSaveOnAFree
       uint8_t want = a == ActionId::kRecentre ? kLeftHand : a == ActionId::kReset ? kRightHand : kBothHands;
       EXPECT_EQ(hands, want) << p << " action " << int(a);
     }
-    // Saving: the right B where the controller has one (Touch, Index), nowhere else (the mirror
-    // window's panel saves for those), and never on a path another action of the hand uses.
+    // Saving: the right B where the controller has one (Touch, Index), the trackpad click (Vive), the
+    // thumbstick click (WMR), none on the simple controller (the mirror panel saves there), and never on
+    // a path another action of the hand uses.
     std::string save;
     for (const auto& b : SuggestedBindings())
       if (b.profile == p && b.action == ActionId::kSaveState) {
@@ -104,7 +105,11 @@ TEST(XrBindings, EveryProfileBindsGripTriggerAndHapticsOnBothHandsAndSaveOnAFree
         save = b.suffix;
       }
     const bool hasB = p.find("touch") != std::string::npos || p.find("index") != std::string::npos;
-    EXPECT_EQ(save, hasB ? "/input/b/click" : "") << p;
+    const std::string want = hasB ? "/input/b/click"
+                             : p.find("vive") != std::string::npos ? "/input/trackpad/click"
+                             : p.find("microsoft") != std::string::npos ? "/input/thumbstick/click"
+                                                                          : "";
+    EXPECT_EQ(save, want) << p;
     for (const auto& b : SuggestedBindings())
       if (b.profile == p && b.action != ActionId::kSaveState && (b.hands & kRightHand)) EXPECT_NE(std::string(b.suffix), save) << p;
   }

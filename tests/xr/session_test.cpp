@@ -400,10 +400,12 @@ namespace {
 
 // Each controller profile of the binding table, chosen by the simulated headset: the scripted
 // trigger (0.75) and squeeze (0.6) reach the application through that profile's paths. Click
-// sources read 0 or 1; the simple controller has no squeeze.
+// sources read 0 or 1; the simple controller has no squeeze. The right hand's save input, pressed
+// from 0.05 s, arrives as one save request (and no reset); the simple controller has none.
 struct ProfileCase {
   const char* profile;
   float trigger, squeeze;
+  const char* saveKey;  // the pose script's key of the save button ("" none)
 };
 
 class XrProfiles : public ::testing::TestWithParam<ProfileCase> {};
@@ -415,13 +417,17 @@ TEST_P(XrProfiles, ScriptedInputsArriveThroughTheProfilesBindings) {
   headset.env.Set("SPHXR_SIM_XR_POSES",
                   WriteFile(headset.dir / "poses.txt",
                             "0 left -0.2 1 0 0 0 0 1 trigger=0.75 squeeze=0.6\n"
-                            "0 right 0.2 1 0 0 0 0 1 trigger=0.75 squeeze=0.6\n")
+                            "0 right 0.2 1 0 0 0 0 1 trigger=0.75 squeeze=0.6\n" +
+                                (*c.saveKey ? Format("0.05 right 0.2 1 0 0 0 0 1 trigger=0.75 squeeze=0.6 %s=1\n", c.saveKey)
+                                            : std::string()))
                       .string());
   headset.env.Set("SPHXR_SIM_XR_HAPTICS_LOG", (headset.dir / "haptics.txt").string());
   auto session = MakeSession();
   ASSERT_TRUE(session);
-  int focused = 0;
-  RunSession(*session, 5, [&](Session& s, const FrameInfo& f) {
+  int focused = 0, saves = 0, resets = 0;
+  RunSession(*session, 20, [&](Session& s, const FrameInfo& f) {
+    saves += f.saveRequested;
+    resets += f.resetRequested;
     if (!f.hands[0].active) return;
     ++focused;
     for (const HandState& h : f.hands) {
@@ -434,6 +440,8 @@ TEST_P(XrProfiles, ScriptedInputsArriveThroughTheProfilesBindings) {
     EXPECT_TRUE(s.ApplyHaptics(Hand::kRight, 0.5f));
   });
   EXPECT_GE(focused, 3);
+  EXPECT_EQ(saves, *c.saveKey ? 1 : 0) << "one press, one save (an edge)";
+  EXPECT_EQ(resets, 0);
   EXPECT_EQ(session->interactionProfile(Hand::kLeft), std::string("/interaction_profiles/") + c.profile);
   session.reset();
   std::ifstream log(headset.dir / "haptics.txt");
@@ -444,11 +452,11 @@ TEST_P(XrProfiles, ScriptedInputsArriveThroughTheProfilesBindings) {
 
 INSTANTIATE_TEST_SUITE_P(
     Table, XrProfiles,
-    ::testing::Values(ProfileCase{"khr/simple_controller", 1.0f, 0.0f},
-                      ProfileCase{"oculus/touch_controller", 0.75f, 0.6f},
-                      ProfileCase{"valve/index_controller", 0.75f, 0.6f},
-                      ProfileCase{"htc/vive_controller", 0.75f, 1.0f},
-                      ProfileCase{"microsoft/motion_controller", 0.75f, 1.0f}),
+    ::testing::Values(ProfileCase{"khr/simple_controller", 1.0f, 0.0f, ""},
+                      ProfileCase{"oculus/touch_controller", 0.75f, 0.6f, "b"},
+                      ProfileCase{"valve/index_controller", 0.75f, 0.6f, "b"},
+                      ProfileCase{"htc/vive_controller", 0.75f, 1.0f, "trackpad"},
+                      ProfileCase{"microsoft/motion_controller", 0.75f, 1.0f, "thumbstick"}),
     [](const ::testing::TestParamInfo<ProfileCase>& info) {
       std::string name = info.param.profile;
       for (char& ch : name)

@@ -23,8 +23,9 @@ constexpr const char* kWmr = "/interaction_profiles/microsoft/motion_controller"
 // Paths from the OpenXR 1.0 specification, section 6.4 "Interaction Profile Paths". The simple
 // controller has no squeeze; Touch has a menu button on the left hand only (the right one is the
 // reserved system button), so reset sits on A; Index has no menu button: recentre on left B. Saving
-// the state takes the right B where there is one (Touch, Index); the simple, Vive and WMR controllers
-// have no spare button, and their users save from the mirror window's panel.
+// the state takes the right B where there is one (Touch, Index), else the right trackpad click (Vive)
+// or thumbstick click (WMR); the simple controller has no spare button, and its users save from the
+// mirror window's panel.
 constexpr SuggestedBinding kBindings[] = {
     {kSimple, ActionId::kGripPose, kBothHands, "/input/grip/pose"},
     {kSimple, ActionId::kTrigger, kBothHands, "/input/select/click"},
@@ -54,6 +55,7 @@ constexpr SuggestedBinding kBindings[] = {
     {kVive, ActionId::kHaptic, kBothHands, "/output/haptic"},
     {kVive, ActionId::kRecentre, kLeftHand, "/input/menu/click"},
     {kVive, ActionId::kReset, kRightHand, "/input/menu/click"},
+    {kVive, ActionId::kSaveState, kRightHand, "/input/trackpad/click"},
 
     {kWmr, ActionId::kGripPose, kBothHands, "/input/grip/pose"},
     {kWmr, ActionId::kTrigger, kBothHands, "/input/trigger/value"},
@@ -61,6 +63,7 @@ constexpr SuggestedBinding kBindings[] = {
     {kWmr, ActionId::kHaptic, kBothHands, "/output/haptic"},
     {kWmr, ActionId::kRecentre, kLeftHand, "/input/menu/click"},
     {kWmr, ActionId::kReset, kRightHand, "/input/menu/click"},
+    {kWmr, ActionId::kSaveState, kRightHand, "/input/thumbstick/click"},
 };
 
 }  // namespace

@@ -3,7 +3,8 @@
 // The runtime picks one interaction profile (SPHXR_SIM_XR_PROFILE, default the Khronos simple
 // controller; the first suggested profile if the application suggested nothing for it) and reads
 // each bound input from the scripted device of that hand: a binding path's last components name the
-// source (grip/aim pose, trigger or select, squeeze, menu, a/x, b/y, haptic output).
+// source (grip/aim pose, trigger or select, squeeze, menu, a/x, b/y, trackpad and thumbstick clicks,
+// haptic output).
 #include <algorithm>
 #include <cstring>
 
@@ -12,7 +13,7 @@
 namespace sphxr::xr::simrt {
 namespace {
 
-enum class Source { kNone, kPose, kTrigger, kSqueeze, kMenu, kA, kB, kHaptic };
+enum class Source { kNone, kPose, kTrigger, kSqueeze, kMenu, kA, kB, kTrackpad, kThumbstick, kHaptic };
 
 struct Bound {
   Device device;
@@ -41,6 +42,8 @@ Bound Classify(const std::string& path) {
   if (rest == "input/menu/click" || rest == "input/menu") b.source = Source::kMenu;
   if (rest == "input/a/click" || rest == "input/x/click") b.source = Source::kA;
   if (rest == "input/b/click" || rest == "input/y/click") b.source = Source::kB;
+  if (rest == "input/trackpad/click") b.source = Source::kTrackpad;
+  if (rest == "input/thumbstick/click") b.source = Source::kThumbstick;
   if (rest == "output/haptic") b.source = Source::kHaptic;
   b.click = rest.size() > 6 && rest.compare(rest.size() - 6, 6, "/click") == 0;
   return b;
@@ -77,6 +80,8 @@ float SourceValue(const DeviceSample& d, Bound b) {
     case Source::kMenu: return d.menu ? 1.0f : 0.0f;
     case Source::kA: return d.a ? 1.0f : 0.0f;
     case Source::kB: return d.b ? 1.0f : 0.0f;
+    case Source::kTrackpad: return d.trackpad ? 1.0f : 0.0f;
+    case Source::kThumbstick: return d.thumbstick ? 1.0f : 0.0f;
     default: return 0.0f;
   }
 }

@@ -96,6 +96,8 @@ bool PoseScript::Parse(const std::string& text, PoseScript* out, std::string* er
       else if (k == "menu") s.menu = v != 0;
       else if (k == "a" || k == "x") s.a = v != 0;
       else if (k == "b" || k == "y") s.b = v != 0;
+      else if (k == "trackpad") s.trackpad = v != 0;
+      else if (k == "thumbstick") s.thumbstick = v != 0;
       else if (k == "tracked") s.tracked = v != 0;
       else return fail("unknown key '" + k + "'");
     }

@@ -4,7 +4,9 @@
 //
 // File format, one key frame per line ('#' starts a comment):
 //   <time_s> <head|left|right> <px> <py> <pz> <qx> <qy> <qz> <qw> [trigger=F] [squeeze=F] [menu=0|1]
-//                                                                  [a=0|1] [b=0|1] [tracked=0|1]
+//                                                                  [a=0|1] [b=0|1] [trackpad=0|1]
+//                                                                  [thumbstick=0|1] [tracked=0|1]
+// (trackpad and thumbstick: their clicks, the Vive's and the WMR controller's.)
 // Poses are in the STAGE space (metres, +y up, -z forward). Between key frames of one device the
 // position is interpolated linearly, the orientation by slerp; buttons and values hold the earlier
 // key frame's value. Before the first / after the last key frame the device holds that frame. A
@@ -23,7 +25,7 @@ constexpr int kDeviceCount = 3;
 struct DeviceSample {
   Pose pose;
   float trigger = 0, squeeze = 0;
-  bool menu = false, a = false, b = false;
+  bool menu = false, a = false, b = false, trackpad = false, thumbstick = false;  // clicks
   bool tracked = true;
 };
 
