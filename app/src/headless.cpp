@@ -626,7 +626,14 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       nextFrame += 1.0 / scene.paddleFrameRate;
       if (Status s = paddles->BeginFrame(nextFrame); !s) return s;
     }
-    if (Status s = solver->Step(); !s) return s;
+    if (Status s = solver->Step(); !s) {
+      // The solver counts this run's steps (--validate names them); after a state file, say which
+      // step of the whole run (the CSV's numbering) that is.
+      if (stepsBefore == 0) return s;
+      return Status::Error(Format("%s (this run's count; step %lld of the whole run, as the CSV numbers it)",
+                                  s.message().c_str(),
+                                  static_cast<long long>(stepsBefore + solver->GetTotals().steps + 1)));
+    }
     if (paddles) {
       paddles->AfterStep();
       for (int k = 0; k < paddles->Count(); ++k) {
