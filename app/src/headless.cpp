@@ -169,8 +169,8 @@ std::string UsageText() {
          "                    minimisation on the solver's steps; the run then starts at t = 0 from that\n"
          "                    state; default: the scene's run.settle; 0: none)\n"
          "  --save-state FILE write the fluid and the clock to FILE at the end of the run (also when it is\n"
-         "                    stopped early), to start another run from; in the window and --xr, where\n"
-         "                    their save (the s key, the panel, the right B in the headset) writes\n"
+         "                    stopped early), to start another run from; in the window and --xr, the\n"
+         "                    file their save writes (the s key, the panel, the headset's save button)\n"
          "  --load-state FILE start from a state file instead of the scene's fluid (the same scene; its\n"
          "                    spacing is the file's); --time is then the end time on the file's clock\n"
          "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda\n"
@@ -627,10 +627,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       if (Status s = paddles->BeginFrame(nextFrame); !s) return s;
     }
     if (Status s = solver->Step(); !s) {
-      // The solver counts this run's steps (--validate names them); after a state file, say which
-      // step of the whole run (the CSV's numbering) that is.
-      if (stepsBefore == 0) return s;
-      return Status::Error(Format("%s (this run's count; step %lld of the whole run, as the CSV numbers it)",
+      // --validate names the step by the solver's count, this run's; after a state file, say which step
+      // of the whole run (the CSV's numbering) that is.
+      if (stepsBefore == 0 || s.message().rfind("validate:", 0) != 0) return s;
+      return Status::Error(Format("%s (counted in this run; step %lld of the whole run, as the CSV numbers it)",
                                   s.message().c_str(),
                                   static_cast<long long>(stepsBefore + solver->GetTotals().steps + 1)));
     }

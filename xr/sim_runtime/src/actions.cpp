@@ -293,7 +293,7 @@ XrResult GetActionStateVector2f(XrSession h, const XrActionStateGetInfo* info, X
   std::lock_guard lock(Lock());
   float v = 0;
   XrResult r = GetState(h, info, XR_ACTION_TYPE_VECTOR2F_INPUT, state, &v);
-  if (r == XR_SUCCESS) state->currentState = {0, 0};  // no thumbsticks on the simulated controllers
+  if (r == XR_SUCCESS) state->currentState = {0, 0};  // the simulated thumbsticks and trackpads only click
   return r;
 }
 
