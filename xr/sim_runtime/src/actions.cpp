@@ -49,6 +49,124 @@ Bound Classify(const std::string& path) {
   return b;
 }
 
+// The input and output paths each known interaction profile has (OpenXR 1.0, section 6.4 "Interaction
+// Profile Paths"), per hand: a real runtime refuses a profile's whole suggestion when one path is not
+// the controller's (XR_ERROR_PATH_UNSUPPORTED), and so does this one, so that a binding valid on
+// one controller but not on another fails here as on a headset. Components left out name the
+// identifier alone (".../input/trigger"), which the spec lets the runtime resolve.
+constexpr uint8_t kL = 1, kR = 2, kLR = 3;
+struct ProfilePath {
+  const char* profile;  // after "/interaction_profiles/"
+  uint8_t hands;
+  const char* path;  // after "/user/hand/<hand>/"
+};
+constexpr ProfilePath kProfilePaths[] = {
+    {"khr/simple_controller", kLR, "input/select/click"},
+    {"khr/simple_controller", kLR, "input/menu/click"},
+    {"khr/simple_controller", kLR, "input/grip/pose"},
+    {"khr/simple_controller", kLR, "input/aim/pose"},
+    {"khr/simple_controller", kLR, "output/haptic"},
+
+    {"oculus/touch_controller", kL, "input/x/click"},
+    {"oculus/touch_controller", kL, "input/x/touch"},
+    {"oculus/touch_controller", kL, "input/y/click"},
+    {"oculus/touch_controller", kL, "input/y/touch"},
+    {"oculus/touch_controller", kL, "input/menu/click"},
+    {"oculus/touch_controller", kR, "input/a/click"},
+    {"oculus/touch_controller", kR, "input/a/touch"},
+    {"oculus/touch_controller", kR, "input/b/click"},
+    {"oculus/touch_controller", kR, "input/b/touch"},
+    {"oculus/touch_controller", kR, "input/system/click"},
+    {"oculus/touch_controller", kLR, "input/squeeze/value"},
+    {"oculus/touch_controller", kLR, "input/trigger/value"},
+    {"oculus/touch_controller", kLR, "input/trigger/touch"},
+    {"oculus/touch_controller", kLR, "input/thumbstick/x"},
+    {"oculus/touch_controller", kLR, "input/thumbstick/y"},
+    {"oculus/touch_controller", kLR, "input/thumbstick/click"},
+    {"oculus/touch_controller", kLR, "input/thumbstick/touch"},
+    {"oculus/touch_controller", kLR, "input/thumbrest/touch"},
+    {"oculus/touch_controller", kLR, "input/grip/pose"},
+    {"oculus/touch_controller", kLR, "input/aim/pose"},
+    {"oculus/touch_controller", kLR, "output/haptic"},
+
+    {"valve/index_controller", kLR, "input/system/click"},
+    {"valve/index_controller", kLR, "input/system/touch"},
+    {"valve/index_controller", kLR, "input/a/click"},
+    {"valve/index_controller", kLR, "input/a/touch"},
+    {"valve/index_controller", kLR, "input/b/click"},
+    {"valve/index_controller", kLR, "input/b/touch"},
+    {"valve/index_controller", kLR, "input/squeeze/value"},
+    {"valve/index_controller", kLR, "input/squeeze/force"},
+    {"valve/index_controller", kLR, "input/trigger/click"},
+    {"valve/index_controller", kLR, "input/trigger/value"},
+    {"valve/index_controller", kLR, "input/trigger/touch"},
+    {"valve/index_controller", kLR, "input/thumbstick/x"},
+    {"valve/index_controller", kLR, "input/thumbstick/y"},
+    {"valve/index_controller", kLR, "input/thumbstick/click"},
+    {"valve/index_controller", kLR, "input/thumbstick/touch"},
+    {"valve/index_controller", kLR, "input/trackpad/x"},
+    {"valve/index_controller", kLR, "input/trackpad/y"},
+    {"valve/index_controller", kLR, "input/trackpad/force"},
+    {"valve/index_controller", kLR, "input/trackpad/touch"},
+    {"valve/index_controller", kLR, "input/grip/pose"},
+    {"valve/index_controller", kLR, "input/aim/pose"},
+    {"valve/index_controller", kLR, "output/haptic"},
+
+    {"htc/vive_controller", kLR, "input/system/click"},
+    {"htc/vive_controller", kLR, "input/squeeze/click"},
+    {"htc/vive_controller", kLR, "input/menu/click"},
+    {"htc/vive_controller", kLR, "input/trigger/click"},
+    {"htc/vive_controller", kLR, "input/trigger/value"},
+    {"htc/vive_controller", kLR, "input/trackpad/x"},
+    {"htc/vive_controller", kLR, "input/trackpad/y"},
+    {"htc/vive_controller", kLR, "input/trackpad/click"},
+    {"htc/vive_controller", kLR, "input/trackpad/touch"},
+    {"htc/vive_controller", kLR, "input/grip/pose"},
+    {"htc/vive_controller", kLR, "input/aim/pose"},
+    {"htc/vive_controller", kLR, "output/haptic"},
+
+    {"microsoft/motion_controller", kLR, "input/menu/click"},
+    {"microsoft/motion_controller", kLR, "input/squeeze/click"},
+    {"microsoft/motion_controller", kLR, "input/trigger/value"},
+    {"microsoft/motion_controller", kLR, "input/thumbstick/x"},
+    {"microsoft/motion_controller", kLR, "input/thumbstick/y"},
+    {"microsoft/motion_controller", kLR, "input/thumbstick/click"},
+    {"microsoft/motion_controller", kLR, "input/trackpad/x"},
+    {"microsoft/motion_controller", kLR, "input/trackpad/y"},
+    {"microsoft/motion_controller", kLR, "input/trackpad/click"},
+    {"microsoft/motion_controller", kLR, "input/trackpad/touch"},
+    {"microsoft/motion_controller", kLR, "input/grip/pose"},
+    {"microsoft/motion_controller", kLR, "input/aim/pose"},
+    {"microsoft/motion_controller", kLR, "output/haptic"},
+};
+
+bool KnownProfile(const std::string& profile) {
+  for (const ProfilePath& p : kProfilePaths)
+    if (profile == std::string("/interaction_profiles/") + p.profile) return true;
+  return false;
+}
+
+/// Whether `path` (/user/hand/<hand>/...) is one of `profile`'s, whole or as an identifier alone.
+bool PathOfProfile(const std::string& profile, const std::string& path) {
+  uint8_t hand = 0;
+  std::string rest;
+  if (path.rfind("/user/hand/left/", 0) == 0) {
+    hand = kL;
+    rest = path.substr(16);
+  } else if (path.rfind("/user/hand/right/", 0) == 0) {
+    hand = kR;
+    rest = path.substr(17);
+  } else {
+    return false;
+  }
+  for (const ProfilePath& p : kProfilePaths) {
+    if (profile != std::string("/interaction_profiles/") + p.profile || !(p.hands & hand)) continue;
+    const std::string known = p.path;
+    if (rest == known || known.rfind(rest + "/", 0) == 0) return true;
+  }
+  return false;
+}
+
 XrPath HandPath(Instance* inst, Device d) {
   return InternPath(inst, d == Device::kLeft ? "/user/hand/left" : "/user/hand/right");
 }
@@ -221,7 +339,7 @@ XrResult SuggestInteractionProfileBindings(XrInstance handle, const XrInteractio
   if (!inst) return XR_ERROR_HANDLE_INVALID;
   if (inst->lost) return XR_ERROR_INSTANCE_LOST;
   const std::string* profile = PathString(inst, info->interactionProfile);
-  if (!profile || profile->rfind("/interaction_profiles/", 0) != 0) return XR_ERROR_PATH_UNSUPPORTED;
+  if (!profile || !KnownProfile(*profile)) return XR_ERROR_PATH_UNSUPPORTED;
   std::vector<std::pair<Action*, XrPath>> list;
   for (uint32_t i = 0; i < info->countSuggestedBindings; ++i) {
     Action* a = Check<Action>(info->suggestedBindings[i].action, Tag::kAction);
@@ -229,8 +347,12 @@ XrResult SuggestInteractionProfileBindings(XrInstance handle, const XrInteractio
     if (a->set->attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
     const std::string* path = PathString(inst, info->suggestedBindings[i].binding);
     if (!path) return XR_ERROR_PATH_INVALID;
+    if (!PathOfProfile(*profile, *path)) return XR_ERROR_PATH_UNSUPPORTED;  // not this controller's
     Bound b = Classify(*path);
-    if (b.source == Source::kNone) return XR_ERROR_PATH_UNSUPPORTED;
+    if (b.source == Source::kNone) {  // the controller's, but not simulated (a thumbrest, a force): never active
+      list.push_back({a, info->suggestedBindings[i].binding});
+      continue;
+    }
     bool isPose = b.source == Source::kPose, isHaptic = b.source == Source::kHaptic;
     if ((a->type == XR_ACTION_TYPE_POSE_INPUT) != isPose || (a->type == XR_ACTION_TYPE_VIBRATION_OUTPUT) != isHaptic)
       return XR_ERROR_PATH_UNSUPPORTED;
