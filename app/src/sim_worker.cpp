@@ -382,6 +382,7 @@ std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::s
   }
   SPHXR_LOG_INFO("state saved to %s at t = %.6g s (sphxr --load-state %s continues from there)", path.c_str(), t,
                  path.c_str());
+  ++m_savesDone;
   return Format("saved to %s (t = %.4g s): sphxr --load-state %s", path.c_str(), t, path.c_str());
 }
 

@@ -85,6 +85,8 @@ class SimWorker {
   /// it is done first. SaveMessage() then returns the line the panel shows.
   void RequestSave(const std::string& savePath, const std::string& sceneName);
   std::string SaveMessage() const;
+  /// Saves that succeeded so far (either way): the headset buzzes when it grows.
+  uint64_t SavesDone() const { return m_savesDone.load(); }
   /// How the water surface reaches GL: ChooseSurfacePath of the solver's device (logged once at Start),
   /// kHostCopy after FallBackToHostCopy.
   SurfacePath Path() const { return m_path.load(); }
@@ -125,6 +127,7 @@ class SimWorker {
   std::unique_ptr<SimScene> m_pendingReset;
   std::unique_ptr<std::pair<std::string, std::string>> m_pendingSave;  // path option, scene name; by m_mutex
   std::string m_saveMessage;                                            // guarded by m_mutex
+  std::atomic<uint64_t> m_savesDone{0};
   std::vector<interaction::HandInput> m_hands;  // guarded by m_mutex
   SurfaceRequest m_surface;                     // guarded by m_mutex
   bool m_surfaceChanged = false;                // guarded by m_mutex

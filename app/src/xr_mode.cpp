@@ -101,6 +101,12 @@ struct XrApp {
   render::RenderMode mode = render::RenderMode::kWater;
   render::ParticleColor color = render::ParticleColor::kSpeed;
   float lastHaptic[xr::kHandCount] = {0, 0};
+  // A finished save is felt: the right controller buzzes (kSaveBuzz) for kSaveBuzzSeconds, since the
+  // person in the headset cannot see the mirror panel's message. A failed save is not (logged).
+  static constexpr float kSaveBuzz = 0.8f;
+  static constexpr double kSaveBuzzSeconds = 0.15;
+  uint64_t savesFelt = 0;
+  Clock::time_point buzzUntil{};
   bool exitRequested = false;
 
   ~XrApp() {
@@ -320,9 +326,14 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
           std::vector<interaction::HandInput> hands;
           for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, app.setup.tank, displayTime));
           app.worker->SetHands(hands);
+          if (const uint64_t saves = app.worker->SavesDone(); saves != app.savesFelt) {
+            app.savesFelt = saves;
+            app.buzzUntil = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(XrApp::kSaveBuzzSeconds));
+          }
           for (int h = 0; h < xr::kHandCount; ++h) {
             float amplitude = snap->haptic[h];
             if (amplitude < 0.01f) amplitude = 0.0f;
+            if (h == static_cast<int>(xr::Hand::kRight) && now < app.buzzUntil) amplitude = std::max(amplitude, XrApp::kSaveBuzz);
             if (amplitude == 0.0f && app.lastHaptic[h] == 0.0f) continue;  // stop once, not every frame
             app.lastHaptic[h] = amplitude;
             if (Status hs = app.session->ApplyHaptics(static_cast<xr::Hand>(h), amplitude); !hs) {

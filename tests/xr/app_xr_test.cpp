@@ -331,10 +331,13 @@ TEST(XrApp, StartsFromAStateFile) {
 }
 
 // The save button (Touch: right B) writes the running water to --save-state's file between two steps,
-// once per press, and a headless run continues from it.
+// once per press, and a headless run continues from it. The right controller buzzes when the save is
+// done (the hands are away from the water, so no paddle asks for haptics).
 TEST(XrApp, SaveButtonSavesTheWaterAndARunContinuesFromIt) {
   SimHeadset headset("app_save");
   headset.env.Set("SPHXR_SIM_XR_PROFILE", "oculus/touch_controller");
+  const auto haptics = headset.dir / "haptics.txt";
+  headset.env.Set("SPHXR_SIM_XR_HAPTICS_LOG", haptics.string());
   SetUpHeadset(headset, "0 right 0.3 0.8 0.1 0 0 0 1\n0.1 right 0.3 0.8 0.1 0 0 0 1 b=1\n");
   const std::string scene = WriteScene(headset.dir).string();
   const std::string state = (headset.dir / "saved.state").string();
@@ -346,6 +349,30 @@ TEST(XrApp, SaveButtonSavesTheWaterAndARunContinuesFromIt) {
   EXPECT_EQ(CountOf(r.out, "honoured by"), 0) << "--xr honours --save-state:\n" << r.out;
   ASSERT_TRUE(std::filesystem::exists(state));
   ExpectNoValidationErrors(headset);
+  // The log: "frame time_s hand amplitude duration_ns frequency_hz [stop]".
+  std::stringstream logFile;
+  logFile << std::ifstream(haptics).rdbuf();
+  const std::string logText = logFile.str();
+  std::istringstream log(logText);
+  int buzzes = 0, left = 0, other = 0;
+  double firstBuzz = -1.0;
+  for (std::string line; std::getline(log, line);) {
+    std::istringstream in(line);
+    long long frame = 0;
+    double time = 0.0, amplitude = 0.0;
+    std::string hand;
+    in >> frame >> time >> hand >> amplitude;
+    if (line.empty() || line[0] == '#' || line.find("stop") != std::string::npos) continue;
+    if (hand == "left") ++left;
+    else if (std::abs(amplitude - 0.8) < 1e-6) {
+      ++buzzes;
+      if (firstBuzz < 0.0) firstBuzz = time;
+    } else ++other;
+  }
+  EXPECT_GE(buzzes, 1) << "the save is felt on the right controller";
+  EXPECT_GE(firstBuzz, 0.1) << "after the press at 0.1 s, not before";
+  EXPECT_EQ(left, 0);
+  EXPECT_EQ(other, 0) << "no other haptics: the paddles are out of the water\n" << logText;
   const AppRun next = RunSphxr("--headless --scene " + scene + " --steps 3 --threads 1 --no-progress --load-state " + state,
                                headset.dir);
   ASSERT_EQ(next.code, 0) << next.out;
