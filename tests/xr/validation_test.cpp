@@ -10,13 +10,19 @@
 namespace sphxr::xr::test {
 namespace {
 
-TEST(XrValidationLayer, ReportsAnApiMisuseInItsLog) {
-  SimHeadset headset("misuse");
+/// An instance of the simulated headset straight through the loader (XR_NULL_HANDLE on failure).
+XrInstance CreateInstance(const char* name) {
   XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
-  std::strcpy(ci.applicationInfo.applicationName, "misuse");
+  std::strcpy(ci.applicationInfo.applicationName, name);
   ci.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
   XrInstance instance = XR_NULL_HANDLE;
-  ASSERT_EQ(xrCreateInstance(&ci, &instance), XR_SUCCESS);
+  return xrCreateInstance(&ci, &instance) == XR_SUCCESS ? instance : XR_NULL_HANDLE;
+}
+
+TEST(XrValidationLayer, ReportsAnApiMisuseInItsLog) {
+  SimHeadset headset("misuse");
+  const XrInstance instance = CreateInstance("misuse");
+  ASSERT_NE(instance, XR_NULL_HANDLE);
   EXPECT_EQ(headset.ValidationText(), "");
   XrSystemGetInfo si{XR_TYPE_SYSTEM_PROPERTIES};  // wrong type on purpose
   si.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
@@ -33,11 +39,8 @@ TEST(XrValidationLayer, ReportsAnApiMisuseInItsLog) {
 // on one controller but not on another, instead of passing on the simulated headset alone.
 TEST(XrSimRuntime, RefusesABindingPathTheControllerDoesNotHave) {
   SimHeadset headset("paths");
-  XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
-  std::strcpy(ci.applicationInfo.applicationName, "paths");
-  ci.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
-  XrInstance instance = XR_NULL_HANDLE;
-  ASSERT_EQ(xrCreateInstance(&ci, &instance), XR_SUCCESS);
+  const XrInstance instance = CreateInstance("paths");
+  ASSERT_NE(instance, XR_NULL_HANDLE);
   XrActionSetCreateInfo si{XR_TYPE_ACTION_SET_CREATE_INFO};
   std::strcpy(si.actionSetName, "paths");
   std::strcpy(si.localizedActionSetName, "Paths");
