@@ -23,7 +23,6 @@
 #include "sphxr/app/param_registry.h"
 #include "sim_worker.h"
 #include "sphxr/app/pictures.h"
-#include "sphxr/app/quality.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/render/renderer.h"
@@ -255,9 +254,7 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   if (Status s = OpenGlWindow(request, &m.window); !s) return s;
   if (Status s = render::Renderer::Create(config, &m.renderer); !s) return s;
   SPHXR_LOG_INFO("desktop window %dx%d, %s", options.windowWidth, options.windowHeight, render::GlDescription());
-  Options notSaved = options;  // the window saves with its s key, into --save-state's file
-  notSaved.saveState.clear();
-  if (const std::string ignored = HeadlessOnlyOptions(notSaved); !ignored.empty()) {
+  if (const std::string ignored = HeadlessOnlyOptions(options); !ignored.empty()) {
     SPHXR_LOG_WARN("%s: honoured by --headless runs only; the window ignores them", ignored.c_str());
   }
 
@@ -299,15 +296,7 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
     solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
     SPHXR_LOG_INFO("simulation on %d CPU threads, one core left for drawing (--threads to change)", solverConfig.threads);
   }
-  if (m.start && options.quality != 0 && options.spacing <= 0.0f) {
-    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", m.start->spacing);
-  } else if (options.quality != 0 && options.spacing <= 0.0f) {
-    QualityChoice choice;
-    if (Status s = ChooseQuality(m.setup, solverConfig, 1.0, 1.0, &choice); !s) {
-      return Status::Error(options.scenePath + ": " + s.message());
-    }
-    m.setup.params.spacing = choice.spacing;
-  }
+  if (Status s = ApplyAutoQuality(options, options.quality != 0, m.start.get(), solverConfig, &m.setup); !s) return s;
   m.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
   m.MakeSimScene();
   m.worker = std::make_unique<SimWorker>(solverConfig);

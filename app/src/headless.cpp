@@ -365,7 +365,6 @@ std::string HeadlessOnlyOptions(const Options& options) {
   add(options.time > 0.0, "--time");
   add(options.steps > 0, "--steps");
   add(options.settle >= 0.0, "--settle");
-  add(!options.saveState.empty(), "--save-state");
   return out;
 }
 
@@ -381,6 +380,19 @@ float ExplicitSpacing(const Options& options) {
   return spacing;
 }
 
+Status ApplyAutoQuality(const Options& options, bool wanted, const StateFile* start, const sim::SolverConfig& config,
+                        sim::SceneSetup* setup) {
+  if (!wanted || options.spacing > 0.0f) return Status::Ok();
+  if (start) {
+    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", start->spacing);
+    return Status::Ok();
+  }
+  QualityChoice choice;
+  if (Status s = ChooseQuality(*setup, config, 1.0, 1.0, &choice); !s) return Status::Error(options.scenePath + ": " + s.message());
+  setup->params.spacing = choice.spacing;
+  return Status::Ok();
+}
+
 Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
@@ -392,15 +404,11 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
   std::shared_ptr<const StateFile> state;
   if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), &scene.setup, &state); !s) return s;
-  if (state && options.quality == 1 && options.spacing <= 0.0f) {
-    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", state->spacing);
-  } else if (options.quality == 1 && options.spacing <= 0.0f) {
+  {
     sim::SolverConfig probe;
     probe.device = options.device;
     probe.threads = options.threads;
-    QualityChoice choice;
-    if (Status s = ChooseQuality(scene.setup, probe, 1.0, 1.0, &choice); !s) return Status::Error(options.scenePath + ": " + s.message());
-    scene.setup.params.spacing = choice.spacing;
+    if (Status s = ApplyAutoQuality(options, options.quality == 1, state.get(), probe, &scene.setup); !s) return s;
   }
 
   double targetTime = options.time;
@@ -467,7 +475,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   std::unique_ptr<sim::Solver> solver;
   if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) return Status::Error(options.scenePath + ": " + s.message());
 
-  bool stepCountKnown = true;  // false from a state file without one: saved as unknown again
+  int64_t savedStep = 0;  // the state file's step count (-1: unknown, and saved as unknown again)
   if (state) {
     if (Status s = RestoreState(*state, solver.get()); !s) return Status::Error("--load-state " + s.message());
     SPHXR_LOG_INFO("started from %s: t = %.6g s, step %s, %d fluid particles (saved from '%s')",
@@ -479,8 +487,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                      "are numbered from 0 again, and a state saved from this run has no count either",
                      options.loadState.c_str());
     }
-    summary->stepsBefore = std::max<int64_t>(state->step, 0);
-    stepCountKnown = state->step >= 0;
+    savedStep = state->step;
+    summary->stepsBefore = std::max<int64_t>(savedStep, 0);
   }
   // Steps count on from the state's (the whole run's numbering): the CSV's step column, the export files'
   // numbers and the state saved at the end.
@@ -701,9 +709,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     }
   }
   if (!options.saveState.empty()) {
-    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame,
-                                  stepCountKnown ? stepsBefore : -1);
-        !s) {
+    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame, savedStep); !s) {
       return Status::Error("--save-state " + s.message());
     }
     summary->stateSaved = options.saveState;

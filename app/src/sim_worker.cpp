@@ -365,18 +365,18 @@ std::unique_lock<std::mutex> SimWorker::LockSolver() {
   return std::unique_lock(m_solverMutex);
 }
 
-Status SimWorker::SaveState(const std::string& path, const std::string& sceneName, double* time) {
-  ++m_surfaceWriters;  // ahead of the worker's next step, as a surface writer
-  std::unique_lock solverLock(m_solverMutex);
-  --m_surfaceWriters;
-  *time = m_solver->Time();
-  return WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextPaddleFrame, m_stepsBefore);
-}
-
 std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::string& sceneName) {
   const std::string path = !savePath.empty() ? savePath : (sceneName.empty() ? std::string("sphxr") : sceneName) + ".state";
+  Status s;
   double t = 0.0;
-  if (const Status s = SaveState(path, sceneName, &t); !s) {
+  {
+    ++m_surfaceWriters;  // ahead of the worker's next step, as a surface writer
+    std::unique_lock solverLock(m_solverMutex);
+    --m_surfaceWriters;
+    t = m_solver->Time();
+    s = WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextPaddleFrame, m_stepsBefore);
+  }
+  if (!s) {
     SPHXR_LOG_WARN("save state: %s", s.message().c_str());
     return "save failed: " + s.message();
   }

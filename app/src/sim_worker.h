@@ -72,13 +72,11 @@ class SimWorker {
   std::string LastError() const;
   void Stop();
 
-  /// Writes the running solver's fluid, clock and paddle poses to `path` (state_file.h) between two
-  /// steps: the window's "save state". Holds the solver lock meanwhile (a step in progress finishes first).
-  /// `*time`: the simulated time saved.
-  Status SaveState(const std::string& path, const std::string& sceneName, double* time);
   /// "save state" in the window and in --xr (the s key, the panel's button, the controller's save
-  /// button): SaveState into `savePath` (--save-state's file), else "<scene name>.state" in the working
-  /// directory; logged either way. Returns the line the panel shows.
+  /// button): the running solver's fluid, clock and paddles (state_file.h) into `savePath`
+  /// (--save-state's file), else "<scene name>.state" in the working directory, between two steps: it
+  /// holds the solver lock meanwhile (a step in progress finishes first). Logged either way; returns
+  /// the line the panel shows.
   std::string SaveStateLogged(const std::string& savePath, const std::string& sceneName);
   /// The same save done by the worker thread between its next two steps (paused or not), for a caller
   /// that must not wait for a step and a disk sync: the headset's frame loop. A reset asked for before

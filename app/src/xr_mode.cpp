@@ -24,7 +24,6 @@
 #include "sim_worker.h"
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/pictures.h"
-#include "sphxr/app/quality.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/interaction/hand.h"
@@ -212,22 +211,13 @@ Status StartSimulation(XrApp& app) {
     // One core is left to the frame loop (and llvmpipe's rasteriser, on machines without a GPU).
     solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
   }
-  const std::shared_ptr<const StateFile>& start = app.start;
-  if (start && options.quality != 0 && options.spacing <= 0.0f) {
-    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", start->spacing);
-  } else if (options.quality != 0 && options.spacing <= 0.0f) {
-    QualityChoice choice;
-    if (Status s = ChooseQuality(app.setup, solverConfig, 1.0, 1.0, &choice); !s) {
-      return Status::Error(options.scenePath + ": " + s.message());
-    }
-    app.setup.params.spacing = choice.spacing;
-  }
+  if (Status s = ApplyAutoQuality(options, options.quality != 0, app.start.get(), solverConfig, &app.setup); !s) return s;
   // Each controller holds a paddle: the scene's hand-held ones, else the default blade on a handle
   // (sized at the spacing in use).
   SceneFile atSpacing = app.scene;
   atSpacing.setup = app.setup;
   app.simScene = SimSceneFromFile(atSpacing, {0, 1});
-  app.simScene.start = start;
+  app.simScene.start = app.start;
   app.simScene.surface.enabled = app.mode == render::RenderMode::kWater;
   app.worker = std::make_unique<SimWorker>(solverConfig);
   if (Status s = app.worker->Start(app.simScene); !s) return Status::Error(options.scenePath + ": " + s.message());
@@ -270,9 +260,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     outcome->fallback = true;
     return s;
   }
-  Options notSaved = options;  // the save button and the panel save into --save-state's file
-  notSaved.saveState.clear();
-  if (const std::string ignored = HeadlessOnlyOptions(notSaved); !ignored.empty()) {
+  if (const std::string ignored = HeadlessOnlyOptions(options); !ignored.empty()) {
     SPHXR_LOG_WARN("%s: honoured by --headless runs only; the headset session ignores them", ignored.c_str());
   }
   if (Status s = StartSimulation(app); !s) return s;

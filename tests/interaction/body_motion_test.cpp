@@ -14,21 +14,27 @@
 namespace sphxr::sim {
 namespace {
 
-TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
+/// A 0.3 x 0.2 x 0.2 m tank with 5 cm of water and a small blade on a handle at height `y`.
+SceneSetup PaddleScene(float y) {
   SceneSetup scene = test::TankScene({0, 0, 0}, {0.3f, 0.2f, 0.2f}, 0.01f);
   scene.fluid.push_back(test::Block({0, 0, 0}, {0.3f, 0.05f, 0.2f}));
   RigidBodySetup body;
   body.shapes = interaction::BladeOnHandle(0.05f, 0.01f, 0.06f, 0.05f, 0.012f);
   body.points = interaction::SamplePaddle(body.shapes, scene.params.spacing);
-  body.pose.position = Vec3{0.1f, 0.15f, 0.1f};  // above the water
+  body.pose.position = Vec3{0.1f, y, 0.1f};
   scene.bodies.push_back(body);
+  return scene;
+}
+
+TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
+  const SceneSetup scene = PaddleScene(0.15f);  // the paddle above the water
   auto solver = test::CreateOrFail(scene);
   ASSERT_TRUE(solver);
   ASSERT_EQ(solver->BodyCount(), 1);
 
   // 0.05 s: move 5 cm along x and turn 90 degrees about y.
   const double duration = 0.05;
-  const Vec3 from = body.pose.position, to = from + Vec3{0.05f, 0.0f, 0.0f};
+  const Vec3 from = scene.bodies[0].pose.position, to = from + Vec3{0.05f, 0.0f, 0.0f};
   const float half = 0.25f * 3.14159265f;
   const Quat q1{std::cos(half), 0.0f, std::sin(half), 0.0f};
   ASSERT_TRUE(solver->SetBodyTarget(0, RigidPose{to, q1}, duration).ok());
@@ -75,16 +81,10 @@ TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
 // A restart (state files): a body's whole motion read mid-segment and set on a fresh solver of the same
 // scene gives the same next steps, body and water, bit for bit; bad motions and late calls are refused.
 TEST(BodyMotion, ARestartContinuesTheMotionExactly) {
-  SceneSetup scene = test::TankScene({0, 0, 0}, {0.3f, 0.2f, 0.2f}, 0.01f);
-  scene.fluid.push_back(test::Block({0, 0, 0}, {0.3f, 0.05f, 0.2f}));
-  RigidBodySetup body;
-  body.shapes = interaction::BladeOnHandle(0.05f, 0.01f, 0.06f, 0.05f, 0.012f);
-  body.points = interaction::SamplePaddle(body.shapes, scene.params.spacing);
-  body.pose.position = Vec3{0.1f, 0.08f, 0.1f};  // in the water
-  scene.bodies.push_back(body);
+  const SceneSetup scene = PaddleScene(0.08f);  // the paddle in the water
   auto through = test::CreateOrFail(scene);
   ASSERT_TRUE(through);
-  ASSERT_TRUE(through->SetBodyTarget(0, RigidPose{Vec3{0.2f, 0.08f, 0.1f}, body.pose.orientation}, 0.1).ok());
+  ASSERT_TRUE(through->SetBodyTarget(0, RigidPose{Vec3{0.2f, 0.08f, 0.1f}, scene.bodies[0].pose.orientation}, 0.1).ok());
   for (int k = 0; k < 15; ++k) ASSERT_TRUE(through->Step().ok());
   const BodyMotionState motion = through->BodyMotionOf(0);
   EXPECT_GT(Length(motion.velocity), 0.5f) << "saved while moving along its segment (1 m/s)";

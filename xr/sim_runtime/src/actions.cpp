@@ -21,18 +21,23 @@ struct Bound {
   bool click = false;  // a .../click source reads 0 or 1
 };
 
+/// "/user/hand/left/input/..." -> kLeft and "input/..."; false for a path of no hand.
+bool SplitHand(const std::string& path, Device* device, std::string* rest) {
+  for (Device d : {Device::kLeft, Device::kRight}) {
+    const std::string prefix = d == Device::kLeft ? "/user/hand/left/" : "/user/hand/right/";
+    if (path.rfind(prefix, 0) == 0) {
+      *device = d;
+      *rest = path.substr(prefix.size());
+      return true;
+    }
+  }
+  return false;
+}
+
 Bound Classify(const std::string& path) {
   Bound b{Device::kHead, Source::kNone};
   std::string rest;
-  if (path.rfind("/user/hand/left/", 0) == 0) {
-    b.device = Device::kLeft;
-    rest = path.substr(16);
-  } else if (path.rfind("/user/hand/right/", 0) == 0) {
-    b.device = Device::kRight;
-    rest = path.substr(17);
-  } else {
-    return b;
-  }
+  if (!SplitHand(path, &b.device, &rest)) return b;
   for (const char* p : {"input/grip/pose", "input/grip", "input/aim/pose", "input/aim"})
     if (rest == p) b.source = Source::kPose;
   for (const char* p : {"input/trigger/value", "input/trigger", "input/trigger/click", "input/select/click", "input/select"})
@@ -148,17 +153,10 @@ bool KnownProfile(const std::string& profile) {
 
 /// Whether `path` (/user/hand/<hand>/...) is one of `profile`'s, whole or as an identifier alone.
 bool PathOfProfile(const std::string& profile, const std::string& path) {
-  uint8_t hand = 0;
+  Device device = Device::kHead;
   std::string rest;
-  if (path.rfind("/user/hand/left/", 0) == 0) {
-    hand = kL;
-    rest = path.substr(16);
-  } else if (path.rfind("/user/hand/right/", 0) == 0) {
-    hand = kR;
-    rest = path.substr(17);
-  } else {
-    return false;
-  }
+  if (!SplitHand(path, &device, &rest)) return false;
+  const uint8_t hand = device == Device::kLeft ? kL : kR;
   for (const ProfilePath& p : kProfilePaths) {
     if (profile != std::string("/interaction_profiles/") + p.profile || !(p.hands & hand)) continue;
     const std::string known = p.path;

@@ -60,11 +60,18 @@ struct SceneFile;
 Status LoadSceneWithOptions(const Options& options, SceneFile* scene);
 
 /// The options given that only a headless run honours (--stats, --export-every, --export-surface-every,
-/// --time, --steps), e.g. "--stats, --time"; empty when none. The desktop window and --xr warn with it
-/// once their window is open (a fallback to headless still honours them).
+/// --time, --steps, --settle), e.g. "--stats, --time"; empty when none. The desktop window and --xr warn
+/// with it once their window is open (a fallback to headless still honours them). --save-state is not
+/// one: every mode writes its file (the window's and the headset's saves).
 std::string HeadlessOnlyOptions(const Options& options);
 /// The spacing the command line asks for (--spacing, else --set spacing=...), 0 when it asks for none.
 float ExplicitSpacing(const Options& options);
+struct StateFile;
+/// --quality auto, where the mode wants it (`wanted`: headless with --quality auto; the window and --xr
+/// unless --quality scene): `setup`'s spacing from ChooseQuality for `config`, unless --spacing is given
+/// or a state file (`start`, may be null) fixes it (logged). Errors name the scene file.
+Status ApplyAutoQuality(const Options& options, bool wanted, const StateFile* start, const sim::SolverConfig& config,
+                        sim::SceneSetup* setup);
 
 /// What a headless run measured (also printed as the summary).
 struct RunSummary {
