@@ -46,6 +46,18 @@ class Writer {
   std::ofstream* m_out;
 };
 
+// A paddle's restart state is used as it is (nothing downstream checks it, unlike a body's motion, which
+// Solver::SetBodyMotion does): a NaN here would become the paddle's target pose, or the controller's
+// buzz amplitude.
+bool Finite(sim::Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool Sound(const interaction::PaddleRestart& p) {
+  const interaction::Quat& q = p.state.commanded.orientation;
+  return Finite(p.state.commanded.position) && std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) &&
+         std::isfinite(q.z) && Finite(p.state.force) && Finite(p.state.torque) && Finite(p.state.rawForce) &&
+         p.state.haptic >= 0.0f && p.state.haptic <= 1.0f && p.state.teleports >= 0 && std::isfinite(p.lostSince) &&
+         std::isfinite(p.lastFrame);
+}
+
 class Reader {
  public:
   explicit Reader(std::vector<char> data) : m_data(std::move(data)) {}
@@ -239,9 +251,14 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
     }
     p.state.mode = static_cast<interaction::PaddleMode>(mode);
     p.lost = lost != 0;
+    if (!Sound(p)) {
+      return Status::Error(Format("%s: paddle %u has a non-finite pose, load or time, or a buzz outside 0..1: the file is "
+                                  "damaged", path.c_str(), k));
+    }
     out->paddles.push_back(p);
   }
   if (!r.Get(&out->paddleClock)) return truncated();
+  if (!std::isfinite(out->paddleClock)) return Status::Error(path + ": non-finite paddle clock: the file is damaged");
   out->fluidCount = fluid;
   out->boundaryCount = boundary;
   uint32_t fields = 0;

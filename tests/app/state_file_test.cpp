@@ -5,12 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <string_view>
 
 #include "sphxr/app/state_file.h"
+#include "sphxr/interaction/paddle.h"
 #include "support.h"
 
 namespace sphxr::app {
@@ -128,6 +131,55 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   Put(bad, other.substr(0, other.size()));
   ExpectRefused(bad, "appears twice");
   ExpectRefused(dir.path().string(), "is a directory");
+}
+
+// A paddle's saved state is used as it is read (its commanded pose becomes the paddle's target, its
+// load the controller's buzz), so a damaged value is refused by the reader, naming the paddle.
+TEST(StateFile, APaddleWithANonFiniteStateIsRefused) {
+  test::TempDir dir("state_paddle");
+  sim::SceneSetup scene = test::SmallDamBreak(0.01f);
+  interaction::PaddleDesc desc;
+  desc.holder = interaction::Holder::kRightHand;
+  desc.shapes = interaction::BladeOnHandle(0.05f, 0.008f, 0.04f, 0.04f, 0.012f);
+  std::unique_ptr<interaction::PaddleSystem> paddles;
+  const Status c = interaction::PaddleSystem::Create({desc}, scene, &paddles);
+  ASSERT_TRUE(c.ok()) << c.message();
+  paddles->AddBodies(&scene);
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  ASSERT_TRUE(paddles->Attach(solver.get()).ok());
+  ASSERT_TRUE(paddles->Advance(0.005).ok());
+  const std::string good = dir.File("good.state"), bad = dir.File("bad.state");
+  ASSERT_TRUE(WriteStateFile(good, *solver, "s", paddles.get(), 0.005).ok());
+  StateFile state;
+  ASSERT_TRUE(ReadStateFile(good, &state).ok());
+  ASSERT_EQ(state.paddles.size(), 1u);
+  EXPECT_EQ(state.paddleClock, 0.005);
+
+  // The paddle's record follows the bodies' motions; its commanded pose is the first after its mode.
+  const std::string bytes = Bytes(good);
+  const sim::Vec3 commanded = state.paddles[0].state.commanded.position;
+  const size_t fields = bytes.find("position");  // the first field's name: the records end before it
+  ASSERT_NE(fields, std::string::npos);
+  const size_t at = std::string_view(bytes.data(), fields).rfind(std::string_view(reinterpret_cast<const char*>(&commanded), 12));
+  ASSERT_NE(at, std::string_view::npos);
+  const int32_t mode = static_cast<int32_t>(state.paddles[0].state.mode);  // (withdrawing: no hand holds it)
+  ASSERT_EQ(std::memcmp(&bytes[at - 4], &mode, 4), 0) << "the paddle's mode precedes its pose";
+  const float nan = std::nanf("");
+  std::string other = bytes;
+  std::memcpy(&other[at + 4], &nan, 4);  // commanded y
+  Put(bad, other);
+  ExpectRefused(bad, "paddle 0 has a non-finite pose");
+  other = bytes;  // the buzz amplitude: after the pose (12 + 16) and force, torque, raw force (3 x 12)
+  const float loud = 3.0f;
+  std::memcpy(&other[at + 28 + 36], &loud, 4);
+  Put(bad, other);
+  ExpectRefused(bad, "buzz outside 0..1");
+  other = bytes;  // the paddle clock: the last 8 bytes before the field count and the first field's name
+  const double inf = INFINITY;
+  std::memcpy(&other[fields - 4 - 4 - 8], &inf, 8);
+  Put(bad, other);
+  ExpectRefused(bad, "non-finite paddle clock");
 }
 
 // Version 1 (the first session's files) had no step count: it is still read, with the step unknown
