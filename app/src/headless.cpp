@@ -140,6 +140,32 @@ Status CheckPlaceToWrite(const std::string& flag, const std::string& path, const
   return Status::Ok();
 }
 
+/// What `--stats` keeps of an earlier file when a run continues from a state saved at step
+/// `stepsBefore`: the header and the rows up to that step, when the file has this run's header and a
+/// row for that step (it is the first half's CSV); else nothing, and the file is written anew.
+/// `*dropped` counts the rows after that step (a second half run before).
+std::string StatsRowsToKeep(const std::string& path, const std::string& header, int64_t stepsBefore, int64_t* dropped) {
+  *dropped = 0;
+  if (stepsBefore <= 0) return {};
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line) || line != header) return {};
+  std::string keep = header + "\n";
+  bool found = false;
+  while (std::getline(in, line)) {
+    char* end = nullptr;
+    const long long step = std::strtoll(line.c_str(), &end, 10);
+    if (end == line.c_str() || *end != ',') return {};  // not one of our rows
+    if (step <= stepsBefore) {
+      keep += line + "\n";
+      found = step == stepsBefore;
+    } else {
+      ++*dropped;
+    }
+  }
+  return found ? keep : std::string();
+}
+
 }  // namespace
 
 std::string UsageText() {
@@ -427,10 +453,12 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                                 options.loadState.c_str(), state->clock.time, targetTime));
   }
 
-  // Files are opened before the solver allocates anything, so a bad path costs nothing.
+  // Files are checked before the solver allocates anything, so a bad path costs nothing. The CSV is
+  // opened without truncating it here: a run continued from a state file keeps the first half's rows
+  // (below), and a run refused at start-up leaves the file as it was.
   std::ofstream stats;
   if (!options.statsPath.empty()) {
-    stats.open(options.statsPath);
+    stats.open(options.statsPath, std::ios::app);
     if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
   }
   // Files written after the run: check their places before it.
@@ -515,14 +543,27 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
 
   const bool probeEveryStep = scene.damBreak.has_value() && stats.is_open();
-  if (stats) {
-    stats << "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction";
-    if (probeEveryStep) stats << ",front_Z,height_H";
+  if (stats.is_open()) {
+    std::string header = "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction";
+    if (probeEveryStep) header += ",front_Z,height_H";
     if (paddles) {
-      stats << ",pushed_out";
-      for (int k = 0; k < paddles->Count(); ++k) stats << Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
+      header += ",pushed_out";
+      for (int k = 0; k < paddles->Count(); ++k) header += Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
     }
-    stats << "\n";
+    // A continued run appends to the first half's CSV: the whole run's rows in one file.
+    stats.close();
+    int64_t dropped = 0;
+    const std::string keep = StatsRowsToKeep(options.statsPath, header, stepsBefore, &dropped);
+    stats.open(options.statsPath, std::ios::trunc);
+    if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
+    if (!keep.empty()) {
+      stats << keep;
+      SPHXR_LOG_INFO("--stats %s: the rows continue the earlier run's (its steps up to %lld kept%s)",
+                     options.statsPath.c_str(), static_cast<long long>(stepsBefore),
+                     dropped > 0 ? Format(", %lld rows after it replaced", static_cast<long long>(dropped)).c_str() : "");
+    } else {
+      stats << header << "\n";
+    }
   }
 
   const bool showProgress = options.progress == 1 || (options.progress == -1 && isatty(STDERR_FILENO));
@@ -660,7 +701,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                                   "to find the stage and particle, and lower solver.fixed_dt or raise solver.stiffness",
                                   static_cast<long long>(wholeStep), info.time));
     }
-    if (stats) {
+    if (stats.is_open()) {
       stats << wholeStep << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
             << info.maxDensityError << ',' << info.clamped << ',' << info.activeFraction;
       if (probeEveryStep) {

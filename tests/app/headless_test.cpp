@@ -670,12 +670,15 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
                                  dir);
   ASSERT_TRUE(first.Exited() && first.Code() == 0) << first.err;
   EXPECT_NE(first.out.find("state           saved to " + half), std::string::npos) << first.out;
-  const Result second = RunBinary("--headless --time 0.04 --load-state " + Quote(half) + " --save-state " +
-                                      Quote(continued) + " --stats " + Quote(dir.File("continued.csv")) +
-                                      files("parts", "frames") + common,
-                                  dir);
+  // The continued run's --stats is a copy of the first half's CSV: it appends the whole run's rows to it.
+  std::filesystem::copy_file(dir.File("half.csv"), dir.File("joined.csv"));
+  const std::string continuedRun = "--headless --time 0.04 --load-state " + Quote(half) + " --save-state " +
+                                   Quote(continued) + " --stats " + Quote(dir.File("joined.csv")) +
+                                   files("parts", "frames") + common;
+  const Result second = RunBinary(continuedRun, dir);
   ASSERT_TRUE(second.Exited() && second.Code() == 0) << second.err;
   EXPECT_NE(second.err.find("started from " + half), std::string::npos) << second.err;
+  EXPECT_NE(second.err.find("the rows continue the earlier run's (its steps up to 90 kept)"), std::string::npos) << second.err;
   EXPECT_NE(second.out.find("(from the state file)"), std::string::npos) << second.out;
   EXPECT_NE(second.out.find("of the whole run"), std::string::npos) << second.out;
   const Result through = RunBinary("--headless --time 0.04 --save-state " + Quote(whole) + " --stats " +
@@ -687,19 +690,16 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
   ASSERT_GT(a.size(), static_cast<size_t>(kSmallSceneParticles) * 60) << "every field of every particle";
   EXPECT_TRUE(a == b) << "the continued run's state differs from the whole run's";
 
-  // The two halves' CSV rows are the whole run's rows: the step column counts on, the clock goes on.
+  // The first half's CSV with the continued run's rows is the whole run's: the step column counts on,
+  // the clock goes on.
   const std::vector<std::string> halfRows = Lines(test::ReadFile(dir.File("half.csv"))),
-                                 restRows = Lines(test::ReadFile(dir.File("continued.csv"))),
+                                 joinedRows = Lines(test::ReadFile(dir.File("joined.csv"))),
                                  wholeRows = Lines(test::ReadFile(dir.File("whole.csv")));
-  ASSERT_GT(halfRows.size(), 2u);
-  ASSERT_GT(restRows.size(), 2u);
-  std::vector<std::string> joined = halfRows;
-  joined.insert(joined.end(), restRows.begin() + 1, restRows.end());  // without its header
-  EXPECT_EQ(joined, wholeRows);
-  const std::vector<std::string> firstRow = Split(restRows[1], ',');
-  EXPECT_EQ(std::stoll(firstRow[0]), static_cast<long long>(halfRows.size()))  // header + N rows: step N + 1
-      << "the continued run numbers its steps on from the saved one";
-  ASSERT_EQ(halfRows.size(), 91u);
+  ASSERT_EQ(halfRows.size(), 91u);  // header + 90 rows
+  ASSERT_GT(joinedRows.size(), halfRows.size() + 1);
+  EXPECT_EQ(joinedRows, wholeRows);
+  EXPECT_TRUE(std::equal(halfRows.begin(), halfRows.end(), joinedRows.begin())) << "the first half's rows are kept";
+  EXPECT_EQ(std::stoll(Split(joinedRows[91], ',')[0]), 91) << "the continued run numbers its steps on from the saved one";
   const long long lastStep = std::stoll(Split(wholeRows.back(), ',')[0]);
   EXPECT_NE(second.out.find(Format("exported        %lld files", 1 + (lastStep - 90) / 5)), std::string::npos)
       << "the start (step 90) and every fifth step after it:\n" << second.out;
@@ -728,8 +728,19 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
                      "another --spacing");
   ExpectOneLineError(RunBinary("--headless --time 0.04 --set spacing=0.012 --load-state " + Quote(half) + common, dir),
                      "another --spacing");
-  ExpectOneLineError(RunBinary("--headless --time 0.04 --save-state " + Quote(dir.path().string()) + common, dir),
+  // Refused after --stats is checked: the CSV it names is left as it was.
+  ExpectOneLineError(RunBinary("--headless --time 0.04 --stats " + Quote(dir.File("joined.csv")) + " --save-state " +
+                                   Quote(dir.path().string()) + common,
+                               dir),
                      "is a directory");
+  EXPECT_EQ(Lines(test::ReadFile(dir.File("joined.csv"))), wholeRows) << "a refused run truncated its --stats file";
+  // The second half run again into the joined CSV replaces its own earlier rows.
+  const Result again = RunBinary(continuedRun, dir);
+  ASSERT_TRUE(again.Exited() && again.Code() == 0) << again.err;
+  EXPECT_NE(again.err.find(Format("its steps up to 90 kept, %zu rows after it replaced", wholeRows.size() - 91)),
+            std::string::npos)
+      << again.err;
+  EXPECT_EQ(Lines(test::ReadFile(dir.File("joined.csv"))), wholeRows);
   ExpectOneLineError(RunBinary("--headless --time 0.04 --save-state /nonexistent/x.state" + common, dir),
                      "cannot write into");
 }
