@@ -134,17 +134,25 @@ inline std::string CsvField(const std::string& s) {
   return out + "\"";
 }
 
-/// Opens `path` for appending; writes `header` first when the file is new or empty.
-inline bool OpenCsv(const std::string& path, const std::string& header, bool append, std::ofstream* out) {
+/// Opens `path` (appending, or anew) and writes `header` first when the file is new or empty. Returns
+/// "" or the reason it cannot: appending to a file whose header is another one (an older bench's
+/// columns) is refused, since its rows would then sit under the wrong names.
+inline std::string OpenCsv(const std::string& path, const std::string& header, bool append, std::ofstream* out) {
   bool empty = true;
   if (append) {
-    std::ifstream probe(path, std::ios::ate);
-    empty = !probe || probe.tellg() <= 0;
+    std::ifstream probe(path);
+    std::string first;
+    if (probe && std::getline(probe, first) && !first.empty()) {
+      empty = false;
+      if (first != header) {
+        return "--csv " + path + ": its header is not this bench's (other columns, an older version?): give a new file";
+      }
+    }
   }
   out->open(path, append ? std::ios::app : std::ios::trunc);
-  if (!*out) return false;
+  if (!*out) return "--csv " + path + ": cannot open for writing";
   if (empty) *out << header << '\n';
-  return true;
+  return {};
 }
 
 inline double Median(std::vector<double> v) {

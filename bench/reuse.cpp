@@ -383,14 +383,14 @@ int main(int argc, char** argv) {
     cases.push_back({"dam_break_1m", SPHXR_SCENES_DIR "/dam_break_1m.json", t, {t / 3, 2 * t / 3, t}, true});
   }
   std::ofstream csv;
-  if (!args.csv.empty() &&
-      !OpenCsv(args.csv,
+  if (const std::string why = args.csv.empty() ? std::string() : OpenCsv(args.csv,
                "timestamp_utc,cpu_model,nproc,threads,scene,fluid,setting,enabled,delta1,delta2,threshold,idle,accel_tolerance,"
                "sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,paired_ref_step_ms,speedup,active_fraction,"
                "mean_density_error,peak_density_error,surface_rms_spacings,front_deviation,max_speed,clamped,"
                "finite,load_avg_start,load_avg_end",
-               false, &csv)) {
-    std::fprintf(stderr, "cannot write %s\n", args.csv.c_str());
+               false, &csv);
+      !why.empty()) {
+    std::fprintf(stderr, "%s\n", why.c_str());
     return 1;
   }
   const std::string when = UtcTimestamp();

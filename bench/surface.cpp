@@ -136,13 +136,13 @@ int Run(int argc, char** argv) {
   surface->SetTraversalRun(run);
 
   std::ofstream out;
-  if (!csv.empty() &&
-      !OpenCsv(csv,
+  if (const std::string why = csv.empty() ? std::string() : OpenCsv(csv,
                "timestamp,cpu,threads,load_before,load_after,scene,fluid,time_s,cell_size_m,cell_over_spacing,samples,"
                "cells,triangles,field_ms,pyramid_ms,traversal_ms,extraction_ms,step_ms,reference_mc_ms,"
                "pyramid_over_base,base_bytes,pyramid_bytes,field_bytes",
-               true, &out)) {
-    std::fprintf(stderr, "--csv %s: cannot open\n", csv.c_str());
+               true, &out);
+      !why.empty()) {
+    std::fprintf(stderr, "%s\n", why.c_str());
     return 1;
   }
   struct Row {

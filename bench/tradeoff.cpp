@@ -349,8 +349,8 @@ int main(int argc, char** argv) {
         "step_wall_s,loop_wall_s,wall_per_sim_s,front_rms_rel,front_max_rel,front_bias_rel,front_points,front_T_min,front_T_max,final_Z,"
         "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_viscosity,cfl,"
         "max_dt";
-    if (!OpenCsv(args.csv, header, /*append=*/false, &csv)) {
-      std::fprintf(stderr, "--csv %s: cannot open for writing\n", args.csv.c_str());
+    if (const std::string why = OpenCsv(args.csv, header, /*append=*/false, &csv); !why.empty()) {
+      std::fprintf(stderr, "%s\n", why.c_str());
       return 1;
     }
     csv.precision(9);
