@@ -279,7 +279,7 @@ void SimWorker::Run() {
         m_paddles = std::move(freshPaddles);  // bound to the old solver: replaced first
         m_solver = std::move(fresh);
         m_builtBuild = 0;  // the new solver has built no surface yet
-        m_nextPaddleFrame = paddleClock;  // (under the solver lock: SaveState reads both)
+        m_nextPaddleFrame = paddleClock;  // (under the solver lock: a save reads both)
         m_stepsBefore = stepsBefore;
         solverLock.unlock();
         {
