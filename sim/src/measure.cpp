@@ -58,7 +58,11 @@ EnergySummary SphEnergy(const SceneSetup& scene, float particleMass, const HostF
     return sigma * 2.0 * t * t * t;
   };
   // e(rho) = int_rho0^rho B ((s/rho0)^gamma - 1) / s^2 ds for rho > rho0.
-  auto F = [&](double r) { return B * (std::pow(r / rho0, gamma) / ((gamma - 1.0) * r) + 1.0 / r); };
+  // (At gamma = 1, an allowed exponent, the first term's integral is log(s) / rho0.)
+  auto F = [&](double r) {
+    if (std::abs(gamma - 1.0) < 1e-12) return B * (std::log(r) / rho0 + 1.0 / r);
+    return B * (std::pow(r / rho0, gamma) / ((gamma - 1.0) * r) + 1.0 / r);
+  };
   auto e = [&](double rho) { return rho > rho0 ? F(rho) - F(rho0) : 0.0; };
   EnergySummary out;
   Vec3 lo, hi;

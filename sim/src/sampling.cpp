@@ -98,7 +98,12 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
                      scene.params.stiffness;
     const double e = 1.0 - 1.0 / scene.params.exponent;
     const bool compress = block.hydrostatic && a > 0.0;
-    auto compressedDepth = [&](double d) { return (std::pow(1.0 + a * d, e) - 1.0) / (a * e); };
+    // ((1 + a d)^e - 1) / (a e), written so that it stays finite as e -> 0 (exponent 1, allowed): there
+    // it is log(1 + a d) / a.
+    auto compressedDepth = [&](double d) {
+      const double l = std::log1p(a * d);
+      return std::abs(e) < 1e-12 ? l / a : std::expm1(e * l) / (a * e);
+    };
     const double bottom = block.box.min.y + 0.5 * dx;
     const double bottomDepth = compress ? compressedDepth(top - bottom) : 0.0;
     auto layerY = [&](int64_t j) -> float {

@@ -469,6 +469,15 @@ Status Solver::Step() {
     }
   }
 
+  if (red.nonFinite > 0) {
+    // Without --validate nothing else would notice: the step's maxima drop NaN, and a NaN particle
+    // sits in the grid's last cell with no neighbours, exported and saved as NaN.
+    return Status::Error(Format("%d fluid particles became non-finite (NaN or infinite position, velocity, acceleration "
+                                "or density) in the step from t = %.6g s: the simulation has become unstable; rerun "
+                                "with --validate to find the stage and particle, and lower solver.fixed_dt or raise "
+                                "solver.stiffness",
+                                red.nonFinite, m_last.time));
+  }
   m_last.time += dt;
   m_last.dt = dt;
   m_last.maxSpeed = std::sqrt(red.maxSpeed2);
@@ -572,6 +581,14 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
     off.enabled = false;
     if (Status s = SetReuse(off); !s) return s;
   }
+  // A failed settle still gives the scene its reuse back (the caller may go on, or save).
+  struct RestoreReuse {
+    Solver* solver;
+    ReuseParams reuse;
+    ~RestoreReuse() {
+      if (reuse.enabled && !solver->m_scene.reuse.enabled) (void)solver->SetReuse(reuse);  // validated before
+    }
+  } restoreReuse{this, reuse};
   SettleReport r;
   double alpha = 0.1;
   int downhill = 0;

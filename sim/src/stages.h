@@ -646,7 +646,13 @@ struct StepReduction {
   int32_t clamped = 0;
   int32_t computed = 0;  // particles that computed density and forces this step (set by the backend)
   int32_t pushed = 0;    // fluid particles pushed out of a moving body this step (body_stages.h)
+  int32_t nonFinite = 0; // fluid particles with a NaN or infinite position, velocity, acceleration or density
 };
+
+/// x is neither NaN nor infinite (x - x is NaN for both). Written out because the max reductions
+/// below drop NaN (fmaxf(x, NaN) = x): a NaN particle would otherwise never show in the step's
+/// statistics. (No fast-math flags are used, so the compiler may not fold this to true.)
+SPHXR_HD SPHXR_INLINE bool FiniteValue(float x) { return x - x == 0.0f; }
 
 struct StepReductionOp {
   FluidView fluid;
@@ -655,6 +661,11 @@ struct StepReductionOp {
     StepReduction r;
     const Vec4 v = fluid.velocity[i];
     const Vec4 a = fluid.acceleration[i];
+    const Vec4 x = fluid.position[i];
+    const bool finite = FiniteValue(x.x) && FiniteValue(x.y) && FiniteValue(x.z) && FiniteValue(v.x) &&
+                        FiniteValue(v.y) && FiniteValue(v.z) && FiniteValue(a.x) && FiniteValue(a.y) &&
+                        FiniteValue(a.z) && FiniteValue(fluid.density[i]);
+    r.nonFinite = finite ? 0 : 1;
     r.maxSpeed2 = v.x * v.x + v.y * v.y + v.z * v.z;
     r.maxAccel2 = a.x * a.x + a.y * a.y + a.z * a.z;
     const float err = fluid.density[i] * invRestDensity - 1.0f;
@@ -676,6 +687,7 @@ struct StepReductionCombine {
     r.sumCompression = a.sumCompression + b.sumCompression;
     r.clamped = a.clamped + b.clamped;
     r.pushed = a.pushed + b.pushed;
+    r.nonFinite = a.nonFinite + b.nonFinite;
     return r;
   }
 };

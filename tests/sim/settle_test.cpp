@@ -107,8 +107,10 @@ TEST(SettleTest, RefusesBadTimesAndALateCall) {
 
 // A state that goes non-finite while settling is an error naming the step, not minutes of NaN steps.
 TEST(SettleTest, ANonFiniteStateStopsItWithAnError) {
+  SceneSetup scene = Tank();
+  ASSERT_TRUE(ApplyReusePreset("balanced", &scene.reuse));  // the settle turns reuse off while it runs
   std::unique_ptr<Solver> solver;
-  ASSERT_TRUE(Solver::Create(Tank(), SolverConfig{}, &solver).ok());
+  ASSERT_TRUE(Solver::Create(scene, SolverConfig{}, &solver).ok());
   HostFluid fluid;
   solver->Download(&fluid);
   fluid.velocity[17].y = std::numeric_limits<float>::quiet_NaN();
@@ -118,6 +120,7 @@ TEST(SettleTest, ANonFiniteStateStopsItWithAnError) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("non-finite"), std::string::npos) << s.message();
   EXPECT_LT(solver->GetTotals().steps, 5) << "stopped at once";
+  EXPECT_TRUE(solver->Scene().reuse.enabled) << "a failed settle gives the scene its reuse back";
 }
 
 }  // namespace

@@ -95,7 +95,9 @@ class Solver {
   static Status Create(const SceneSetup& scene, const SolverConfig& config, std::unique_ptr<Solver>* out);
   ~Solver();
 
-  /// Advances one time step. Fails only in validate mode (a non-finite value, named by stage and particle).
+  /// Advances one time step. Fails when a fluid particle became non-finite (validate mode names the stage
+  /// and particle; without it the step's reduction counts them), or when the time step collapses. A
+  /// failed step leaves the clock and the statistics where they were; the fluid is not rolled back.
   Status Step();
 
   /// Relaxes the water toward a rest state before a run (docs/physics.md, "Tenth session"): `seconds`
