@@ -286,8 +286,11 @@ GridShape MakeGridShape(const SceneSetup& scene) {
   GridShape g;
   g.cellSize = support;
   g.origin = Vec3{scene.tank.min.x - margin, scene.tank.min.y - margin, scene.tank.min.z - margin};
+  // In double, and saturated: a huge tank must come out as a huge grid (refused by ValidateScene), not
+  // as a float-to-int overflow (undefined; INT_MIN on x86, which passed the size check).
   auto dim = [&](float lo, float hi) {
-    return static_cast<int>(std::ceil((hi - lo + 2.0f * margin) / support)) + 1;
+    const double n = std::ceil((static_cast<double>(hi) - lo + 2.0 * margin) / support) + 1.0;
+    return n < 2147483647.0 ? static_cast<int>(n) : 2147483647;
   };
   g.nx = dim(scene.tank.min.x, scene.tank.max.x);
   g.ny = dim(scene.tank.min.y, scene.tank.max.y);

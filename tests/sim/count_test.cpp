@@ -2,9 +2,12 @@
 // sampling creates: the counts are computed in closed form, the samples by walking the lattice.
 #include <gtest/gtest.h>
 
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "sampling.h"
+#include "sphxr/sim/solver.h"
 
 namespace sphxr::sim {
 namespace {
@@ -42,6 +45,32 @@ TEST(CountParticles, ClosedFormEqualsSampling) {
       }
     }
   }
+}
+
+// Scenes too large for the solver are refused by Solver::Create before anything is allocated, with a
+// one-line reason. A tank of 5e9 m made the grid size overflow int (negative, so it passed the size
+// check) and the counts overflow int64, and the run allocated until it died.
+TEST(CountParticles, ScenesTooLargeAreRefusedBeforeAllocating) {
+  SceneSetup huge;
+  huge.params.spacing = 1.0f;
+  huge.tank = {{0.0f, 0.0f, 0.0f}, {5e9f, 5e9f, 5e9f}};
+  huge.fluid.push_back({{{0.0f, 0.0f, 0.0f}, {4.0f, 4.0f, 4.0f}}, {}});
+  std::unique_ptr<Solver> solver;
+  Status s = Solver::Create(huge, SolverConfig{}, &solver);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("neighbour grid"), std::string::npos) << s.message();
+
+  // 820^3 = 551M fluid particles in a grid of 420 cells per axis: more than the SIMD stages' 32-bit
+  // gather offsets can reach (2^29), refused by count whatever the machine's memory.
+  SceneSetup many;
+  many.params.spacing = 0.01f;
+  many.tank = {{0.0f, 0.0f, 0.0f}, {8.2f, 8.2f, 8.2f}};
+  many.fluid.push_back({{{0.0f, 0.0f, 0.0f}, {8.2f, 8.2f, 8.2f}}, {}});
+  ASSERT_GE(CountParticles(many).fluid, int64_t{1} << 29);
+  s = Solver::Create(many, SolverConfig{}, &solver);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("at most 536870911 of each"), std::string::npos) << s.message();
+  EXPECT_EQ(s.message().find('\n'), std::string::npos) << s.message();
 }
 
 }  // namespace
