@@ -137,6 +137,23 @@ Status ValidateScene(const SceneSetup& scene) {
                            " is not inside the tank " + Str(scene.tank.min) + " to " + Str(scene.tank.max));
     }
   }
+  // Overlapping blocks would put particles on top of each other (where their lattices share points,
+  // exactly: such twins have no force between them and never separate) or closer than the spacing.
+  // Blocks may touch.
+  for (size_t i = 0; i < scene.fluid.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      const Aabb& a = scene.fluid[i].box;
+      const Aabb& b = scene.fluid[j].box;
+      const float d = scene.params.spacing * 0.5f;  // less than half a spacing of overlap is rounding
+      if (a.min.x < b.max.x - d && b.min.x < a.max.x - d && a.min.y < b.max.y - d && b.min.y < a.max.y - d &&
+          a.min.z < b.max.z - d && b.min.z < a.max.z - d) {
+        return Status::Error(Format("fluid[%zu] %s to %s overlaps fluid[%zu] %s to %s: their particles would sit on "
+                                    "top of each other; make the blocks touch, not overlap",
+                                    i, Str(a.min).c_str(), Str(a.max).c_str(), j, Str(b.min).c_str(),
+                                    Str(b.max).c_str()));
+      }
+    }
+  }
   for (size_t i = 0; i < scene.obstacles.size(); ++i) {
     const std::string key = Format("obstacles[%zu]", i);
     if (Status s = ValidateBox(scene.obstacles[i], key); !s) return s;

@@ -450,6 +450,15 @@ TEST(HeadlessTest, FluidOutsideTheTankFailsCleanly) {
                      {"fluid[0]"});
 }
 
+// Overlapping blocks would give particles at the same place (twins with no force between them, which
+// never separate); touching blocks are fine.
+TEST(HeadlessTest, OverlappingFluidBlocksFailCleanly) {
+  ExpectCleanFailure(R"({ "tank": { "min": [0,0,0], "max": [0.2,0.2,0.2] },
+                          "fluid": [ { "min": [0,0,0], "max": [0.1,0.1,0.1] },
+                                     { "min": [0.08,0,0], "max": [0.15,0.1,0.1] } ] })",
+                     {"fluid[1]", "overlaps fluid[0]"});
+}
+
 // A failed run whose whole stderr is one line containing `needle`; `code` the exit code (0: any but 0).
 void ExpectOneLineError(const Result& r, const std::string& needle, int code = 0, const char* why = "") {
   ASSERT_TRUE(r.Exited()) << "crashed: status " << r.status << "\nstderr:\n" << r.err;
