@@ -564,10 +564,13 @@ Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
   }
   if (Status s = CheckFluidSizes(fluid, "restore"); !s) return s;
   for (size_t i = 0; i < fluid.size(); ++i) {
+    // With reuse, a particle restored idle uses its saved density, pressure and pressure term in its
+    // neighbours' first steps (they divide by its density): all must be sound.
     if (!Finite(Xyz(fluid.position[i])) || !Finite(Xyz(fluid.velocity[i])) || !Finite(Xyz(fluid.acceleration[i])) ||
-        !std::isfinite(fluid.density[i]) || !std::isfinite(fluid.pressure[i])) {
+        !(fluid.density[i] > 0.0f) || !std::isfinite(fluid.density[i]) || !std::isfinite(fluid.pressure[i]) ||
+        !std::isfinite(fluid.pressureTerm[i])) {
       return Status::Error(Format("restore: particle %zu (id %u) has a non-finite position, velocity, acceleration, "
-                                  "density or pressure",
+                                  "pressure or pressure term, or a density that is not a positive number",
                                   i, fluid.id[i]));
     }
   }
@@ -724,7 +727,7 @@ RigidPose Solver::BodyPoseAt(const BodyMotion& body, double time) const {
 float Solver::MaxBodySpeed() const {
   float speed = 0.0f;
   for (const BodyMotion& b : m_bodies) {
-    if (m_last.time >= b.toTime) continue;
+    if (m_last.time >= b.toTime || !(b.toTime > b.fromTime)) continue;  // held (BodyPoseAt: at `to`)
     const float span = static_cast<float>(b.toTime - b.fromTime);
     const float linear = Length(b.to.position - b.from.position) / span;
     const float angular = Length(RotationVector(Mul(b.to.orientation, Conjugate(b.from.orientation)))) / span;
@@ -742,7 +745,25 @@ Status Solver::SetBodyMotion(int body, const BodyMotionState& m) {
                       Finite(m.from.orientation) && Finite(m.to.position) && Finite(m.to.orientation) &&
                       std::isfinite(m.fromTime) && std::isfinite(m.toTime) && Finite(m.velocity) && Finite(m.angular);
   if (!finite) return Status::Error(Format("SetBodyMotion: non-finite motion for body %d", body));
-  static_cast<BodyMotionState&>(m_bodies[body]) = m;
+  // Orientations are unit quaternions up to rounding (a body's particles are placed by them): one far
+  // from unit length is damage, one a little off is normalised. A segment must not end before it begins.
+  auto unitish = [](Quat q) {
+    const float n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
+    return n2 > 0.25f && n2 < 4.0f;
+  };
+  if (!unitish(m.pose.orientation) || !unitish(m.from.orientation) || !unitish(m.to.orientation) ||
+      m.toTime < m.fromTime) {
+    return Status::Error(Format("SetBodyMotion: body %d has an orientation far from unit length, or a motion that ends "
+                                "(t = %g s) before it begins (t = %g s)",
+                                body, m.toTime, m.fromTime));
+  }
+  // (Only those visibly off: the solver's own, saved, must come back bit for bit for a continued run.)
+  BodyMotionState unit = m;
+  for (RigidPose* p : {&unit.pose, &unit.from, &unit.to}) {
+    const Quat q = p->orientation;
+    if (std::abs(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z - 1.0f) > 1e-4f) p->orientation = Normalized(q);
+  }
+  static_cast<BodyMotionState&>(m_bodies[body]) = unit;
   return Status::Ok();
 }
 

@@ -121,6 +121,19 @@ TEST(BodyMotion, ARestartContinuesTheMotionExactly) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("non-finite"), std::string::npos) << s.message();
   EXPECT_FALSE(fresh->SetBodyMotion(1, motion).ok()) << "no body 1";
+  bad = motion;  // a zero quaternion would place the body's particles at its origin
+  bad.to.orientation = Quat{0.0f, 0.0f, 0.0f, 0.0f};
+  s = fresh->SetBodyMotion(0, bad);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("far from unit length"), std::string::npos) << s.message();
+  bad = motion;  // ends before it begins (a zero-length segment ahead made the CFL step 0)
+  bad.toTime = bad.fromTime - 0.01;
+  EXPECT_FALSE(fresh->SetBodyMotion(0, bad).ok());
+  bad = motion;  // a little off unit length: normalised
+  bad.to.orientation.w *= 1.01f;
+  ASSERT_TRUE(fresh->SetBodyMotion(0, bad).ok());
+  const Quat q = fresh->BodyMotionOf(0).to.orientation;
+  EXPECT_NEAR(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z, 1.0f, 1e-6f);
   s = restored->SetBodyMotion(0, motion);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("before the first step"), std::string::npos) << s.message();

@@ -121,6 +121,18 @@ TEST(Restore, RefusesWhatCannotBeTheSameScene) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("non-finite"), std::string::npos) << s.message();
 
+  // A restored idle particle's neighbours divide by its density and read its pressure term.
+  HostFluid empty = fluid;
+  empty.density[3] = 0.0f;
+  s = solver->Restore(empty, clock);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("density that is not a positive number"), std::string::npos) << s.message();
+  HostFluid term = fluid;
+  term.pressureTerm[5] = std::numeric_limits<float>::infinity();
+  s = solver->Restore(term, clock);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("pressure term"), std::string::npos) << s.message();
+
   SolverClock bad;
   bad.time = -1.0;
   EXPECT_FALSE(solver->Restore(fluid, bad).ok());
