@@ -69,14 +69,17 @@ class SurfaceImpl final : public SurfaceExtractor {
     const float lo[3] = {b.min.x - job.margin, b.min.y - job.margin, b.min.z - job.margin};
     const float hi[3] = {b.max.x + job.margin, b.max.y + job.margin, b.max.z + job.margin};
     const float origin[3] = {p.grid.origin.x, p.grid.origin.y, p.grid.origin.z};
-    double first[3];
-    int64_t dims[3];
+    double first[3], extent[3];
     for (int a = 0; a < 3; ++a) {
       first[a] = std::floor((static_cast<double>(lo[a]) - origin[a]) / cs);
       const double last = std::ceil((static_cast<double>(hi[a]) - origin[a]) / cs);
-      dims[a] = static_cast<int64_t>(last - first[a]) + 1;
+      extent[a] = last - first[a] + 1.0;
     }
-    const double samples = static_cast<double>(dims[0]) * static_cast<double>(dims[1]) * static_cast<double>(dims[2]);
+    // In double, and checked before any cast: bounds that are not finite numbers give no lattice.
+    const double samples = extent[0] * extent[1] * extent[2];
+    if (!(samples >= 1.0)) {
+      return Status::Error("surface: the particles' bounding box is not finite (a non-finite position?)");
+    }
     if (samples > static_cast<double>(job.maxSamples)) {
       return Status::Error(Format("surface: cell size %g m over the fluid's %.3g x %.3g x %.3g m bounding box needs "
                                   "%.3g field samples, above the limit of %lld: use a larger surface.cell_size",
@@ -85,9 +88,9 @@ class SurfaceImpl final : public SurfaceExtractor {
     }
     grid.origin = Vec3{origin[0] + static_cast<float>(first[0] * cs), origin[1] + static_cast<float>(first[1] * cs),
                        origin[2] + static_cast<float>(first[2] * cs)};
-    grid.nx = static_cast<int>(dims[0]);
-    grid.ny = static_cast<int>(dims[1]);
-    grid.nz = static_cast<int>(dims[2]);
+    grid.nx = static_cast<int>(extent[0]);
+    grid.ny = static_cast<int>(extent[1]);
+    grid.nz = static_cast<int>(extent[2]);
     m_field.resize(static_cast<size_t>(grid.Samples()));
     // Every sample is written by exactly one block of the field stage; NaN first makes a miss visible.
     thrust::fill(policy, m_field.begin(), m_field.end(), std::numeric_limits<float>::quiet_NaN());
@@ -115,8 +118,9 @@ class SurfaceImpl final : public SurfaceExtractor {
       return Status::Error(Format("surface: %zu field values for a %d x %d x %d lattice", field.size(), grid.nx,
                                   grid.ny, grid.nz));
     }
-    if (grid.Samples() > (int64_t{1} << 30) || grid.cellSize <= 0.0f) {
-      return Status::Error("surface: the lattice must have at most 2^30 samples and a positive cell size");
+    // 2^27 as for particles (kMaxSurfaceSamples): the pyramid's offsets and level sums are 32-bit.
+    if (grid.nx < 1 || grid.ny < 1 || grid.nz < 1 || grid.Samples() > (int64_t{1} << 27) || !(grid.cellSize > 0.0f)) {
+      return Status::Error("surface: the lattice must have 1 to 2^27 samples (at least 1 per axis) and a positive cell size");
     }
     m_field.assign(field.begin(), field.end());
     return BuildPyramid(grid, isoLevel, begin, stats);

@@ -646,6 +646,25 @@ TEST(SurfaceParticles, EmptySceneGivesNoTriangles) {
   EXPECT_EQ(mesh.VertexCount(), 0);
 }
 
+// Positions that are all non-finite along an axis leave the bounding box at its initial +-1e30: the
+// lattice size was converted from an out-of-range double (undefined; a silent empty mesh on x86). It is
+// an error now; a few NaN particles among finite ones are skipped, as before.
+TEST(SurfaceParticles, ANonFiniteBoundingBoxIsAnError) {
+  auto solver = CreateOrFail(SmallDamBreak());
+  ASSERT_TRUE(solver);
+  HostFluid f = DownloadFluid(*solver);
+  f.position[0].y = std::nanf("");
+  ASSERT_TRUE(solver->Upload(f).ok());
+  SurfaceMesh mesh;
+  ASSERT_TRUE(solver->ExtractSurface(sim::SurfaceParams{}, &mesh).ok()) << "one NaN particle among finite ones";
+  EXPECT_GT(mesh.TriangleCount(), 0);
+  for (Vec4& p : f.position) p.x = std::nanf("");
+  ASSERT_TRUE(solver->Upload(f).ok());
+  const Status s = solver->ExtractSurface(sim::SurfaceParams{}, &mesh);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("not finite"), std::string::npos) << s.message();
+}
+
 TEST(SurfaceParticles, BadParametersAreRefusedWithTheKey) {
   auto solver = CreateOrFail(SmallDamBreak());
   ASSERT_TRUE(solver);
