@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -39,6 +40,10 @@ class Reader {
     if (!j.is_number()) return Error(key, "must be a number, got " + std::string(j.type_name()) + " " + j.dump());
     *v = j.get<double>();
     if (!std::isfinite(*v)) return Error(key, "must be finite");
+    // Every scene number is stored as a float: beyond its range the conversion is undefined.
+    if (std::fabs(*v) > static_cast<double>(std::numeric_limits<float>::max())) {
+      return Error(key, "is " + j.dump() + ", beyond the range of a float (3.4e38)");
+    }
     return Status::Ok();
   }
 
