@@ -87,6 +87,7 @@ class BackendImpl final : public Backend {
       auto end = thrust::copy_if(Traits::Policy(), cell, cell + cells, m_boundaryStart.begin(), m_wallCells.begin(),
                                  NonEmptyCell{});
       m_wallCells.resize(end - m_wallCells.begin());
+      m_wallCells.shrink_to_fit();  // (a vector keeps its capacity: 4 B per grid cell for the whole run)
     }
     // Which cells have boundary particles in their 27-cell neighbourhood (the walls never move).
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), static_cast<int>(cells),

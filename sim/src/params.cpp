@@ -42,18 +42,28 @@ ParticleCounts CountParticles(const SceneSetup& scene) {
   c.boundary = SampleBoundary(scene, nullptr);
   c.gridCells = MakeGridShape(scene).Cells();
   c.neighbourSlots = NeighbourCapacity(scene.params.supportFactor);
+  for (const RigidBodySetup& b : scene.bodies) c.bodyParticles += static_cast<int64_t>(b.points.size());
+  c.reuse = scene.reuse.enabled;
+  c.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity;
   return c;
 }
 
 int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
-  // Fluid: the field list (68 B) + sort keys and order (8) + reorder scratch of the widest field (16)
-  // + the sort's temporary storage (about keys and values again, 8). Boundary: 16 B, plus its sort at
-  // start-up (~40 B transient). Grid: 4 ranges of 4 B per cell. Host copy at creation: the same again.
-  // Neighbour lists: 4 B per slot and a count (sim/src/stages.h NeighbourList).
-  const int64_t fluid = counts.fluid * (68 + 8 + 16 + 8 + 68 + 4 * counts.neighbourSlots + 4);
-  const int64_t boundary = counts.boundary * (16 + 40 + 16);
-  const int64_t grid = counts.gridCells * 17;  // 4 ranges of 4 B and the near-boundary flag
-  return fluid + boundary + grid;
+  // sim/src/backend_impl.h's members. Fluid: the field list (68 B) + sort keys and order (8) + reorder
+  // scratch of each element type (16 + 4 + 4 + 4) + the sort's temporary storage (about keys and values
+  // again, 8) + the CPU density stage's block starts (4) + the host copy at creation (68). Neighbour
+  // lists: 4 B per slot and a count (sim/src/stages.h NeighbourList). Reuse: the compacted list (4);
+  // bodies: each fluid particle's pressure term for the reaction (4). Boundary: 16 B, plus its sort at
+  // start-up (~40 B transient) and the host copy (16); with wall_density its pressure term (4). Grid:
+  // 4 ranges of 4 B and the near-boundary flag per cell; with bodies their 2 ranges and near flag (9),
+  // with wall_density the wall-cell list's first size (4). Bodies' own particles: body frame, index and
+  // alpha (24), sorted world copies of position, velocity and force (48), keys, order and owner (12).
+  const int64_t perFluid = 68 + 8 + 28 + 8 + 4 + 68 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 4 : 0) +
+                           (counts.bodyParticles > 0 ? 4 : 0);
+  const int64_t perBoundary = 16 + 40 + 16 + (counts.wallDensity ? 4 : 0);
+  const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0);
+  return counts.fluid * perFluid + counts.boundary * perBoundary + counts.gridCells * perCell +
+         counts.bodyParticles * (24 + 48 + 12);
 }
 
 }  // namespace sphxr::sim

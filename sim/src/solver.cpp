@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <fstream>
 #include <cmath>
 #include <limits>
 
@@ -47,6 +48,14 @@ int64_t AvailableHostBytes() {
   struct rlimit limit;
   if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
     have = std::min<int64_t>(have, static_cast<int64_t>(limit.rlim_cur / 2));
+  }
+  // In a container the memory cgroup's limit is the real one (past it the OOM killer ends the process,
+  // instead of this friendly refusal): v2's memory.max ("max": none), v1's limit_in_bytes (a huge
+  // number: none). Three quarters of it, as of the physical memory.
+  for (const char* path : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(path);
+    long long bytes = 0;
+    if (in >> bytes && bytes > 0) have = std::min<int64_t>(have, bytes / 4 * 3);
   }
   return have;
 }
