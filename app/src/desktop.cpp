@@ -242,7 +242,7 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   if (Status s = LoadSceneWithOptions(options, &m.scene); !s) return s;
   m.setup = m.scene.setup;
   // A bad state file is one line before any window opens.
-  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), &m.setup, &m.start); !s) return s;
+  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), m.scene.name, &m.setup, &m.start); !s) return s;
 
   render::RendererConfig config;
   config.debug = config.debug || options.glDebug;

@@ -429,7 +429,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     return Status::Error("--settle and --load-state: the state file is the start; settle in the run that saves it");
   }
   std::shared_ptr<const StateFile> state;
-  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), &scene.setup, &state); !s) return s;
+  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), scene.name, &scene.setup, &state); !s) return s;
   {
     sim::SolverConfig probe;
     probe.device = options.device;

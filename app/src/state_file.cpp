@@ -315,8 +315,8 @@ bool RestorePaddles(const StateFile& state, const sim::Solver& solver, interacti
   return true;
 }
 
-Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSetup* setup,
-                      std::shared_ptr<const StateFile>* out) {
+Status ReadStartState(const std::string& path, float spacingOption, const std::string& sceneName,
+                      sim::SceneSetup* setup, std::shared_ptr<const StateFile>* out) {
   out->reset();
   if (path.empty()) return Status::Ok();
   auto state = std::make_shared<StateFile>();
@@ -325,6 +325,13 @@ Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSe
     return Status::Error(Format("--load-state %s: saved at spacing %g m; the command line asks for %g m, another "
                                 "particle count (another --spacing)",
                                 path.c_str(), state->spacing, spacingOption));
+  }
+  // Only the particle counts and the spacing must match (RestoreState): a renamed scene is still the
+  // same scene. Another name may be another scene of the same size, though, so it is said.
+  if (state->scene != sceneName) {
+    SPHXR_LOG_WARN("--load-state %s was saved from scene '%s', this scene is '%s': it is used if its particle counts "
+                   "and spacing match",
+                   path.c_str(), state->scene.c_str(), sceneName.c_str());
   }
   setup->params.spacing = state->spacing;
   *out = std::move(state);

@@ -244,7 +244,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   if (Status s = LoadSceneWithOptions(options, &app.scene); !s) return s;
   app.setup = app.scene.setup;
   // A bad state file is one line before the headset session starts.
-  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), &app.setup, &app.start); !s) return s;
+  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), app.scene.name, &app.setup, &app.start); !s) return s;
   app.offset = XrSceneOffset(app.setup.tank);
   app.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
 

@@ -688,6 +688,7 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
   ASSERT_TRUE(second.Exited() && second.Code() == 0) << second.err;
   EXPECT_NE(second.err.find("started from " + half), std::string::npos) << second.err;
   EXPECT_NE(second.err.find("the rows continue the earlier run's (its steps up to 90 kept)"), std::string::npos) << second.err;
+  EXPECT_EQ(second.err.find("was saved from scene"), std::string::npos) << "the same scene: " << second.err;
   EXPECT_NE(second.out.find("(from the state file)"), std::string::npos) << second.out;
   EXPECT_NE(second.out.find("of the whole run"), std::string::npos) << second.out;
   const Result through = RunBinary("--headless --time 0.04 --save-state " + Quote(whole) + " --stats " +
@@ -727,6 +728,17 @@ TEST(HeadlessTest, ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds) {
   EXPECT_EQ(names, namesWhole);
   EXPECT_TRUE(parts == partsWhole) << "the exports of the two halves differ from the whole run's";
   EXPECT_TRUE(frames == framesWhole) << "the frames of the two halves differ from the whole run's";
+
+  // A scene of another name with the same particles and spacing is used, and the name is said.
+  std::string renamedText = kSmallScene;
+  renamedText.replace(renamedText.find("headless_e2e"), 12, "renamed_tank");
+  const std::string renamed = dir.Write("renamed.json", renamedText);
+  const Result other = RunBinary("--headless --steps 2 --threads 1 --no-progress --load-state " + Quote(half) +
+                                     " --scene " + Quote(renamed),
+                                 dir);
+  ASSERT_TRUE(other.Exited() && other.Code() == 0) << other.err;
+  EXPECT_NE(other.err.find("was saved from scene 'headless_e2e', this scene is 'renamed_tank'"), std::string::npos)
+      << other.err;
 
   // Refusals.
   ExpectOneLineError(RunBinary("--headless --time 0.04 --settle 1 --load-state " + Quote(half) + common, dir),

@@ -56,9 +56,10 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
 /// version or byte order, a field this build does not have or lacks, truncated).
 Status ReadStateFile(const std::string& path, StateFile* out);
 /// `--load-state path` for every mode: reads the file, refuses a `spacingOption` (--spacing, 0 when not
-/// given) other than the file's, and sets `setup`'s spacing to the file's. An empty path reads nothing.
-Status ReadStartState(const std::string& path, float spacingOption, sim::SceneSetup* setup,
-                      std::shared_ptr<const StateFile>* out);
+/// given) other than the file's, warns when it was saved from a scene of another name than `sceneName`,
+/// and sets `setup`'s spacing to the file's. An empty path reads nothing.
+Status ReadStartState(const std::string& path, float spacingOption, const std::string& sceneName,
+                      sim::SceneSetup* setup, std::shared_ptr<const StateFile>* out);
 /// Checks that `state` fits `solver` (the same fluid and boundary counts and spacing: the same scene at
 /// the same spacing) and restores it (sim::Solver::Restore). With as many bodies as the file has, each
 /// body's whole motion is restored; with fewer or more (the window and --xr add hand paddles after the
