@@ -1,6 +1,7 @@
 #include "sphxr/app/export.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <cstring>
 #include <memory>
 #include <type_traits>
@@ -18,7 +19,12 @@ using File = std::unique_ptr<FILE, FileCloser>;
 Status Close(File* f, const std::string& path) {
   FILE* raw = f->release();
   const bool failed = std::ferror(raw) != 0;
-  if (std::fclose(raw) != 0 || failed) return Status::Error(path + ": write failed");
+  if (std::fclose(raw) != 0 || failed) {
+    // A truncated export would look like a real one: removed (a regular file only, never a device).
+    std::error_code ignored;
+    if (std::filesystem::is_regular_file(path, ignored)) std::filesystem::remove(path, ignored);
+    return Status::Error(path + ": write failed (disk full?); no partial file is left");
+  }
   return Status::Ok();
 }
 

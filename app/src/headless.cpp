@@ -134,6 +134,10 @@ Status CheckPlaceToWrite(const std::string& flag, const std::string& path, const
   if (std::filesystem::is_directory(file, ec)) {
     return Status::Error(flag + " " + path + ": is a directory; give a file name" + nameHint);
   }
+  // (These files are replaced whole: a device or a pipe there is not a place for them.)
+  if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec)) {
+    return Status::Error(flag + " " + path + ": not a regular file (a device or pipe); give a file name" + nameHint);
+  }
   if (!std::filesystem::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
     return Status::Error(flag + " " + path + ": cannot write into " + dir.string());
   }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -29,8 +30,23 @@ Status WritePng(const std::string& path, const render::Image& image) {
       dst[3 * x + 2] = src[4 * x + 2];
     }
   }
-  if (!stbi_write_png(path.c_str(), image.width, image.height, 3, rgb.data(), 3 * image.width)) {
-    return Status::Error(path + ": cannot write the PNG file (does the directory exist and is it writable?)");
+  // Encoded in memory and written by us: stbi_write_png does not check its writes, so a full disk left a
+  // truncated PNG and a success. A failed write removes the partial file.
+  std::string png;
+  auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data), static_cast<size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, rgb.data(), 3 * image.width)) {
+    return Status::Error(path + ": cannot encode the PNG image");
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return Status::Error(path + ": cannot write the PNG file (does the directory exist and is it writable?)");
+  out.write(png.data(), static_cast<std::streamsize>(png.size()));
+  out.close();
+  if (out.fail()) {
+    std::error_code ignored;
+    if (std::filesystem::is_regular_file(path, ignored)) std::filesystem::remove(path, ignored);  // (never a device)
+    return Status::Error(path + ": write failed (disk full?); no partial file is left");
   }
   return Status::Ok();
 }

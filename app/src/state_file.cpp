@@ -91,10 +91,26 @@ class Reader {
 
 Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
                       const interaction::PaddleSystem* paddles, double paddleClock, int64_t stepsBefore) {
+  // The file is written beside its place and renamed over it, which would replace whatever is there: a
+  // device or a pipe (--save-state /dev/null, as root, replaced the system's /dev/null) is refused, and
+  // a symbolic link is followed, so the link stays and its target gets the state.
+  std::error_code linkError;
+  std::string target = path;
+  if (std::filesystem::is_symlink(path, linkError)) {
+    const std::filesystem::path resolved = std::filesystem::canonical(path, linkError);
+    if (!linkError) target = resolved.string();
+  }
+  {
+    std::error_code ignored;
+    const auto st = std::filesystem::status(target, ignored);
+    if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
+      return Status::Error(path + ": not a regular file (a directory, device or pipe): a state file needs a file of its own");
+    }
+  }
   sim::HostFluid fluid;
   solver.Download(&fluid);
   const sim::SolverClock clock = solver.Clock();
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = target + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) return Status::Error(path + ": cannot open " + tmp + " for writing: " + std::strerror(errno));
@@ -163,7 +179,7 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     std::filesystem::remove(tmp, ec);
     return Status::Error(path + ": cannot sync " + tmp + " to the disk; an earlier file there is unchanged");
   }
-  std::filesystem::rename(tmp, path, ec);
+  std::filesystem::rename(tmp, target, ec);
   if (ec) {
     std::error_code ignored;
     std::filesystem::remove(tmp, ignored);

@@ -523,6 +523,8 @@ TEST(HeadlessTest, ExportThatCannotBeWrittenFailsTheRun) {
   ASSERT_TRUE(r.Exited());
   EXPECT_EQ(r.Code(), 1);
   EXPECT_NE(r.err.find("particles_000002.ply: write failed"), std::string::npos) << r.err;
+  EXPECT_TRUE(std::filesystem::is_symlink(out / "particles_000002.ply")) << "a device behind a failed export stays";
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/full"));
 }
 
 // The screenshot is written after the run; a place it cannot go is refused before the run costs anything.

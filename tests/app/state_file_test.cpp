@@ -3,6 +3,7 @@
 // run continues as the saved one would have: tests/sim/restore_test.cpp (the solver) and the headless
 // end-to-end test ARunContinuedFromItsStateFileEndsWhereTheWholeRunEnds.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -227,6 +228,30 @@ TEST(StateFile, AnotherSceneOrSpacingIsRefused) {
   EXPECT_NE(s.message().find("saved from 'small'"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("another scene"), std::string::npos) << s.message();
   EXPECT_EQ(coarser->Time(), 0.0) << "a refused state changes nothing";
+}
+
+// The file is renamed into place, which would replace whatever is there: a pipe or device is refused
+// and left alone (--save-state /dev/null, as root, replaced the system's /dev/null), and a symbolic link
+// is followed: the link stays, its target gets the state.
+TEST(StateFile, APipeIsRefusedAndALinkIsFollowed) {
+  test::TempDir dir("state_nodes");
+  auto solver = SteppedSolver(2);
+  ASSERT_TRUE(solver);
+  const std::string fifo = dir.File("pipe");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const Status s = WriteStateFile(fifo, *solver, "s");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("not a regular file"), std::string::npos) << s.message();
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo)) << "the pipe is still a pipe";
+
+  const std::string target = dir.File("target.state"), link = dir.File("link.state");
+  Put(target, "old");
+  std::filesystem::create_symlink(target, link);
+  ASSERT_TRUE(WriteStateFile(link, *solver, "s").ok());
+  EXPECT_TRUE(std::filesystem::is_symlink(link)) << "the link is kept";
+  StateFile state;
+  ASSERT_TRUE(ReadStateFile(target, &state).ok()) << "its target holds the state";
+  EXPECT_EQ(state.step, 2);
 }
 
 TEST(StateFile, AFailedWriteLeavesTheEarlierFile) {

@@ -147,6 +147,26 @@ TEST(HeadlessPicturesTest, FramesWritesOnePngPerFrameInterval) {
   EXPECT_NE(r.out.find("frames          3 PNG files"), std::string::npos) << r.out;
 }
 
+// A PNG that cannot be written whole is an error (stbi_write_png ignored its write errors: a full disk
+// left a truncated PNG and a success). /dev/full fails every write; it is not removed (not a regular
+// file), and a partial regular file would be.
+TEST(HeadlessPicturesTest, APngThatCannotBeWrittenWholeIsAnError) {
+  render::Image image;
+  image.width = 64;
+  image.height = 48;
+  image.rgba.assign(4 * 64 * 48, 200);
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const Status s = app::WritePng("/dev/full", image);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("write failed"), std::string::npos) << s.message();
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/full")) << "a device is never removed";
+  TempDir dir("png_ok");
+  ASSERT_TRUE(app::WritePng(dir.File("a.png"), image).ok());
+  render::Image back;
+  ASSERT_TRUE(app::ReadPng(dir.File("a.png"), &back).ok());
+  EXPECT_EQ(back.width, 64);
+}
+
 TEST(HeadlessPicturesTest, BadImageOptionsAreOneLineErrors) {
   TempDir dir("badimg");
   const std::string scene = dir.Write("small.json", kSmallScene);
