@@ -372,8 +372,53 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
   return Status::Ok();
 }
 
+namespace {
+
+// Two paths name the same file: the same inode when both exist (links, "./a" and "a"), else the same
+// absolute, normalised path.
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) return std::filesystem::equivalent(a, b, ec);
+  const auto ca = std::filesystem::weakly_canonical(a, ec);
+  const auto cb = std::filesystem::weakly_canonical(b, ec);
+  return !ec && ca == cb;
+}
+
+// An output that is one of the run's inputs, or another output, would be destroyed by it (a typo in
+// --stats wiped a state file that took minutes to settle): refused before anything runs. A state saved
+// over the one the run started from is allowed: it was read whole at the start, and is replaced
+// atomically (a checkpoint carried forward).
+Status CheckOutputsAreNotInputs(const Options& options, const SceneFile& scene) {
+  std::vector<std::pair<std::string, std::string>> inputs = {{"the scene", options.scenePath}};
+  if (!options.loadState.empty()) inputs.push_back({"--load-state", options.loadState});
+  for (const std::string& t : scene.inputs) inputs.push_back({"the trajectory", t});
+  const std::pair<const char*, std::string> outputs[] = {
+      {"--stats", options.statsPath}, {"--save-state", options.saveState}, {"--screenshot", options.screenshotPath}};
+  for (size_t k = 0; k < std::size(outputs); ++k) {
+    const auto& [flag, path] = outputs[k];
+    if (path.empty()) continue;
+    for (const auto& [what, input] : inputs) {
+      if (std::string(flag) == "--save-state" && what == "--load-state") continue;
+      if (SameFile(path, input)) {
+        return Status::Error(Format("%s %s is %s (%s): it would be overwritten; give another file", flag, path.c_str(),
+                                    what.c_str(), input.c_str()));
+      }
+    }
+    for (size_t j = 0; j < k; ++j) {
+      if (!outputs[j].second.empty() && SameFile(path, outputs[j].second)) {
+        return Status::Error(Format("%s %s is also %s's file: one would overwrite the other; give another file", flag,
+                                    path.c_str(), outputs[j].first));
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status LoadSceneWithOptions(const Options& options, SceneFile* scene) {
   if (Status s = LoadScene(options.scenePath, scene); !s) return s;
+  if (Status s = CheckOutputsAreNotInputs(options, *scene); !s) return s;
   // A preset from the command line replaces the scene's reuse parameters; --set reuse.* then overrides.
   if (!options.reusePreset.empty()) sim::ApplyReusePreset(options.reusePreset, &scene->setup.reuse);
   for (const std::string& set : options.sets) {

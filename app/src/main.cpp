@@ -28,8 +28,13 @@ int Main(int argc, char** argv) {
   }
   // A bad scene is one error, whatever the mode (a window failing on it is not "unavailable").
   {
+    // (Quietly: the mode loads it again and logs its warnings then, once.)
+    const sphxr::LogLevel level = sphxr::GetLogLevel();
+    sphxr::SetLogLevel(sphxr::LogLevel::kError);
     sphxr::app::SceneFile scene;
-    if (sphxr::Status s = sphxr::app::LoadSceneWithOptions(options, &scene); !s) {
+    const sphxr::Status s = sphxr::app::LoadSceneWithOptions(options, &scene);
+    sphxr::SetLogLevel(level);
+    if (!s) {
       std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
       return 1;
     }

@@ -377,6 +377,7 @@ class Reader {
         // Relative to the scene file's folder.
         std::filesystem::path file = p["trajectory"].get<std::string>();
         if (file.is_relative()) file = std::filesystem::path(m_out->path).parent_path() / file;
+        m_out->inputs.push_back(file.string());
         if (Status st = interaction::Trajectory::Load(file.string(), &d.trajectory); !st) {
           return Error(key + ".trajectory", st.message());
         }

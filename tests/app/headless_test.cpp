@@ -791,6 +791,42 @@ TEST(HeadlessTest, AStirredRunContinuedFromItsStateFileEndsWhereTheWholeRunEnds)
   EXPECT_TRUE(a == b) << "the continued stirred run's state differs from the whole run's";
 }
 
+// An output that is one of the run's inputs, or another output, is refused before the run, and the file
+// is left as it was (a typo in --stats wiped a state file). Saving over the state the run started from
+// is allowed: a checkpoint carried forward.
+TEST(HeadlessTest, OutputsThatAreInputsAreRefused) {
+  test::TempDir dir("outputs_inputs");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string common = " --threads 1 --no-progress --steps 2 --scene " + Quote(scene);
+  const std::string state = dir.File("a.state");
+  ASSERT_EQ(RunBinary("--headless --save-state " + Quote(state) + common, dir).Code(), 0);
+  const std::string sceneBytes = test::ReadFile(scene), stateBytes = test::ReadFile(state);
+  ExpectOneLineError(RunBinary("--headless --stats " + Quote(scene) + common, dir), "is the scene");
+  ExpectOneLineError(RunBinary("--headless --stats " + Quote(dir.path().string() + "/./scene.json") + common, dir),
+                     "is the scene");
+  ExpectOneLineError(RunBinary("--headless --load-state " + Quote(state) + " --stats " + Quote(state) + common, dir),
+                     "is --load-state");
+  const std::string csv = Quote(dir.File("x.csv"));
+  ExpectOneLineError(RunBinary("--headless --stats " + csv + " --screenshot " + csv + common, dir), "is also --stats's file");
+  EXPECT_EQ(test::ReadFile(scene), sceneBytes);
+  EXPECT_EQ(test::ReadFile(state), stateBytes);
+  // A paddle's trajectory (a copy of the stirring scene, which names its CSV relative to itself).
+  std::filesystem::copy_file(SPHXR_SCENES_DIR "/stir.json", dir.File("stir.json"));
+  std::filesystem::copy_file(SPHXR_SCENES_DIR "/stir_paddle.csv", dir.File("stir_paddle.csv"));
+  const std::string trajectory = test::ReadFile(dir.File("stir_paddle.csv"));
+  ExpectOneLineError(RunBinary("--headless --steps 1 --scene " + Quote(dir.File("stir.json")) + " --stats " +
+                                   Quote(dir.File("stir_paddle.csv")),
+                               dir),
+                     "is the trajectory");
+  EXPECT_EQ(test::ReadFile(dir.File("stir_paddle.csv")), trajectory);
+  // Carried forward in place: allowed, and the file is the longer run's.
+  const Result forward = RunBinary("--headless --load-state " + Quote(state) + " --save-state " + Quote(state) + common, dir);
+  ASSERT_EQ(forward.Code(), 0) << forward.err;
+  StateFile after;
+  ASSERT_TRUE(ReadStateFile(state, &after).ok());
+  EXPECT_EQ(after.step, 4);
+}
+
 // A signal during the settling stops it too, with the summary and the exit code of an interrupted run.
 TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
   test::TempDir dir("settle_interrupt");

@@ -42,6 +42,7 @@ struct SceneFile {
   double paddleFrameRate = 90.0;  // Hz: display frames at which the paddles get new targets
   std::optional<sim::SurfaceParams> surface;  // "surface" section (cell_size, iso_level, margin); absent: defaults
   std::vector<std::string> warnings;  // unknown keys, already logged
+  std::vector<std::string> inputs;    // the other files it read (paddle trajectories)
 };
 
 /// Parses `text` (the content of a scene file). `origin` names it in messages.
