@@ -228,7 +228,10 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   out->step = -1;  // version 1 has no step count
   if (version >= 2) {
     if (!r.Get(&out->step)) return truncated();
-    if (out->step < -1) return Status::Error(Format("%s: step count %lld: the file is damaged", path.c_str(), static_cast<long long>(out->step)));
+    // (Below -1, or past 1e15 steps, a thousand years of steps at 30 us: damage, e.g. a flipped high bit.)
+    if (out->step < -1 || out->step > 1000000000000000LL) {
+      return Status::Error(Format("%s: step count %lld: the file is damaged", path.c_str(), static_cast<long long>(out->step)));
+    }
   }
   if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return truncated();
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");

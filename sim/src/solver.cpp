@@ -565,10 +565,12 @@ SolverClock Solver::Clock() const {
 
 Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
   if (m_totals.steps != 0) return Status::Error("restore: only before the first step (it replaces the start)");
-  if (!std::isfinite(clock.time) || clock.time < 0.0 || !std::isfinite(clock.lastMaxSpeed) ||
+  // A clock past 1e9 s (32 years) is damage, not a run: there a step of ~1e-4 s no longer moves a double
+  // clock, and frame numbers computed from it overflow (a flipped exponent bit hung the headless runner).
+  if (!std::isfinite(clock.time) || clock.time < 0.0 || clock.time > 1e9 || !std::isfinite(clock.lastMaxSpeed) ||
       clock.lastMaxSpeed < 0.0f || !std::isfinite(clock.lastMaxAccel) || clock.lastMaxAccel < 0.0f) {
     return Status::Error(Format("restore: the clock (t = %g s, last max speed %g m/s, last max |a| %g m/s^2) must be "
-                                "finite and not negative",
+                                "finite, not negative, and t at most 1e9 s",
                                 clock.time, clock.lastMaxSpeed, clock.lastMaxAccel));
   }
   if (Status s = CheckFluidSizes(fluid, "restore"); !s) return s;

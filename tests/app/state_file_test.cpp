@@ -116,6 +116,11 @@ TEST(StateFile, DamagedAndForeignFilesAreRefusedByName) {
   Put(bad, other);
   ExpectRefused(bad, "step count -5");
   other = bytes;
+  const int64_t huge_step = int64_t{1} << 62;  // a flipped high bit
+  std::memcpy(&other[kStepAt], &huge_step, 8);
+  Put(bad, other);
+  ExpectRefused(bad, "step count 4611686018427387904");
+  other = bytes;
   std::reverse(&other[8], &other[12]);  // the byte-order mark as the other byte order writes it
   Put(bad, other);
   ExpectRefused(bad, "byte order");
