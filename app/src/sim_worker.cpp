@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 
@@ -365,8 +366,23 @@ std::unique_lock<std::mutex> SimWorker::LockSolver() {
   return std::unique_lock(m_solverMutex);
 }
 
+std::string DefaultStatePath(const std::string& sceneName) {
+  // The scene's name comes from a file that may be shared: only its letters, digits, '-', '_' and inner
+  // '.' make the file name (a name like "../x" or "/abs/x" saved outside the working directory).
+  std::string stem;
+  char previous = '\0';
+  for (char c : sceneName) {
+    const bool safe = std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ||
+                      (c == '.' && std::isalnum(static_cast<unsigned char>(previous)));
+    stem += safe ? c : '_';
+    previous = c;
+  }
+  if (stem.find_first_not_of('_') == std::string::npos) stem = "sphxr";
+  return stem + ".state";
+}
+
 std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::string& sceneName) {
-  const std::string path = !savePath.empty() ? savePath : (sceneName.empty() ? std::string("sphxr") : sceneName) + ".state";
+  const std::string path = !savePath.empty() ? savePath : DefaultStatePath(sceneName);
   Status s;
   double t = 0.0;
   {

@@ -44,6 +44,11 @@ SimScene SimSceneFromFile(const SceneFile& scene, std::initializer_list<int> han
 /// The default paddle for a hand: a blade on a handle, at most 10 cm wide, narrower in a small tank.
 interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand);
 
+/// "<scene name>.state" for a save without --save-state: the name's letters, digits, '-', '_' and a '.'
+/// after a letter or digit only (others become '_'), so a shared scene cannot name a path outside the
+/// working directory; "sphxr.state" for a name without any.
+std::string DefaultStatePath(const std::string& sceneName);
+
 class SimWorker {
  public:
   SimWorker(const sim::SolverConfig& config);

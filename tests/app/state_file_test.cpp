@@ -15,6 +15,7 @@
 
 #include "sphxr/app/state_file.h"
 #include "sphxr/interaction/paddle.h"
+#include "sim_worker.h"  // app/src: DefaultStatePath
 #include "support.h"
 
 namespace sphxr::app {
@@ -257,6 +258,18 @@ TEST(StateFile, APipeIsRefusedAndALinkIsFollowed) {
   StateFile state;
   ASSERT_TRUE(ReadStateFile(target, &state).ok()) << "its target holds the state";
   EXPECT_EQ(state.step, 2);
+}
+
+// Without --save-state the window and the headset save to "<scene name>.state": a scene's name from a
+// shared file must not name a path (it saved "../escape_dir/evil.state").
+TEST(StateFile, TheDefaultSaveNameStaysInTheWorkingDirectory) {
+  EXPECT_EQ(DefaultStatePath("dam_break"), "dam_break.state");
+  EXPECT_EQ(DefaultStatePath("deep tank v1.2"), "deep_tank_v1.2.state");
+  EXPECT_EQ(DefaultStatePath("../escape_dir/evil"), "___escape_dir_evil.state");
+  EXPECT_EQ(DefaultStatePath("/abs/x"), "_abs_x.state");
+  EXPECT_EQ(DefaultStatePath(""), "sphxr.state");
+  EXPECT_EQ(DefaultStatePath("/"), "sphxr.state");
+  EXPECT_EQ(DefaultStatePath(".."), "sphxr.state");
 }
 
 TEST(StateFile, AFailedWriteLeavesTheEarlierFile) {
