@@ -31,8 +31,9 @@ volatile std::sig_atomic_t g_interrupt = 0;
 
 extern "C" void OnInterrupt(int signal) { g_interrupt = signal; }
 
-/// SIGINT and SIGTERM set g_interrupt while a run steps; SA_RESETHAND makes a second signal act as if
-/// we had never caught the first (the process ends). The previous handlers come back afterwards.
+/// SIGINT, SIGTERM and SIGHUP (a closed terminal, a dropped ssh session: long runs are started that
+/// way) set g_interrupt while a run steps; SA_RESETHAND makes a second signal act as if we had never
+/// caught the first (the process ends). The previous handlers come back afterwards.
 class InterruptScope {
  public:
   InterruptScope() {
@@ -43,19 +44,22 @@ class InterruptScope {
     action.sa_flags = SA_RESETHAND;
     sigaction(SIGINT, nullptr, &m_int);
     sigaction(SIGTERM, nullptr, &m_term);
+    sigaction(SIGHUP, nullptr, &m_hup);
     // A signal ignored on entry (a background job of a script, nohup) stays ignored.
     if (m_int.sa_handler != SIG_IGN) sigaction(SIGINT, &action, nullptr);
     if (m_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &action, nullptr);
+    if (m_hup.sa_handler != SIG_IGN) sigaction(SIGHUP, &action, nullptr);
   }
   ~InterruptScope() {
     sigaction(SIGINT, &m_int, nullptr);
     sigaction(SIGTERM, &m_term, nullptr);
+    sigaction(SIGHUP, &m_hup, nullptr);
   }
   InterruptScope(const InterruptScope&) = delete;
   InterruptScope& operator=(const InterruptScope&) = delete;
 
  private:
-  struct sigaction m_int {}, m_term {};
+  struct sigaction m_int {}, m_term {}, m_hup {};
 };
 
 Status ParseDouble(const std::string& flag, const char* text, double lo, double hi, double* out) {
@@ -788,7 +792,9 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     const int64_t step = stepsBefore + solver->GetTotals().steps;
     progress.Finish();
     SPHXR_LOG_WARN("%s at step %lld (t = %.4f s): stopping; the summary and the files cover the run so far",
-                   summary->interrupted == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)",
+                   summary->interrupted == SIGINT    ? "interrupted (SIGINT)"
+                   : summary->interrupted == SIGHUP ? "hung up (SIGHUP: the terminal closed)"
+                                                    : "terminated (SIGTERM)",
                    static_cast<long long>(step), solver->Time());
     // The state reached is not lost: one more export at this step unless it was just written.
     if (options.exportEvery > 0 && step % options.exportEvery != 0) {
@@ -904,7 +910,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                 static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds, summary->settle.maxAccel);
   }
   if (summary->interrupted) {
-    std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n", summary->interrupted == SIGINT ? "SIGINT" : "SIGTERM",
+    std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n",
+                summary->interrupted == SIGINT ? "SIGINT" : summary->interrupted == SIGHUP ? "SIGHUP" : "SIGTERM",
                 summary->simulatedTime,
                 targetSteps > 0 ? Format("%lld steps", static_cast<long long>(targetSteps)).c_str()
                                 : Format("%.4g s", targetTime).c_str());

@@ -855,6 +855,9 @@ TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
 
 TEST(HeadlessTest, InterruptKeepsWholeRowsAndTheLastState) { InterruptRun(SIGINT, "SIGINT"); }
 TEST(HeadlessTest, TerminateKeepsWholeRowsAndTheLastState) { InterruptRun(SIGTERM, "SIGTERM"); }
+// A closed terminal or a dropped ssh session (long runs are started that way) is a stop too; before,
+// the default action killed the run mid-row with no state and no summary.
+TEST(HeadlessTest, HangUpKeepsWholeRowsAndTheLastState) { InterruptRun(SIGHUP, "SIGHUP"); }
 
 TEST(HeadlessTest, OutWithoutAnExportIsNamed) {
   test::TempDir dir("outonly");
