@@ -10,6 +10,7 @@
 
 #include "sphxr/app/param_registry.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/text_file.h"
 #include "sphxr/sim/solver.h"
 
 namespace sphxr::app {
@@ -411,13 +412,9 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
 }
 
 Status LoadScene(const std::string& path, SceneFile* out) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return Status::Error(path + ": is a directory, not a scene file");
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open the scene file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return ParseScene(buffer.str(), path, out);
+  std::string text;
+  if (Status s = ReadTextFile(path, "scene file", size_t{16} << 20, &text); !s) return s;  // 16 MiB
+  return ParseScene(text, path, out);
 }
 
 

@@ -7,6 +7,7 @@
 
 #include "pose_math.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/text_file.h"
 
 namespace sphxr::interaction {
 namespace {
@@ -103,11 +104,10 @@ Status Trajectory::Parse(const std::string& text, const std::string& origin, Tra
 }
 
 Status Trajectory::Load(const std::string& path, Trajectory* out) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open the trajectory file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return Parse(buffer.str(), path, out);
+  // 256 MiB: hours of a recorded hand at 90 Hz.
+  std::string text;
+  if (Status s = ReadTextFile(path, "trajectory file", size_t{256} << 20, &text); !s) return s;
+  return Parse(text, path, out);
 }
 
 HandInput Trajectory::Sample(double time) const {

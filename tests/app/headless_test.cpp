@@ -508,6 +508,22 @@ TEST(HeadlessTest, StatsThatCannotBeWrittenFailTheRun) {
   EXPECT_NE(r.err.find("--stats /dev/full: write failed"), std::string::npos) << r.err;
 }
 
+// A scene or trajectory "file" that never ends (/dev/zero) is refused at its size limit, in a moment,
+// instead of being read until the kernel kills the process; a directory as a trajectory is named so.
+TEST(HeadlessTest, EndlessOrDirectoryInputsFailCleanly) {
+  if (!std::filesystem::exists("/dev/zero")) GTEST_SKIP() << "no /dev/zero";
+  test::TempDir dir("endless");
+  ExpectOneLineError(RunBinary("--headless --steps 1 --scene /dev/zero", dir), "more than 16 MiB: not a scene file");
+  std::string stir = test::ReadFile(SPHXR_SCENES_DIR "/stir.json");
+  const size_t at = stir.find("stir_paddle.csv");
+  ASSERT_NE(at, std::string::npos);
+  const std::string endless = dir.Write("endless.json", std::string(stir).replace(at, 15, "/dev/zero"));
+  ExpectOneLineError(RunBinary("--headless --steps 1 --scene " + Quote(endless), dir),
+                     "more than 256 MiB: not a trajectory file");
+  const std::string directory = dir.Write("directory.json", std::string(stir).replace(at, 15, "."));
+  ExpectOneLineError(RunBinary("--headless --steps 1 --scene " + Quote(directory), dir), "is a directory");
+}
+
 // So must a particle export that does not reach the disk (a small file used to sit in stdio's buffer
 // past the error check, and fclose's failure was ignored).
 TEST(HeadlessTest, ExportThatCannotBeWrittenFailsTheRun) {

@@ -1,0 +1,26 @@
+#include "sphxr/common/text_file.h"
+
+#include <filesystem>
+#include <fstream>
+
+namespace sphxr {
+
+Status ReadTextFile(const std::string& path, const char* what, size_t maxBytes, std::string* out) {
+  out->clear();
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return Status::Error(path + ": is a directory, not a " + what);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(path + ": cannot open the " + what);
+  char buffer[65536];
+  while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
+    out->append(buffer, static_cast<size_t>(in.gcount()));
+    if (out->size() > maxBytes) {
+      out->clear();
+      return Status::Error(path + ": more than " + std::to_string(maxBytes >> 20) + " MiB: not a " + what);
+    }
+  }
+  if (in.bad()) return Status::Error(path + ": read failed");
+  return Status::Ok();
+}
+
+}  // namespace sphxr
