@@ -135,19 +135,28 @@ inline std::string CsvField(const std::string& s) {
 }
 
 /// Opens `path` (appending, or anew) and writes `header` first when the file is new or empty. Returns
-/// "" or the reason it cannot: appending to a file whose header is another one (an older bench's
-/// columns) is refused, since its rows would then sit under the wrong names.
+/// "" or the reason it cannot: a file that exists with another first line is refused either way, since
+/// appended rows would sit under the wrong names, and overwriting it would destroy something that is
+/// not this bench's table (a scene given by mistake).
+/// The reason `path` cannot take this bench's table ("" if it can): see OpenCsv. For a bench that writes
+/// its CSV at the end, to ask before minutes of measuring.
+inline std::string CsvRefusal(const std::string& path, const std::string& header) {
+  std::ifstream probe(path);
+  std::string first;
+  if (probe && std::getline(probe, first) && !first.empty() && first != header) {
+    return "--csv " + path + ": its first line is not this bench's header (another file, or an older version's "
+           "columns): give a new file";
+  }
+  return {};
+}
+
 inline std::string OpenCsv(const std::string& path, const std::string& header, bool append, std::ofstream* out) {
-  bool empty = true;
+  if (std::string why = CsvRefusal(path, header); !why.empty()) return why;
+  bool empty = true;  // (a file opened anew is)
   if (append) {
     std::ifstream probe(path);
     std::string first;
-    if (probe && std::getline(probe, first) && !first.empty()) {
-      empty = false;
-      if (first != header) {
-        return "--csv " + path + ": its header is not this bench's (other columns, an older version?): give a new file";
-      }
-    }
+    empty = !(probe && std::getline(probe, first) && !first.empty());
   }
   out->open(path, append ? std::ios::app : std::ios::trunc);
   if (!*out) return "--csv " + path + ": cannot open for writing";

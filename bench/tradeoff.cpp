@@ -276,6 +276,18 @@ int main(int argc, char** argv) {
     return 0;
   }
   SetLogLevel(LogLevel::kError);  // the soft stiffness warns about its sound speed: that is the point of the sweep
+  const std::string header =
+      "timestamp_utc,cpu_model,nproc,threads,load_avg_start,load_avg_end,mode,spacing_divisor,spacing_m,"
+      "stiffness_factor,stiffness_pa,sound_speed,fluid,boundary,steps,dt_clamped_steps,clamped_events,sim_time_s,"
+      "step_wall_s,loop_wall_s,wall_per_sim_s,front_rms_rel,front_max_rel,front_bias_rel,front_points,front_T_min,front_T_max,final_Z,"
+      "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_viscosity,cfl,"
+      "max_dt";
+  if (!args.csv.empty()) {  // before minutes of measuring
+    if (const std::string why = CsvRefusal(args.csv, header); !why.empty()) {
+      std::fprintf(stderr, "%s\n", why.c_str());
+      return 1;
+    }
+  }
 
   std::vector<Point> measured;
   if (!ReadFront(args.measurements, &measured)) {
@@ -343,12 +355,6 @@ int main(int argc, char** argv) {
 
   if (!args.csv.empty()) {
     std::ofstream csv;
-    const std::string header =
-        "timestamp_utc,cpu_model,nproc,threads,load_avg_start,load_avg_end,mode,spacing_divisor,spacing_m,"
-        "stiffness_factor,stiffness_pa,sound_speed,fluid,boundary,steps,dt_clamped_steps,clamped_events,sim_time_s,"
-        "step_wall_s,loop_wall_s,wall_per_sim_s,front_rms_rel,front_max_rel,front_bias_rel,front_points,front_T_min,front_T_max,final_Z,"
-        "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_viscosity,cfl,"
-        "max_dt";
     if (const std::string why = OpenCsv(args.csv, header, /*append=*/false, &csv); !why.empty()) {
       std::fprintf(stderr, "%s\n", why.c_str());
       return 1;
