@@ -71,7 +71,7 @@ const char* kUsage =
     "                          [--presets] [--unpaired]\n"
     "  --quick         off, the three presets and 2 more settings, to t = 0.1 s (a smoke run)\n"
     "  --threads N     CPU backend threads (default 0 = all cores)\n"
-    "  --csv FILE      write one row per run to FILE (overwritten)\n"
+    "  --csv FILE      write one row per run to FILE (overwritten; only a file with this bench's header)\n"
     "  --scene NAME    one of the two scenes only\n"
     "  --time T        simulated seconds per run (default 0.3 deep_tank, 0.5 dam_break_1m)\n"
     "  --presets       off and the three presets only (no sweep)\n"

@@ -53,7 +53,7 @@ const char* kUsage =
     "  --quick       2 configurations (a/14 and a/20, stiffness x1) to t = 0.05 s (a smoke run; the front error\n"
     "                then covers only the measured points with T <= 0.93, which the full sweep excludes)\n"
     "  --threads N   CPU backend threads (default 0 = all cores)\n"
-    "  --csv FILE    write one row per run to FILE (overwritten)\n"
+    "  --csv FILE    write one row per run to FILE (overwritten; only a file with this bench's header)\n"
     "  --scene FILE  dam-break scene (default " SPHXR_SCENES_DIR "/dam_break.json)\n"
     "  --data FILE   Martin & Moyce measurements (default " SPHXR_TEST_DATA_DIR "/martin_moyce_1952.csv)\n";
 
