@@ -638,9 +638,14 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     };
     if (Status s = solver->Settle(settle, &summary->settle, update); !s) return Status::Error("--settle: " + s.message());
     bar.Finish();
-    SPHXR_LOG_INFO("settled: %.4g s in %lld steps (%.1f s wall); largest |a| at the end %.3g m/s^2; the run starts here",
-                   summary->settle.time, static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds,
-                   summary->settle.maxAccel);
+    if (summary->settle.stopped) {
+      SPHXR_LOG_WARN("settle stopped early at %.4g of %g s (%lld steps): the water is not settled", summary->settle.time,
+                     settle, static_cast<long long>(summary->settle.steps));
+    } else {
+      SPHXR_LOG_INFO("settled: %.4g s in %lld steps (%.1f s wall); largest |a| at the end %.3g m/s^2; the run starts here",
+                     summary->settle.time, static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds,
+                     summary->settle.maxAccel);
+    }
   }
   Progress progress(showProgress);
   sim::HostFluid host;
@@ -809,6 +814,12 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       return Status::Error("--save-state " + s.message());
     }
     summary->stateSaved = options.saveState;
+    // The file does not record how it was made: a run from it skips the scene's settle as if it were done.
+    if (summary->settle.stopped) {
+      SPHXR_LOG_WARN("%s holds water whose settle was stopped at %.4g of %g s: a run from it starts from water that is "
+                     "not at rest (settle again without --load-state to have a settled start)",
+                     options.saveState.c_str(), summary->settle.time, settle);
+    }
   }
   if (stats.is_open()) {
     stats.close();  // the last rows leave the buffer here

@@ -849,8 +849,9 @@ TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
   const std::string scene = dir.Write("scene.json", kSmallScene);
   const std::string outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
   const pid_t pid = SpawnSphxr(
-      {"--headless", "--scene", scene, "--settle", "3600", "--steps", "5", "--threads", "1", "--no-progress"}, outPath,
-      errPath);
+      {"--headless", "--scene", scene, "--settle", "3600", "--steps", "5", "--threads", "1", "--no-progress",
+       "--save-state", dir.File("partly.state")},
+      outPath, errPath);
   ASSERT_GE(pid, 0);
   const auto start = std::chrono::steady_clock::now();
   while (test::ReadFile(errPath).find("settling:") == std::string::npos &&
@@ -867,6 +868,12 @@ TEST(HeadlessTest, InterruptDuringTheSettleStopsIt) {
   EXPECT_NE(stdoutText.find("energy minimisation before t = 0, stopped early"), std::string::npos) << stdoutText;
   EXPECT_NE(stdoutText.find("interrupted     by SIGTERM"), std::string::npos) << stdoutText;
   EXPECT_NE(stdoutText.find("steps           0 "), std::string::npos) << "no step of the run was taken:\n" << stdoutText;
+  // The water is saved (nothing is lost), and said to be unsettled: the file cannot say so itself, and a
+  // run from it skips the scene's settle.
+  EXPECT_NE(stderrText.find("settle stopped early at"), std::string::npos) << stderrText;
+  EXPECT_EQ(stderrText.find("settled:"), std::string::npos) << stderrText;
+  EXPECT_TRUE(std::filesystem::exists(dir.File("partly.state")));
+  EXPECT_NE(stderrText.find("partly.state holds water whose settle was stopped at"), std::string::npos) << stderrText;
 }
 
 TEST(HeadlessTest, InterruptKeepsWholeRowsAndTheLastState) { InterruptRun(SIGINT, "SIGINT"); }
