@@ -64,6 +64,12 @@ int Main(int argc, char** argv) {
       return 0;
     }
     SPHXR_LOG_WARN("%s: %s", why.c_str(), display ? "using the desktop window" : "running headless");
+    // The window goes on with the water the headset left (saved by RunXr); a headless run starts from the
+    // scene (its --time would count from the saved clock), and the file stays for --load-state.
+    if (display && !outcome.savedState.empty()) {
+      SPHXR_LOG_INFO("the window continues from the headset's water (%s)", outcome.savedState.c_str());
+      options.loadState = outcome.savedState;
+    }
     if (options.frameLimit > 0) options.frameLimit -= static_cast<int>(outcome.frames);
     options.mode = display ? Mode::kDesktop : Mode::kHeadless;
   }

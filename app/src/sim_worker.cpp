@@ -381,6 +381,11 @@ std::string DefaultStatePath(const std::string& sceneName) {
   return stem + ".state";
 }
 
+std::string LostStatePath(const std::string& sceneName) {
+  const std::string path = DefaultStatePath(sceneName);
+  return path.substr(0, path.size() - 6) + "-lost.state";
+}
+
 std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::string& sceneName) {
   const std::string path = !savePath.empty() ? savePath : DefaultStatePath(sceneName);
   Status s;

@@ -48,6 +48,9 @@ interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand
 /// after a letter or digit only (others become '_'), so a shared scene cannot name a path outside the
 /// working directory; "sphxr.state" for a name without any.
 std::string DefaultStatePath(const std::string& sceneName);
+/// "<scene name>-lost.state" (the same name rule): where a lost headset session's water goes when no
+/// --save-state was given, beside, not over, what the save button wrote.
+std::string LostStatePath(const std::string& sceneName);
 
 class SimWorker {
  public:

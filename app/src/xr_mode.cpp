@@ -388,6 +388,14 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     }
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  // A lost session must not lose the water stirred in it: saved (to --save-state's file, else
+  // "<scene>-lost.state"), and the window that takes over starts from it (main.cpp).
+  if (outcome->lost) {
+    const std::string path = !options.saveState.empty() ? options.saveState : LostStatePath(app.scene.name);
+    const uint64_t before = app.worker->SavesDone();
+    app.worker->SaveStateLogged(path, app.scene.name);
+    if (app.worker->SavesDone() > before) outcome->savedState = path;
+  }
   if (!options.screenshotPath.empty()) {
     if (lastMirror.width == 0) {
       SPHXR_LOG_WARN("--screenshot %s: no frame was drawn, no picture", options.screenshotPath.c_str());

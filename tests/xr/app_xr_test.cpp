@@ -17,7 +17,9 @@ struct AppRun {
 
 AppRun RunSphxr(const std::string& args, const std::filesystem::path& dir) {
   const std::filesystem::path output = dir / "sphxr_out.txt";
-  const std::string cmd = std::string(SPHXR_BINARY) + " " + args + " >" + output.string() + " 2>&1";
+  // In the test's own directory: files the program names itself (a lost session's state) land there.
+  const std::string cmd = "cd '" + std::filesystem::absolute(dir).string() + "' && " + std::string(SPHXR_BINARY) + " " +
+                          args + " >" + output.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
   AppRun r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -448,6 +450,12 @@ TEST(XrApp, SessionLostMidRunEndsCleanlyInTheDesktopWindow) {
             std::string::npos)
       << r.out;
   ExpectNoValidationErrors(headset);
+  // The water stirred in the headset is not lost: saved beside the save button's file, and the window
+  // continues from it.
+  const std::filesystem::path lost = headset.dir / "xr_test_tank-lost.state";
+  EXPECT_TRUE(std::filesystem::exists(lost)) << r.out;
+  EXPECT_NE(r.out.find("the window continues from the headset's water (xr_test_tank-lost.state)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("started from xr_test_tank-lost.state"), std::string::npos) << r.out;
   // Lost after the frame limit's worth of frames: nothing left to show, the program exits.
   SimHeadset again("app_lost_end");
   SetUpHeadset(again);

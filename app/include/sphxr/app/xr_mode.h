@@ -29,6 +29,7 @@ struct XrOutcome {
   bool started = false;    // a session was created
   bool fallback = false;   // the error is the headset's (no display, no runtime, no session): fall back
   bool lost = false;       // the session or instance was lost mid-run (fall back, or exit)
+  std::string savedState;  // lost: where the running water was saved (the window continues from it)
   int64_t frames = 0;      // frames whose update ran
   int64_t rendered = 0;    // frames with eyes drawn
   std::string message;     // how the session ended, one line
