@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <string_view>
 
 #include "sphxr/app/export.h"
 #include "sphxr/app/pictures.h"
@@ -64,8 +65,12 @@ class InterruptScope {
 
 Status ParseDouble(const std::string& flag, const char* text, double lo, double hi, double* out) {
   char* end = nullptr;
+  // Decimal only: strtod also reads hexadecimal ("0x10" was 16 s) and "inf".
+  const std::string_view t(text);
+  if (t.find_first_of("xXpP") != std::string_view::npos) return Status::Error(flag + " " + text + ": not a decimal number");
   const double v = std::strtod(text, &end);
-  if (!*text || *end != '\0' || !std::isfinite(v)) return Status::Error(flag + " " + text + ": not a number");
+  if (!*text || *end != '\0') return Status::Error(flag + " " + text + ": not a number");
+  if (!std::isfinite(v)) return Status::Error(flag + " " + text + ": not a finite number");
   if (v < lo || v > hi) return Status::Error(Format("%s %s: must be from %g to %g", flag.c_str(), text, lo, hi));
   *out = v;
   return Status::Ok();
@@ -83,20 +88,36 @@ Status ParseInt(const std::string& flag, const char* text, int64_t lo, int64_t h
   return Status::Ok();
 }
 
-/// A progress bar on a terminal, redrawn at most ten times a second.
+/// Progress of a long run: a bar redrawn in place on a terminal, or (`lines`: stderr is a log file, the
+/// default when it is not a terminal) one line a minute, so a run logged to a file is not silent for
+/// minutes. Both say how long is left, extrapolated from the wall time so far.
 class Progress {
  public:
-  explicit Progress(bool enabled, const char* label = "") : m_enabled(enabled), m_label(label) {}
+  explicit Progress(bool enabled, const char* label = "", bool lines = false)
+      : m_enabled(enabled), m_lines(lines && !enabled), m_label(label) {}
   void Update(double fraction, double simTime, int64_t steps, double msPerStep) {
-    if (!m_enabled) return;
+    if (!m_enabled && !m_lines) return;
     const auto now = std::chrono::steady_clock::now();
+    if (m_start == std::chrono::steady_clock::time_point{}) m_start = now;
+    if (m_lines) {
+      if (fraction >= 1.0 || now - m_last < std::chrono::seconds(60)) return;
+      if (m_last == std::chrono::steady_clock::time_point{}) {  // the first line a minute in, not at once
+        m_last = now;
+        return;
+      }
+      m_last = now;
+      SPHXR_LOG_INFO("%s%d %%: t = %.4f s, step %lld, %.2f ms/step%s", m_label, static_cast<int>(fraction * 100.0),
+                     simTime, static_cast<long long>(steps), msPerStep, Left(fraction, now).c_str());
+      return;
+    }
     if (fraction < 1.0 && now - m_last < std::chrono::milliseconds(100)) return;
     m_last = now;
     const int width = 30;
     const int filled = std::clamp(static_cast<int>(fraction * width), 0, width);
-    std::fprintf(stderr, "\r%s[%.*s%.*s] %3d%%  t = %.4f s  step %lld  %.2f ms/step ", m_label, filled,
+    std::fprintf(stderr, "\r%s[%.*s%.*s] %3d%%  t = %.4f s  step %lld  %.2f ms/step%s ", m_label, filled,
                  "##############################", width - filled, "                              ",
-                 static_cast<int>(fraction * 100.0), simTime, static_cast<long long>(steps), msPerStep);
+                 static_cast<int>(fraction * 100.0), simTime, static_cast<long long>(steps), msPerStep,
+                 fraction < 1.0 ? Left(fraction, now).c_str() : "");
     m_open = fraction < 1.0;
     if (!m_open) std::fprintf(stderr, "\n");
     std::fflush(stderr);
@@ -108,10 +129,21 @@ class Progress {
   }
 
  private:
+  // ", about 3 min left" once two seconds and a thousandth of the run have passed.
+  std::string Left(double fraction, std::chrono::steady_clock::time_point now) const {
+    const double elapsed = std::chrono::duration<double>(now - m_start).count();
+    if (elapsed < 2.0 || fraction < 1e-3) return {};
+    const double left = elapsed * (1.0 - fraction) / fraction;
+    if (left < 90.0) return Format(", about %.0f s left", left);
+    if (left < 5400.0) return Format(", about %.0f min left", left / 60.0);
+    return Format(", about %.1f h left", left / 3600.0);
+  }
+
   bool m_enabled;
+  bool m_lines;
   const char* m_label;
   bool m_open = false;
-  std::chrono::steady_clock::time_point m_last{};
+  std::chrono::steady_clock::time_point m_start{}, m_last{};
 };
 
 struct DamBreakMeasure {
@@ -216,6 +248,8 @@ std::string UsageText() {
          "  --export-surface-every K  write the water surface (HPMC mesh, the scene's \"surface\" section) every K\n"
          "                    steps to DIR as surface_NNNNNN.ply (binary, with normals) or .obj (--surface-format)\n"
          "  --stats FILE.csv  one CSV row per step (time, dt, speeds, density errors, probes)\n"
+         "  --progress, --no-progress  a progress bar with the time left, or none (default: the bar on a\n"
+         "                    terminal, a progress line a minute when stderr is a log file)\n"
          "  --validate        check every stage for non-finite values; stop at the first, naming it\n"
          "  --reuse on|off|accurate|balanced|fast\n"
          "                    activity-based reuse: on/off keeps the scene's \"reuse\" parameters, a preset\n"
@@ -620,6 +654,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
 
   const bool showProgress = options.progress == 1 || (options.progress == -1 && isatty(STDERR_FILENO));
+  const bool progressLines = options.progress == -1 && !showProgress;  // a log file: a line a minute
   // Ctrl-C/SIGTERM from here on stop the settling or the run after the step in progress.
   InterruptScope interruptScope;
   const double settle = options.loadState.empty() ? (options.settle >= 0.0 ? options.settle : scene.runSettle) : 0.0;
@@ -628,7 +663,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
   if (settle > 0.0) {
     SPHXR_LOG_INFO("settling: %g simulated s of energy minimisation (FIRE) before t = 0", settle);
-    Progress bar(showProgress, "settling ");
+    Progress bar(showProgress, "settling ", progressLines);
     const auto t0 = std::chrono::steady_clock::now();
     auto update = [&](double done) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -647,7 +682,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                      summary->settle.maxAccel);
     }
   }
-  Progress progress(showProgress);
+  Progress progress(showProgress, "", progressLines);
   sim::HostFluid host;
   auto exportNow = [&](int64_t step) -> Status {
     solver->Download(&host);

@@ -405,7 +405,13 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
   try {
     root = json::parse(text);
   } catch (const json::exception& e) {  // parse errors, and numbers too large for a double
-    return Status::Error(origin + ": not valid JSON: " + e.what());
+    // (The parser quotes the bytes it read last: a binary file given by mistake must not put raw control
+    // bytes on the terminal.)
+    std::string what = e.what();
+    for (char& c : what) {
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+    }
+    return Status::Error(origin + ": not valid JSON: " + what);
   }
   Reader reader(out);
   return reader.Parse(root);

@@ -20,6 +20,7 @@ namespace {
 
 // Gravity above this (about 100 g) only makes the force step condition shrink dt towards nothing.
 constexpr double kMaxGravity = 1000.0;
+constexpr double kMaxFluidSpeed = 1000.0;  // m/s of a fluid block's start velocity
 
 bool Finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 std::string Str(Vec3 v) { return Format("[%g, %g, %g]", v.x, v.y, v.z); }
@@ -141,6 +142,16 @@ Status ValidateScene(const SceneSetup& scene) {
     const std::string key = Format("fluid[%zu]", i);
     if (Status s = ValidateBox(scene.fluid[i].box, key); !s) return s;
     if (!Finite(scene.fluid[i].velocity)) return Status::Error(key + ".velocity must be three finite numbers");
+    {
+      // (Far past any water: at 1e30 m/s the first step's CFL limit collapsed with a message about
+      // instability, not about the key.)
+      const Vec3 v = scene.fluid[i].velocity;
+      const double speed = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+      if (speed > kMaxFluidSpeed) {
+        return Status::Error(Format("%s.velocity = %s has speed %g m/s: at most %g m/s is supported", key.c_str(),
+                                    Str(v).c_str(), speed, kMaxFluidSpeed));
+      }
+    }
     if (!Contains(scene.tank, scene.fluid[i].box, slack)) {
       return Status::Error(key + ": the block " + Str(scene.fluid[i].box.min) + " to " + Str(scene.fluid[i].box.max) +
                            " is not inside the tank " + Str(scene.tank.min) + " to " + Str(scene.tank.max));

@@ -172,14 +172,15 @@ TEST(CommandLineTest, RejectsBadValuesNamingTheFlag) {
   ExpectRejected({"--time", "abc"}, {"--time", "abc", "not a number"});
   ExpectRejected({"--time", "-1"}, {"--time"});
   ExpectRejected({"--time", "nan"}, {"--time"});
-  ExpectRejected({"--time", "inf"}, {"--time"});
+  ExpectRejected({"--time", "inf"}, {"--time", "not a finite number"});
   ExpectRejected({"--time", ""}, {"--time"});
   ExpectRejected({"--device", "gpu"}, {"--device", "gpu", "auto, cpu or cuda"});
   ExpectRejected({"--steps", "10", "--time", "1"}, {"--time", "--steps"});
   ExpectRejected({"--time", "1", "--steps", "10"}, {"--time", "--steps"});
   ExpectRejected({"--steps", "0"}, {"--steps"});
   ExpectRejected({"--settle", "-1"}, {"--settle", "0 to 3600"});
-  ExpectRejected({"--settle", "nan"}, {"--settle", "not a number"});
+  ExpectRejected({"--settle", "nan"}, {"--settle", "not a finite number"});
+  ExpectRejected({"--time", "0x10"}, {"--time", "not a decimal number"});  // strtod read it as 16 s
   ExpectRejected({"--load-state", ""}, {"--load-state", "file name"});
   ExpectRejected({"--save-state"}, {"--save-state", "missing value"});
   ExpectRejected({"--steps", "1e3"}, {"--steps"});

@@ -222,6 +222,26 @@ TEST(SceneFileTest, NumbersBeyondTheFloatRangeRefused) {
                 {"solver.stiffness", "beyond the range of a float"});
 }
 
+// A block's start velocity is bounded like gravity (1e30 m/s passed and the first step collapsed with
+// a message about instability, not about the key).
+TEST(SceneFileTest, AHugeBlockVelocityIsRefusedBySolver) {
+  const SceneFile scene = ParseOk(R"({ "tank": { "min": [0,0,0], "max": [0.2,0.2,0.2] },
+                                       "fluid": [ { "min": [0,0,0], "max": [0.1,0.1,0.1], "velocity": [1e30, 0, 0] } ] })");
+  std::unique_ptr<sim::Solver> solver;
+  const Status s = sim::Solver::Create(scene.setup, test::TestConfig(), &solver);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("fluid[0].velocity"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("at most 1000 m/s"), std::string::npos) << s.message();
+}
+
+// A binary file's bytes quoted by the JSON parser do not reach the terminal raw.
+TEST(SceneFileTest, ControlBytesInAParseErrorAreReplaced) {
+  SceneFile scene;
+  const Status s = ParseScene(std::string("{\"a\": \x01\x7f\x1b[31m"), "bin.json", &scene);
+  ASSERT_FALSE(s.ok());
+  for (char c : s.message()) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f) << s.message();
+}
+
 TEST(SceneFileTest, HugeIntegerBoundaryLayersRefused) {
   ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "boundary_layers": 4294967297 } })",
                 {"tank.boundary_layers"});
