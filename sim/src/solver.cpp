@@ -221,6 +221,19 @@ Status ValidateScene(const SceneSetup& scene) {
 
 // Settings that run but will not give usable water are named at start-up, once.
 void WarnAboutSettings(const SceneSetup& scene, float soundSpeed) {
+  // Fluid is not seeded inside the moving bodies at their start poses: say how much that leaves out (a
+  // paddle larger than the water removed 1,484 of 1,575 particles without a word).
+  if (!scene.bodies.empty()) {
+    SceneSetup without = scene;
+    without.bodies.clear();
+    const int64_t all = SampleFluid(without, nullptr), seeded = SampleFluid(scene, nullptr);
+    if (seeded < all) {
+      const bool most = 2 * seeded < all;
+      Log(most ? LogLevel::kWarn : LogLevel::kInfo,
+          "the paddles at their start poses leave %lld of the %lld fluid lattice sites empty%s",
+          static_cast<long long>(all - seeded), static_cast<long long>(all), most ? ": most of the water" : "");
+    }
+  }
   const float g = Length(scene.gravity);
   float height = 0.0f;
   for (const FluidBlock& b : scene.fluid) height = std::max(height, b.box.max.y - scene.tank.min.y);

@@ -26,6 +26,27 @@ SceneSetup PaddleScene(float y) {
   return scene;
 }
 
+// Fluid is not seeded inside a body at its start pose; how much that leaves out is said at creation.
+// Independent count: the fluid of the same scene without the body.
+TEST(BodyMotion, TheFluidABodyDisplacesAtItsStartIsSaid) {
+  SceneSetup inWater = PaddleScene(0.03f);
+  SceneSetup without = inWater;
+  without.bodies.clear();
+  test::LogCapture log;
+  auto a = test::CreateOrFail(without);
+  auto b = test::CreateOrFail(inWater);
+  ASSERT_TRUE(a && b);
+  const int displaced = a->FluidCount() - b->FluidCount();
+  ASSERT_GT(displaced, 0);
+  EXPECT_EQ(log.Count("the paddles at their start poses leave " + std::to_string(displaced) + " of the " +
+                      std::to_string(a->FluidCount()) + " fluid lattice sites empty"),
+            1)
+      << log.All();
+  test::LogCapture quiet;
+  ASSERT_TRUE(test::CreateOrFail(PaddleScene(0.15f)));  // above the water: nothing to say
+  EXPECT_EQ(quiet.Count("lattice sites empty"), 0) << quiet.All();
+}
+
 TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
   const SceneSetup scene = PaddleScene(0.15f);  // the paddle above the water
   auto solver = test::CreateOrFail(scene);
