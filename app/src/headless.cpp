@@ -49,7 +49,11 @@ class InterruptScope {
     // A signal ignored on entry (a background job of a script, nohup) stays ignored.
     if (m_int.sa_handler != SIG_IGN) sigaction(SIGINT, &action, nullptr);
     if (m_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &action, nullptr);
-    if (m_hup.sa_handler != SIG_IGN) sigaction(SIGHUP, &action, nullptr);
+    // SIGHUP without the one-shot reset: a closing terminal's shell and kernel may send it twice in a
+    // moment, and the second must not end the run before its state is saved.
+    struct sigaction hangUp = action;
+    hangUp.sa_flags = 0;
+    if (m_hup.sa_handler != SIG_IGN) sigaction(SIGHUP, &hangUp, nullptr);
   }
   ~InterruptScope() {
     sigaction(SIGINT, &m_int, nullptr);
@@ -180,30 +184,36 @@ Status CheckPlaceToWrite(const std::string& flag, const std::string& path, const
   return Status::Ok();
 }
 
-/// What `--stats` keeps of an earlier file when a run continues from a state saved at step
-/// `stepsBefore`: the header and the rows up to that step, when the file has this run's header and a
-/// row for that step (it is the first half's CSV); else nothing, and the file is written anew.
-/// `*dropped` counts the rows after that step (a second half run before).
-std::string StatsRowsToKeep(const std::string& path, const std::string& header, int64_t stepsBefore, int64_t* dropped) {
+/// How much of an earlier `--stats` file a run continued from a state saved at step `stepsBefore`
+/// keeps: the bytes of the header and the rows up to that step, when it is a regular file with this
+/// run's header, rows in step order and a row for that step (the first half's CSV); else -1, and the
+/// file is written anew. `*dropped` counts the rows after that step (a second half run before).
+int64_t StatsBytesToKeep(const std::string& path, const std::string& header, int64_t stepsBefore, int64_t* dropped) {
   *dropped = 0;
-  if (stepsBefore <= 0) return {};
+  std::error_code ec;
+  if (stepsBefore <= 0 || !std::filesystem::is_regular_file(path, ec)) return -1;  // never read a pipe or device
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  if (!in || !std::getline(in, line) || line != header) return {};
-  std::string keep = header + "\n";
+  if (!in || !std::getline(in, line) || line != header || in.eof()) return -1;
+  int64_t keep = static_cast<int64_t>(line.size()) + 1, at = keep;
   bool found = false;
+  long long previous = 0;
   while (std::getline(in, line)) {
+    const bool whole = !in.eof();  // ended by '\n' (a torn last row is not)
     char* end = nullptr;
     const long long step = std::strtoll(line.c_str(), &end, 10);
-    if (end == line.c_str() || *end != ',') return {};  // not one of our rows
+    if (end == line.c_str() || *end != ',' || step <= previous) return -1;  // not our rows, or not in order
+    previous = step;
+    at += static_cast<int64_t>(line.size()) + (whole ? 1 : 0);
     if (step <= stepsBefore) {
-      keep += line + "\n";
+      if (!whole) return -1;
+      keep = at;
       found = step == stepsBefore;
     } else {
       ++*dropped;
     }
   }
-  return found ? keep : std::string();
+  return found ? keep : -1;
 }
 
 }  // namespace
@@ -417,8 +427,8 @@ namespace {
 bool SameFile(const std::string& a, const std::string& b) {
   std::error_code ec;
   if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) return std::filesystem::equivalent(a, b, ec);
-  const auto ca = std::filesystem::weakly_canonical(a, ec);
-  const auto cb = std::filesystem::weakly_canonical(b, ec);
+  const auto ca = std::filesystem::weakly_canonical(std::filesystem::absolute(a, ec), ec);
+  const auto cb = std::filesystem::weakly_canonical(std::filesystem::absolute(b, ec), ec);
   return !ec && ca == cb;
 }
 
@@ -637,18 +647,26 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       header += ",pushed_out";
       for (int k = 0; k < paddles->Count(); ++k) header += Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
     }
-    // A continued run appends to the first half's CSV: the whole run's rows in one file.
-    stats.close();
+    // A continued run appends to the first half's CSV: the whole run's rows in one file. The first half's
+    // rows are never rewritten: later rows (of an earlier continuation) are cut off, then rows appended.
+    // A pipe or device is written as it was opened (never read back, never reopened).
     int64_t dropped = 0;
-    const std::string keep = StatsRowsToKeep(options.statsPath, header, stepsBefore, &dropped);
-    stats.open(options.statsPath, std::ios::trunc);
-    if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
-    if (!keep.empty()) {
-      stats << keep;
+    const int64_t keep = StatsBytesToKeep(options.statsPath, header, stepsBefore, &dropped);
+    std::error_code ec;
+    if (keep >= 0) {
+      stats.close();
+      if (dropped > 0) std::filesystem::resize_file(options.statsPath, static_cast<uintmax_t>(keep), ec);
+      if (!ec) stats.open(options.statsPath, std::ios::app);
+      if (ec || !stats) return Status::Error("--stats " + options.statsPath + ": cannot continue the file: " + ec.message());
       SPHXR_LOG_INFO("--stats %s: the rows continue the earlier run's (its steps up to %lld kept%s)",
                      options.statsPath.c_str(), static_cast<long long>(stepsBefore),
                      dropped > 0 ? Format(", %lld rows after it replaced", static_cast<long long>(dropped)).c_str() : "");
     } else {
+      if (std::filesystem::is_regular_file(options.statsPath, ec)) {
+        stats.close();
+        stats.open(options.statsPath, std::ios::trunc);
+        if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
+      }
       stats << header << "\n";
     }
   }

@@ -3,6 +3,8 @@
 // one line saying why: no runtime -> the desktop window; no window -> headless; a session lost mid-run ->
 // the desktop window (or exit when there is no display or the --frame-limit is reached).
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <exception>
 #include <new>
 #include <string>
@@ -27,7 +29,9 @@ int Main(int argc, char** argv) {
     return 0;
   }
   // A bad scene is one error, whatever the mode (a window failing on it is not "unavailable").
-  {
+  // (Only a regular file: a pipe, --scene /dev/stdin, can be read once, by the mode.)
+  std::error_code regularError;
+  if (std::filesystem::is_regular_file(options.scenePath, regularError)) {
     // (Quietly: the mode loads it again and logs its warnings then, once.)
     const sphxr::LogLevel level = sphxr::GetLogLevel();
     sphxr::SetLogLevel(sphxr::LogLevel::kError);
@@ -49,6 +53,7 @@ int Main(int argc, char** argv) {
   if (options.mode == Mode::kAuto && sphxr::app::DisplayAvailable() && sphxr::app::XrRuntimeAvailable(nullptr)) {
     options.mode = Mode::kXr;
   }
+  std::optional<std::string> lostStateFor;  // set when the window takes over a lost headset's water
   if (options.mode == Mode::kXr) {
     sphxr::app::XrOutcome outcome;
     const sphxr::Status s = sphxr::app::RunXr(options, &outcome);
@@ -68,6 +73,7 @@ int Main(int argc, char** argv) {
     // scene (its --time would count from the saved clock), and the file stays for --load-state.
     if (display && !outcome.savedState.empty()) {
       SPHXR_LOG_INFO("the window continues from the headset's water (%s)", outcome.savedState.c_str());
+      lostStateFor.emplace(options.loadState);  // what a headless fallback goes back to
       options.loadState = outcome.savedState;
     }
     if (options.frameLimit > 0) options.frameLimit -= static_cast<int>(outcome.frames);
@@ -90,6 +96,9 @@ int Main(int argc, char** argv) {
     if (s) return 0;
     SPHXR_LOG_WARN("desktop window unavailable (%s): running headless", s.message().c_str());
     options.mode = Mode::kHeadless;
+    // A headless run starts from the scene (or the user's --load-state), not from a lost headset's water:
+    // its --time and --settle mean the scene's run; the saved file stays for --load-state.
+    if (lostStateFor) options.loadState = *lostStateFor;
   }
   sphxr::app::RunSummary summary;
   sphxr::Status run = sphxr::app::RunHeadless(options, &summary);
