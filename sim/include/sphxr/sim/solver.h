@@ -97,7 +97,8 @@ class Solver {
 
   /// Advances one time step. Fails when a fluid particle became non-finite (validate mode names the stage
   /// and particle; without it the step's reduction counts them), or when the time step collapses. A
-  /// failed step leaves the clock and the statistics where they were; the fluid is not rolled back.
+  /// failed step leaves the clock and the statistics where they were; the fluid and the bodies are not
+  /// rolled back (the caller stops).
   Status Step();
 
   /// Relaxes the water toward a rest state before a run (docs/physics.md, "Tenth session"): `seconds`
