@@ -53,7 +53,17 @@ int64_t AvailableHostBytes() {
   // In a container the memory cgroup's limit is the real one (past it the OOM killer ends the process,
   // instead of this friendly refusal): v2's memory.max ("max": none), v1's limit_in_bytes (a huge
   // number: none). Three quarters of it, as of the physical memory.
-  for (const char* path : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+  // (v2: also the process's own cgroup, from /proc/self/cgroup's "0::/path": systemd and batch
+  // schedulers set the limit there, not at the root.)
+  std::vector<std::string> limits = {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"};
+  {
+    std::ifstream cgroup("/proc/self/cgroup");
+    std::string line;
+    while (std::getline(cgroup, line)) {
+      if (line.rfind("0::/", 0) == 0 && line.size() > 4) limits.push_back("/sys/fs/cgroup" + line.substr(3) + "/memory.max");
+    }
+  }
+  for (const std::string& path : limits) {
     std::ifstream in(path);
     long long bytes = 0;
     if (in >> bytes && bytes > 0) have = std::min<int64_t>(have, bytes / 4 * 3);

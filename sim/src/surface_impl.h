@@ -77,7 +77,7 @@ class SurfaceImpl final : public SurfaceExtractor {
     }
     // In double, and checked before any cast: bounds that are not finite numbers give no lattice.
     const double samples = extent[0] * extent[1] * extent[2];
-    if (!(samples >= 1.0)) {
+    if (!(extent[0] >= 1.0 && extent[1] >= 1.0 && extent[2] >= 1.0)) {  // (each axis: two inverted ones multiply to > 0)
       return Status::Error("surface: the particles' bounding box is not finite (a non-finite position?)");
     }
     if (samples > static_cast<double>(job.maxSamples)) {
