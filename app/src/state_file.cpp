@@ -49,11 +49,11 @@ class Writer {
 // A paddle's restart state is used as it is (nothing downstream checks it, unlike a body's motion, which
 // Solver::SetBodyMotion does): a NaN here would become the paddle's target pose, or the controller's
 // buzz amplitude.
-bool Finite(sim::Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool Sound(const interaction::PaddleRestart& p) {
+  using sim::Finite;
   const interaction::Quat& q = p.state.commanded.orientation;
-  return Finite(p.state.commanded.position) && std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) &&
-         std::isfinite(q.z) && Finite(p.state.force) && Finite(p.state.torque) && Finite(p.state.rawForce) &&
+  return Finite(p.state.commanded.position) && Finite(sim::Quat{q.w, q.x, q.y, q.z}) && Finite(p.state.force) &&
+         Finite(p.state.torque) && Finite(p.state.rawForce) &&
          p.state.haptic >= 0.0f && p.state.haptic <= 1.0f && p.state.teleports >= 0 && std::isfinite(p.lostSince) &&
          std::isfinite(p.lastFrame);
 }

@@ -22,7 +22,6 @@ namespace {
 constexpr double kMaxGravity = 1000.0;
 constexpr double kMaxFluidSpeed = 1000.0;  // m/s of a fluid block's start velocity
 
-bool Finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 std::string Str(Vec3 v) { return Format("[%g, %g, %g]", v.x, v.y, v.z); }
 
 Status ValidateBox(const Aabb& b, const std::string& key) {
@@ -85,7 +84,6 @@ Status ValidateReuse(const ReuseParams& r) {
   return Status::Ok();
 }
 
-bool Finite(Quat q) { return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z); }
 
 Status ValidateBodies(const SceneSetup& scene) {
   if (scene.bodies.size() > 64) return Status::Error(Format("%zu moving bodies: at most 64", scene.bodies.size()));

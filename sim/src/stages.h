@@ -649,11 +649,6 @@ struct StepReduction {
   int32_t nonFinite = 0; // fluid particles with a NaN or infinite position, velocity, acceleration or density
 };
 
-/// x is neither NaN nor infinite (x - x is NaN for both). Written out because the max reductions
-/// below drop NaN (fmaxf(x, NaN) = x): a NaN particle would otherwise never show in the step's
-/// statistics. (No fast-math flags are used, so the compiler may not fold this to true.)
-SPHXR_HD SPHXR_INLINE bool FiniteValue(float x) { return x - x == 0.0f; }
-
 struct StepReductionOp {
   FluidView fluid;
   float invRestDensity;
@@ -662,9 +657,8 @@ struct StepReductionOp {
     const Vec4 v = fluid.velocity[i];
     const Vec4 a = fluid.acceleration[i];
     const Vec4 x = fluid.position[i];
-    const bool finite = FiniteValue(x.x) && FiniteValue(x.y) && FiniteValue(x.z) && FiniteValue(v.x) &&
-                        FiniteValue(v.y) && FiniteValue(v.z) && FiniteValue(a.x) && FiniteValue(a.y) &&
-                        FiniteValue(a.z) && FiniteValue(fluid.density[i]);
+    // (The maxima below drop NaN, fmaxf(x, NaN) = x: without this count a NaN particle would never show.)
+    const bool finite = Finite(Xyz(x)) && Finite(Xyz(v)) && Finite(Xyz(a)) && IsFinite(fluid.density[i]);
     r.nonFinite = finite ? 0 : 1;
     r.maxSpeed2 = v.x * v.x + v.y * v.y + v.z * v.z;
     r.maxAccel2 = a.x * a.x + a.y * a.y + a.z * a.z;

@@ -15,6 +15,7 @@ struct Quat {
   float w = 1, x = 0, y = 0, z = 0;
 };
 
+SPHXR_HD SPHXR_INLINE bool Finite(Quat q) { return IsFinite(q.w) && IsFinite(q.x) && IsFinite(q.y) && IsFinite(q.z); }
 SPHXR_HD SPHXR_INLINE Quat Mul(Quat a, Quat b) {
   return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
           a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};

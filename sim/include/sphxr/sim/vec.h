@@ -38,6 +38,11 @@ SPHXR_HD SPHXR_INLINE Vec3 Cross(Vec3 a, Vec3 b) {
 }
 SPHXR_HD SPHXR_INLINE float Length(Vec3 a) { return sqrtf(Dot(a, a)); }
 SPHXR_HD SPHXR_INLINE Vec3 Xyz(Vec4 a) { return {a.x, a.y, a.z}; }
+
+/// x is neither NaN nor infinite (x - x is NaN for both). Written out so that it is the same function on
+/// the host and the device (no fast-math flags are used, so the compiler may not fold it to true).
+SPHXR_HD SPHXR_INLINE bool IsFinite(float x) { return x - x == 0.0f; }
+SPHXR_HD SPHXR_INLINE bool Finite(Vec3 v) { return IsFinite(v.x) && IsFinite(v.y) && IsFinite(v.z); }
 SPHXR_HD SPHXR_INLINE Vec4 MakeVec4(Vec3 a, float w = 0.0f) { return {a.x, a.y, a.z, w}; }
 
 }  // namespace sphxr::sim
