@@ -134,30 +134,28 @@ inline std::string CsvField(const std::string& s) {
   return out + "\"";
 }
 
-/// Opens `path` (appending, or anew) and writes `header` first when the file is new or empty. Returns
-/// "" or the reason it cannot: a file that exists with another first line is refused either way, since
-/// appended rows would sit under the wrong names, and overwriting it would destroy something that is
-/// not this bench's table (a scene given by mistake).
 /// The reason `path` cannot take this bench's table ("" if it can): see OpenCsv. For a bench that writes
-/// its CSV at the end, to ask before minutes of measuring.
-inline std::string CsvRefusal(const std::string& path, const std::string& header) {
+/// its CSV at the end, to ask before minutes of measuring. `*empty`: the file is missing or empty.
+inline std::string CsvRefusal(const std::string& path, const std::string& header, bool* empty = nullptr) {
   std::ifstream probe(path);
   std::string first;
-  if (probe && std::getline(probe, first) && !first.empty() && first != header) {
+  if (probe) std::getline(probe, first);
+  if (empty) *empty = first.empty();
+  if (!first.empty() && first != header) {
     return "--csv " + path + ": its first line is not this bench's header (another file, or an older version's "
            "columns): give a new file";
   }
   return {};
 }
 
+/// Opens `path` (appending, or anew) and writes `header` first when the file is new or empty. Returns
+/// "" or the reason it cannot: a file that exists with another first line is refused either way, since
+/// appended rows would sit under the wrong names, and overwriting it would destroy something that is
+/// not this bench's table (a scene given by mistake).
 inline std::string OpenCsv(const std::string& path, const std::string& header, bool append, std::ofstream* out) {
-  if (std::string why = CsvRefusal(path, header); !why.empty()) return why;
-  bool empty = true;  // (a file opened anew is)
-  if (append) {
-    std::ifstream probe(path);
-    std::string first;
-    empty = !(probe && std::getline(probe, first) && !first.empty());
-  }
+  bool empty = true;
+  if (std::string why = CsvRefusal(path, header, &empty); !why.empty()) return why;
+  empty = empty || !append;  // (a file opened anew is)
   out->open(path, append ? std::ios::app : std::ios::trunc);
   if (!*out) return "--csv " + path + ": cannot open for writing";
   if (empty) *out << header << '\n';
