@@ -110,8 +110,11 @@ TEST(XrBindings, EveryProfileBindsGripTriggerAndHapticsOnBothHandsAndSaveOnAFree
                              : p.find("microsoft") != std::string::npos ? "/input/thumbstick/click"
                                                                           : "";
     EXPECT_EQ(save, want) << p;
-    for (const auto& b : SuggestedBindings())
-      if (b.profile == p && b.action != ActionId::kSaveState && (b.hands & kRightHand)) EXPECT_NE(std::string(b.suffix), save) << p;
+    for (const auto& b : SuggestedBindings()) {
+      if (b.profile == p && b.action != ActionId::kSaveState && (b.hands & kRightHand)) {
+        EXPECT_NE(std::string(b.suffix), save) << p;
+      }
+    }
   }
 }
 
