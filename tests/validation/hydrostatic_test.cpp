@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -184,7 +185,7 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   const float depthTotal = static_cast<float>(layers.depthSum / layers.samples);
   int checked = 0;
   double slopeNum = 0.0, slopeDen = 0.0;  // least-squares slope of p against depth, through the origin
-  float lowest = 0.0f, highest = 0.0f;      // relative deviations of the compared layers
+  float lowest = std::numeric_limits<float>::infinity(), highest = -lowest;  // relative deviations of the compared layers
   for (const auto& [layer, mean] : layers.byLayer) {
     const float depth = (static_cast<float>(layer) + 0.5f) * dx;
     // Layers present in every sample, with at least 20 particles on average.
