@@ -21,6 +21,7 @@ struct OmpTraits {
   using DensityBlockStart = sim::DensityBlockStart;
   using DensityBlockStage = sim::DensityBlockStage;
   using ForceListStage = sim::ForceListStage;
+  using WallPressureBlockStage = sim::WallPressureBlockStage;
 };
 
 }  // namespace

@@ -155,8 +155,13 @@ class BackendImpl final : public Backend {
 
     // 3c. the walls' own pressure
     if (physics.wallDensity && !m_wallCells.empty()) {
-      thrust::for_each_n(policy, first, static_cast<int>(m_wallCells.size()),
-                         WallPressureStage{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)});
+      const WallPressureStage wallPressure{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)};
+      const int wallCells = static_cast<int>(m_wallCells.size());
+      if constexpr (Traits::kSimdStages) {  // the CPU: 16 wall particles of a cell at once (cpu_stages.h)
+        thrust::for_each_n(policy, first, wallCells, typename Traits::WallPressureBlockStage{wallPressure});
+      } else {
+        thrust::for_each_n(policy, first, wallCells, wallPressure);
+      }
     }
     // 4. density and pressure. The CPU runs it in cell blocks (cpu_stages.h), with reuse masking the
     // lanes that reuse; CUDA a thread per particle (over the compacted list with reuse).

@@ -203,12 +203,6 @@ inline Lanes16 Gather16(const float* base, LaneInts16 index) {
 #endif
 }
 
-/// fmaxf and fminf are library calls without -ffast-math (6 % of a step on the AVX2 EPYC, most of it the
-/// density blocks' extents). These are inline, and give the same values here: where fmaxf(x, 0) takes 0
-/// for a NaN x (a NaN position), so does Max(x, 0); the other operands are never NaN.
-inline float Max(float a, float b) { return a > b ? a : b; }
-inline float Min(float a, float b) { return a < b ? a : b; }
-
 /// The sum of the 16 lanes, in lane order.
 inline float Sum16(Lanes16 v) {
   float s = 0.0f;
@@ -257,9 +251,102 @@ struct DensityBlockStart {
   }
 };
 
+/// The cells around a block of lanes whose particles lie in one box of cells (x0..x1, cy, cz) of the
+/// grid: the box's 27 (one cell) or 36 (a pair) neighbour cells, less those no lane can reach. Each
+/// lane's position, clamped to the box (as ForEachInCells clamps to a particle's cell), widens the
+/// block's extent per axis; a cell a cell size (>= the support) or more from that extent holds no
+/// particle within any lane's support. The cells are visited in ForEachInCells' order (z, y, x), so
+/// each lane meets its candidates in the order its own scan would.
+struct BlockCells {
+  const GridView* g;
+  int x0, x1, cy, cz;
+  float origin[3], extent[3], lo[3], hi[3];
+
+  BlockCells(const GridView& grid, int boxX0, int boxX1, int boxY, int boxZ)
+      : g(&grid), x0(boxX0), x1(boxX1), cy(boxY), cz(boxZ) {
+    const float cs = grid.cellSize;
+    origin[0] = grid.origin.x + static_cast<float>(x0) * cs;
+    origin[1] = grid.origin.y + static_cast<float>(cy) * cs;
+    origin[2] = grid.origin.z + static_cast<float>(cz) * cs;
+    extent[0] = static_cast<float>(x1 - x0 + 1) * cs;
+    extent[1] = extent[2] = cs;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = extent[a];
+      hi[a] = 0.0f;
+    }
+  }
+  /// Widens the extent by one lane's position.
+  void Add(const Vec4& p) {
+    const float local[3] = {p.x - origin[0], p.y - origin[1], p.z - origin[2]};
+    for (int a = 0; a < 3; ++a) {
+      const float t = AtMost(AtLeast(local[a], 0.0f), extent[a]);
+      lo[a] = AtMost(lo[a], t);
+      hi[a] = AtLeast(hi[a], t);
+    }
+  }
+  /// f(j) for every particle j (ranges start/end) of the cells around the box that the extent reaches.
+  template <class F>
+  void ForEach(const uint32_t* start, const uint32_t* end, F&& f) const {
+    const GridView& grid = *g;
+    const float cs = grid.cellSize;
+    const int base[3] = {x0, cy, cz};
+    // Squared distance along `axis` from the block's extent to cell c.
+    auto gap = [&](int axis, int c) {
+      const float cellLo = static_cast<float>(c - base[axis]) * cs, cellHi = cellLo + cs;
+      const float d = AtLeast(AtLeast(cellLo - hi[axis], lo[axis] - cellHi), 0.0f);
+      return d * d;
+    };
+    const float reach2 = cs * cs;
+    const int z0 = cz > 0 ? cz - 1 : 0, z1 = cz < grid.nz - 1 ? cz + 1 : cz;
+    const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy < grid.ny - 1 ? cy + 1 : cy;
+    const int xa = x0 > 0 ? x0 - 1 : 0, xb = x1 < grid.nx - 1 ? x1 + 1 : x1;
+    for (int z = z0; z <= z1; ++z) {
+      const float dz2 = gap(2, z);
+      for (int y = y0; y <= y1; ++y) {
+        const float dyz2 = dz2 + gap(1, y);
+        if (dyz2 >= reach2) continue;
+        const uint32_t row = grid.Linear(0, y, z);
+        for (int x = xa; x <= xb; ++x) {
+          if (dyz2 + gap(0, x) >= reach2) continue;
+          const uint32_t s = start[row + x];
+          if (s == kEmptyCell) continue;
+          const uint32_t e = end[row + x];
+          for (uint32_t j = s; j < e; ++j) f(j);
+        }
+      }
+    }
+  }
+};
+
+/// sum_j w_j W(|x_l - x_j|) in every lane l over the particles j of `points` that `cells` reaches, in
+/// its order (w_j = `points[j].w`, or 1 when `weighted` is false). Lanes far away (1e30) never hit.
+inline Lanes16 KernelSum16(const CubicSpline& k, const BlockCells& cells, const uint32_t* start, const uint32_t* end,
+                           const Vec4* points, bool weighted, Lanes16 px, Lanes16 py, Lanes16 pz) {
+  Lanes16 sum = Splat16(0.0f);
+  cells.ForEach(start, end, [&](uint32_t j) {
+    const Vec4 pj = points[j];
+    const Lanes16 dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
+    const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
+    const LaneInts16 within = Less16(r2, Splat16(k.H2));
+    if (Bits16(within) == 0) return;
+    const Lanes16 w = KernelW16(k, Sqrt16(r2) * k.invH, within);
+    sum += weighted ? pj.w * w : w;
+  });
+  return sum;
+}
+
+/// CubicSpline::GradFactor in every lane from q = r / H and r (0 where `pair` is off or q >= 1; r > 0
+/// where it is used).
+inline Lanes16 GradFactor16(const CubicSpline& k, Lanes16 q, Lanes16 r, LaneInts16 pair) {
+  const Lanes16 t = 1.0f - q;
+  return Select16(And16(pair, Less16(q, Splat16(1.0f))),
+                  Select16(LessEq16(q, Splat16(0.5f)), k.gradA * (3.0f * q - 2.0f), -k.gradB * t * t / r), Splat16(0.0f));
+}
+
 /// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to 16
 /// particles or the end of its cell pair). With reuse (`idle` set), only the lanes that compute this
-/// step (ComputesThisStep) are written; a block without one costs nothing.
+/// step (ComputesThisStep) are written; a block without one costs nothing. The walls' sums
+/// (DensityStage::WallSum) are taken the same way, for the lanes whose cell has wall particles around.
 struct DensityBlockStage {
   DensityStage stage;
   const uint32_t* blockStart;
@@ -283,80 +370,63 @@ struct DensityBlockStage {
 
     Lanes16 px = Splat16(1e30f), py = px, pz = px;
     uint32_t found[kLanes] = {};
-    // The block's extent inside its cell pair per axis (local coordinates clamped to the pair's box,
-    // as ForEachInCells clamps to the cell), for culling the cells around it that no lane can reach.
-    const float cs = g.cellSize;
-    const int base[3] = {pair.x0, cy, cz};
-    const float extent[3] = {static_cast<float>(pair.x1 - pair.x0 + 1) * cs, cs, cs};
-    const float origin[3] = {g.origin.x + static_cast<float>(pair.x0) * cs, g.origin.y + static_cast<float>(cy) * cs,
-                             g.origin.z + static_cast<float>(cz) * cs};
-    float lo[3] = {extent[0], cs, cs}, hi[3] = {0.0f, 0.0f, 0.0f};
+    BlockCells cells(g, pair.x0, pair.x1, cy, cz);
     for (int l = 0; l < kLanes; ++l) {
       if (computing & (1u << l)) {
         const Vec4 p = position[first + l];
         px[l] = p.x;
         py[l] = p.y;
         pz[l] = p.z;
-        const float local[3] = {p.x - origin[0], p.y - origin[1], p.z - origin[2]};
-        for (int a = 0; a < 3; ++a) {
-          const float t = Min(Max(local[a], 0.0f), extent[a]);
-          lo[a] = Min(lo[a], t);
-          hi[a] = Max(hi[a], t);
-        }
+        cells.Add(p);
       }  // other lanes stay far away, never a hit (their squared distance overflows to +inf)
     }
-    // Squared distance along `axis` from the block's extent to cell c.
-    auto gap = [&](int axis, int c) {
-      const float cellLo = static_cast<float>(c - base[axis]) * cs, cellHi = cellLo + cs;
-      const float d = Max(Max(cellLo - hi[axis], lo[axis] - cellHi), 0.0f);
-      return d * d;
-    };
     const CubicSpline k = stage.ph.kernel;
     Lanes16 sum = Splat16(0.0f);
     const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
-    const float reach2 = cs * cs;  // a cell this far from every lane holds no neighbour (cell size >= support)
-    const int z0 = cz > 0 ? cz - 1 : 0, z1 = cz < g.nz - 1 ? cz + 1 : cz;
-    const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy < g.ny - 1 ? cy + 1 : cy;
-    const int x0 = pair.x0 > 0 ? pair.x0 - 1 : 0, x1 = pair.x1 < g.nx - 1 ? pair.x1 + 1 : pair.x1;
-    for (int z = z0; z <= z1; ++z) {
-      const float dz2 = gap(2, z);
-      for (int y = y0; y <= y1; ++y) {
-        const float dyz2 = dz2 + gap(1, y);
-        if (dyz2 >= reach2) continue;
-        const uint32_t row = g.Linear(0, y, z);
-        for (int x = x0; x <= x1; ++x) {
-          if (dyz2 + gap(0, x) >= reach2) continue;
-          const uint32_t s = g.fluidStart[row + x];
-          if (s == kEmptyCell) continue;
-          const uint32_t e = g.fluidEnd[row + x];
-          for (uint32_t j = s; j < e; ++j) {
-            const Vec4 pj = position[j];
-            const Lanes16 dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
-            const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
-            const LaneInts16 within = Less16(r2, Splat16(k.H2));
-            uint32_t hits = Bits16(within);
-            if (hits == 0) continue;
-            sum += KernelW16(k, Sqrt16(r2) * k.invH, within);
-            while (hits != 0) {  // the neighbour lists: every hit but the particle itself
-              const int l = __builtin_ctz(hits);
-              hits &= hits - 1u;
-              const uint32_t i = first + static_cast<uint32_t>(l);
-              if (j == i) continue;
-              if (found[l] < capacity) stage.Slots(static_cast<int>(i))[found[l]] = j;
-              ++found[l];
-            }
-          }
+    cells.ForEach(g.fluidStart, g.fluidEnd, [&](uint32_t j) {
+      const Vec4 pj = position[j];
+      const Lanes16 dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
+      const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
+      const LaneInts16 within = Less16(r2, Splat16(k.H2));
+      uint32_t hits = Bits16(within);
+      if (hits == 0) return;
+      sum += KernelW16(k, Sqrt16(r2) * k.invH, within);
+      while (hits != 0) {  // the neighbour lists: every hit but the particle itself
+        const int l = __builtin_ctz(hits);
+        hits &= hits - 1u;
+        const uint32_t i = first + static_cast<uint32_t>(l);
+        if (j == i) continue;
+        if (found[l] < capacity) stage.Slots(static_cast<int>(i))[found[l]] = j;
+        ++found[l];
+      }
+    });
+    // The walls: the lanes whose own cell has a wall particle in its 27 cells (WallSum's test); the
+    // others keep 0, as WallSum gives them.
+    Lanes16 wall = Splat16(0.0f);
+    const bool near0 = g.boundaryNear[g.Linear(pair.x0, cy, cz)] != 0, near1 = g.boundaryNear[g.Linear(pair.x1, cy, cz)] != 0;
+    if (near0 || near1) {
+      Lanes16 wx = px, wy = py, wz = pz;
+      if (!(near0 && near1)) {
+        for (int l = 0; l < kLanes; ++l) {
+          if (!(computing & (1u << l))) continue;
+          int lx, ly, lz;
+          g.CellOf(Vec3{px[l], py[l], pz[l]}, &lx, &ly, &lz);
+          if (!g.boundaryNear[g.Linear(lx, ly, lz)]) wx[l] = wy[l] = wz[l] = 1e30f;
         }
       }
+      wall = KernelSum16(k, cells, g.boundaryStart, g.boundaryEnd, g.boundary, true, wx, wy, wz);
     }
     for (int l = 0; l < lanes; ++l) {
-      if (computing & (1u << l)) stage.Finish(static_cast<int>(first) + l, Vec3{px[l], py[l], pz[l]}, sum[l], found[l]);
+      if (computing & (1u << l)) {
+        stage.Complete(static_cast<int>(first) + l, Vec3{px[l], py[l], pz[l]}, sum[l], wall[l], found[l]);
+      }
     }
   }
 };
 
 /// ForceStage for particle i with its fluid neighbours summed 16 at a time from the neighbour list
-/// (a list that overflowed falls back to ForceStage's own cell scan).
+/// (a list that overflowed falls back to ForceStage's own cell scan), and its wall particles 16 at a
+/// time from its cells (ForceStage::End's wall terms).
 struct ForceListStage {
   ForceStage stage;
 
@@ -394,11 +464,7 @@ struct ForceListStage {
       const Lanes16 rhoj = Gather16(f.density, index);
       const Lanes16 r = Sqrt16(r2);
       const Lanes16 q = r * k.invH;
-      const Lanes16 t = 1.0f - q;
-      // CubicSpline::GradFactor in every lane (r > 0 where it is used).
-      const Lanes16 grad = Select16(And16(pair, Less16(q, Splat16(1.0f))),
-                                    Select16(LessEq16(q, Splat16(0.5f)), k.gradA * (3.0f * q - 2.0f), -k.gradB * t * t / r),
-                                    zero);
+      const Lanes16 grad = GradFactor16(k, q, r, pair);
       if (P.shepard) {  // CubicSpline::W / rho_j
         const Lanes16 wj = KernelW16(k, q, pair) / rhoj;
         pSum += Gather16(f.pressure, index) * wj;
@@ -417,7 +483,83 @@ struct ForceListStage {
       P.pAverage += Sum16(pSum);
       P.weight += Sum16(wSum);
     }
-    stage.End(i, P, Vec3{Sum16(ax), Sum16(ay), Sum16(az)});
+    if (P.nearWall) Walls(P, &ax, &ay, &az);
+    stage.Store(i, P, Vec3{Sum16(ax), Sum16(ay), Sum16(az)});
+  }
+
+  /// ForceStage::End's wall terms, added into the lanes: the wall particles of i's cells (its own
+  /// ForEachInCells scan) collected 16 at a time.
+  void Walls(const ForceParticle& P, Lanes16* ax, Lanes16* ay, Lanes16* az) const {
+    const GridView& g = stage.grid;
+    const Physics& ph = stage.ph;
+    const CubicSpline k = ph.kernel;
+    const float eps = 0.01f * ph.smoothing * ph.smoothing;
+    const ForceStage::WallTerms w = stage.Walls(P);
+    const float* boundary = reinterpret_cast<const float*>(g.boundary);  // Vec4: x y z Psi
+    const Lanes16 zero = Splat16(0.0f);
+    Lanes16 laneNumber;
+    for (int l = 0; l < kLanes; ++l) laneNumber[l] = static_cast<float>(l);
+    LaneInts16 index;
+    int n = 0;
+    auto flush = [&]() {
+      for (int l = n; l < kLanes; ++l) index[l] = index[0];  // padding, masked off below
+      const LaneInts16 at = index * 4;
+      const Lanes16 dx = P.xi.x - Gather16(boundary, at), dy = P.xi.y - Gather16(boundary + 1, at),
+                    dz = P.xi.z - Gather16(boundary + 2, at);
+      const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
+      const LaneInts16 pair = And16(And16(Less16(r2, Splat16(k.H2)), NotEq16(r2, zero)),
+                                    Less16(laneNumber, Splat16(static_cast<float>(n))));
+      n = 0;
+      if (Bits16(pair) == 0) return;
+      const Lanes16 r = Sqrt16(r2);
+      const Lanes16 grad = GradFactor16(k, r * k.invH, r, pair);
+      Lanes16 term = ph.wallDensity ? ph.boundaryGradScale * (P.pTermI + Gather16(g.boundaryPressureTerm, index))
+                                    : Splat16(w.pressureTerm);
+      const Lanes16 vx = P.vi.x * dx + P.vi.y * dy + P.vi.z * dz;  // static walls: v_b = 0
+      term = Select16(Less16(vx, zero), term - Gather16(g.boundaryAlpha, index) * w.viscosity * vx / (r2 + eps), term);
+      const Lanes16 s = Gather16(boundary + 3, at) * term * grad;
+      *ax -= dx * s;
+      *ay -= dy * s;
+      *az -= dz * s;
+    };
+    ForEachInCells(g, g.boundaryStart, g.boundaryEnd, g.boundary, P.xi, [&](uint32_t j, Vec3) {
+      index[n++] = static_cast<int32_t>(j);
+      if (n == kLanes) flush();
+    });
+    if (n > 0) flush();
+  }
+};
+
+/// WallPressureStage for the wall particles of cell `cells[k]`, 16 at a time: each lane's kernel sum
+/// over the fluid around the cell, in the order of its own scan.
+struct WallPressureBlockStage {
+  WallPressureStage stage;
+
+  void operator()(int item) const {
+    const GridView& g = stage.grid;
+    const uint32_t c = stage.cells[item];
+    const uint32_t s = g.boundaryStart[c], e = g.boundaryEnd[c];
+    if (!AnyInNeighbourCells(g, g.fluidStart, static_cast<int>(c))) {
+      for (uint32_t b = s; b < e; ++b) stage.out[b] = 0.0f;
+      return;
+    }
+    const int cx = static_cast<int>(c % static_cast<uint32_t>(g.nx));
+    const int cy = static_cast<int>((c / static_cast<uint32_t>(g.nx)) % static_cast<uint32_t>(g.ny));
+    const int cz = static_cast<int>(c / (static_cast<uint32_t>(g.nx) * static_cast<uint32_t>(g.ny)));
+    for (uint32_t first = s; first < e; first += kLanes) {
+      const int lanes = static_cast<int>(e - first < static_cast<uint32_t>(kLanes) ? e - first : kLanes);
+      Lanes16 px = Splat16(1e30f), py = px, pz = px;
+      BlockCells cells(g, cx, cx, cy, cz);
+      for (int l = 0; l < lanes; ++l) {
+        const Vec4 p = g.boundary[first + l];
+        px[l] = p.x;
+        py[l] = p.y;
+        pz[l] = p.z;
+        cells.Add(p);
+      }
+      const Lanes16 sum = KernelSum16(stage.ph.kernel, cells, g.fluidStart, g.fluidEnd, stage.fluid.position, false, px, py, pz);
+      for (int l = 0; l < lanes; ++l) stage.out[first + l] = stage.FromSum(static_cast<int>(first) + l, sum[l]);
+    }
   }
 };
 

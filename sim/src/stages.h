@@ -29,6 +29,12 @@ namespace sphxr::sim {
 
 inline constexpr uint32_t kEmptyCell = 0xffffffffu;
 
+/// max(v, lo) and min(v, hi) as one comparison each. fmaxf and fminf are library calls on the host
+/// without -ffast-math (measured: 3 % of a step on an AVX2 EPYC, from the cell look-ups). Where v is
+/// NaN these give lo and hi, as fmaxf(v, lo) and fminf(v, hi) do; lo and hi must not be NaN.
+SPHXR_HD SPHXR_INLINE float AtLeast(float v, float lo) { return v > lo ? v : lo; }
+SPHXR_HD SPHXR_INLINE float AtMost(float v, float hi) { return v < hi ? v : hi; }
+
 /// Raw pointers to every fluid field (generated from the field list).
 struct FluidView {
 #define SPHXR_VIEW_FIELD(type, name) type* name;
@@ -80,10 +86,10 @@ struct GridView {
 
   SPHXR_HD SPHXR_INLINE int Clampi(int v, int hi) const { return v < 0 ? 0 : (v > hi ? hi : v); }
   SPHXR_HD SPHXR_INLINE void CellOf(Vec3 p, int* cx, int* cy, int* cz) const {
-    // fminf/fmaxf keep a NaN position inside the grid (validate mode names it later).
-    *cx = Clampi(static_cast<int>(fmaxf(0.0f, fminf((p.x - origin.x) * invCellSize, 1e9f))), nx - 1);
-    *cy = Clampi(static_cast<int>(fmaxf(0.0f, fminf((p.y - origin.y) * invCellSize, 1e9f))), ny - 1);
-    *cz = Clampi(static_cast<int>(fmaxf(0.0f, fminf((p.z - origin.z) * invCellSize, 1e9f))), nz - 1);
+    // AtMost takes 1e9 for a NaN: a NaN position stays inside the grid (validate mode names it later).
+    *cx = Clampi(static_cast<int>(AtLeast(AtMost((p.x - origin.x) * invCellSize, 1e9f), 0.0f)), nx - 1);
+    *cy = Clampi(static_cast<int>(AtLeast(AtMost((p.y - origin.y) * invCellSize, 1e9f), 0.0f)), ny - 1);
+    *cz = Clampi(static_cast<int>(AtLeast(AtMost((p.z - origin.z) * invCellSize, 1e9f), 0.0f)), nz - 1);
   }
   SPHXR_HD SPHXR_INLINE uint32_t Linear(int cx, int cy, int cz) const {
     return static_cast<uint32_t>(cx + nx * (cy + ny * cz));
@@ -106,7 +112,7 @@ SPHXR_HD SPHXR_INLINE void ForEachInCells(const GridView& g, const uint32_t* sta
   // position inside the cell is clamped to the cell, so a clamped (out-of-grid) xi only culls less.
   const float cs = g.cellSize;
   auto gaps = [cs](float local, float* out) {
-    const float t = fminf(fmaxf(local, 0.0f), cs);
+    const float t = AtMost(AtLeast(local, 0.0f), cs);
     out[0] = t * t;
     out[1] = 0.0f;
     out[2] = (cs - t) * (cs - t);
@@ -270,6 +276,10 @@ struct WallPressureStage {
       const float r2 = Dot(d, d);
       if (r2 < k.H2) sum += k.W(sqrtf(r2));
     });
+    return FromSum(b, sum);
+  }
+  /// p_b / rho_b^2 of wall particle b from its kernel sum over the fluid.
+  SPHXR_HD SPHXR_INLINE float FromSum(int b, float sum) const {
     const float rho = ph.restDensity * sum * grid.boundaryInvReference[b];
     const float p = TaitPressure(ph, rho);
     return p > 0.0f ? p / (rho * rho) : 0.0f;
@@ -392,17 +402,28 @@ struct DensityStage {
   }
   /// The walls' and bodies' sums, then density, pressure and p/rho^2 of particle i.
   SPHXR_HD SPHXR_INLINE void Finish(int i, Vec3 xi, float sumFluid, uint32_t found) const {
+    Complete(i, xi, sumFluid, WallSum(xi), found);
+  }
+  /// sum_b Psi_b W_ib over the walls' particles around xi, in the order of the cell scan (0 when no
+  /// wall particle lies in xi's 27 cells).
+  SPHXR_HD SPHXR_INLINE float WallSum(Vec3 xi) const {
     const CubicSpline k = ph.kernel;
-    list.count[i] = found;
-    float sumBoundary = 0.0f;
+    float sum = 0.0f;
     int cx, cy, cz;
     grid.CellOf(xi, &cx, &cy, &cz);
     if (grid.boundaryNear[grid.Linear(cx, cy, cz)]) {
       ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
         const float r2 = Dot(d, d);
-        if (r2 < k.H2) sumBoundary += grid.boundary[j].w * k.W(sqrtf(r2));
+        if (r2 < k.H2) sum += grid.boundary[j].w * k.W(sqrtf(r2));
       });
     }
+    return sum;
+  }
+  /// Given the fluid's and the walls' sums: the moving bodies' sum, then density, pressure, p/rho^2.
+  SPHXR_HD SPHXR_INLINE void Complete(int i, Vec3 xi, float sumFluid, float sumWall, uint32_t found) const {
+    const CubicSpline k = ph.kernel;
+    list.count[i] = found;
+    float sumBoundary = sumWall;
     if (grid.MovingNear(xi)) {  // moving boundaries (paddles): the same sum (Akinci et al. 2012, eq. 5)
       ForEachInCells(grid, grid.bodyStart, grid.bodyEnd, grid.body, xi, [&](uint32_t j, Vec3 d) {
         const float r2 = Dot(d, d);
@@ -446,7 +467,7 @@ SPHXR_HD SPHXR_INLINE Vec3 BodyAcceleration(const GridView& grid, const Physics&
 /// What the force stage knows of particle i before its neighbours (ForceStage::Begin).
 struct ForceParticle {
   Vec3 xi, vi;
-  float rhoi, pTermI;
+  float rhoi, pI, pTermI;  // density, pressure, p_i / rho_i^2
   bool nearWall;  // a wall within the support (the density stage's flag)
   bool shepard;   // the Shepard pressure average is needed (mirrored walls or a moving body near)
   float pAverage, weight;  // Shepard sums, self included
@@ -504,48 +525,67 @@ struct ForceStage {
     P.xi = Xyz(fluid.position[i]);
     P.vi = Xyz(fluid.velocity[i]);
     P.rhoi = fluid.density[i];
+    P.pI = fluid.pressure[i];
     P.pTermI = fluid.pressureTerm[i];
     P.nearWall = fluid.position[i].w != 0.0f;
     // The Shepard average feeds the mirrored wall pressure (and the bodies', which are always mirrored).
     P.shepard = P.nearWall && (!ph.wallDensity || grid.MovingNear(P.xi));
-    P.pAverage = fluid.pressure[i] * ph.kernel.W(0.0f) / P.rhoi;
+    P.pAverage = P.pI * ph.kernel.W(0.0f) / P.rhoi;
     P.weight = ph.kernel.W(0.0f) / P.rhoi;
     return P;
   }
 
-  /// Given the fluid neighbours' acceleration `a` (and P's Shepard sums): the walls, the moving bodies,
-  /// gravity, the reuse guard, and the store.
-  SPHXR_HD SPHXR_INLINE void End(int i, const ForceParticle& P, Vec3 a) const {
-    const Vec3 xi = P.xi, vi = P.vi;
-    const float rhoi = P.rhoi, pTermI = P.pTermI;
-    const CubicSpline k = ph.kernel;
-    const float h = ph.smoothing;
-    const float eps = 0.01f * h * h;
+  /// The constants of particle i's wall pair terms (ForceStage::End, and the CPU's SIMD wall sum).
+  struct WallTerms {
+    float pWall;          // mirrored p_b
+    float pressureTerm;   // mirrored walls: s (p_i/rho_i^2 + p_b/rho_i^2), the same for every wall particle
+    float viscosity;      // c h / (2 rho_i), times alpha_b (v_i . x_ib) / (r^2 + eps) in Pi_ib
+  };
+  SPHXR_HD SPHXR_INLINE WallTerms Walls(const ForceParticle& P) const {
     // Wall pressure. Mirrored (the default): p_b = p_i (Akinci et al. 2012), but never below the average
     // pressure of i's fluid neighbours (the extrapolation of Adami et al. 2012, taken at i). Near the free
     // surface p_i is clamped to 0 while the particles below it push it with their own p_j > 0; mirroring
     // alone then gives the wall no strength and the particle sinks into it. Wall density (tank
     // "wall_pressure": "wall_density"): p_b/rho_b^2 of each wall particle from WallPressureStage.
     // Moving bodies always use the mirrored pressure.
+    WallTerms w;
+    w.pWall = fmaxf(P.pI, P.pAverage / P.weight);
+    w.pressureTerm = ph.boundaryGradScale * (P.pTermI + w.pWall / (P.rhoi * P.rhoi));
+    w.viscosity = ph.soundSpeed * ph.smoothing / (2.0f * P.rhoi);
+    return w;
+  }
+
+  /// Given the fluid neighbours' acceleration `a` (and P's Shepard sums): the walls, the moving bodies,
+  /// gravity, the reuse guard, and the store.
+  SPHXR_HD SPHXR_INLINE void End(int i, const ForceParticle& P, Vec3 a) const {
     if (P.nearWall) {
-      const float pWall = fmaxf(fluid.pressure[i], P.pAverage / P.weight);
-      const float wallPressureTerm = ph.boundaryGradScale * (pTermI + pWall / (rhoi * rhoi));
-      const float viscWall = ph.soundSpeed * h / (2.0f * rhoi);
-      ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t j, Vec3 d) {
+      const WallTerms w = Walls(P);
+      const CubicSpline k = ph.kernel;
+      const float eps = 0.01f * ph.smoothing * ph.smoothing;
+      const Vec3 vi = P.vi;
+      const float pTermI = P.pTermI;
+      ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, P.xi, [&](uint32_t j, Vec3 d) {
         const float r2 = Dot(d, d);
         if (r2 >= k.H2 || r2 == 0.0f) return;
-        float term = ph.wallDensity ? ph.boundaryGradScale * (pTermI + grid.boundaryPressureTerm[j]) : wallPressureTerm;
+        float term = ph.wallDensity ? ph.boundaryGradScale * (pTermI + grid.boundaryPressureTerm[j]) : w.pressureTerm;
         const float vx = Dot(vi, d);  // static walls: v_b = 0
-        if (vx < 0.0f) term -= grid.boundaryAlpha[j] * viscWall * vx / (r2 + eps);
+        if (vx < 0.0f) term -= grid.boundaryAlpha[j] * w.viscosity * vx / (r2 + eps);
         a -= d * (grid.boundary[j].w * term * k.GradFactor(sqrtf(r2)));
       });
-      // Moving boundaries (paddles): the same terms with the relative velocity v_i - v_b, so a moving
-      // paddle pushes (pressure) and drags (viscosity) the water. BodyReactionStage applies the opposite.
-      if (grid.MovingNear(xi)) {
-        const float pairTerm = pTermI + pWall / (rhoi * rhoi);
-        if (bodyPressureTerm) bodyPressureTerm[i] = pairTerm;
-        a -= BodyAcceleration(grid, ph, xi, vi, rhoi, pairTerm, grid.bodyStart, grid.bodyEnd);
-      }
+    }
+    Store(i, P, a);
+  }
+
+  /// Given the fluid's and the walls' acceleration `a`: the moving bodies, gravity, the reuse guard, and
+  /// the store.
+  SPHXR_HD SPHXR_INLINE void Store(int i, const ForceParticle& P, Vec3 a) const {
+    // Moving boundaries (paddles): the walls' terms with the relative velocity v_i - v_b, so a moving
+    // paddle pushes (pressure) and drags (viscosity) the water. BodyReactionStage applies the opposite.
+    if (P.nearWall && grid.MovingNear(P.xi)) {
+      const WallTerms w = Walls(P);
+      const float pairTerm = P.pTermI + w.pWall / (P.rhoi * P.rhoi);
+      if (bodyPressureTerm) bodyPressureTerm[i] = pairTerm;
+      a -= BodyAcceleration(grid, ph, P.xi, P.vi, P.rhoi, pairTerm, grid.bodyStart, grid.bodyEnd);
     }
     a += ph.gravity;
     if (ph.reuseEnabled) {

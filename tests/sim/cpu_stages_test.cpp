@@ -1,8 +1,9 @@
-// The CPU backend's blocked density traversal (sim/src/cpu_stages.h) against the per-particle
-// DensityStage (the CUDA backend's) and against a brute-force O(n^2) sum in double: the same neighbour
+// The CPU backend's SIMD stages (sim/src/cpu_stages.h) against the per-particle stages of stages.h (the
+// CUDA backend's) and against brute-force O(n^2) sums in double. Density blocks: the same neighbour
 // lists in the same order, the same densities to float rounding, on random, clustered, cell-border and
 // over-full sets (more than 16 particles in a cell, more neighbours than list slots), with and without
-// reuse masking some particles out.
+// reuse masking some particles out, and with walls (their kernel sums). Forces: the neighbour-list sum
+// and the wall terms (mirrored and wall density). Wall pressure: the blocks of 16 wall particles.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -50,7 +51,7 @@ struct Setup {
   std::vector<uint32_t> start, end, index, count;
   std::vector<uint8_t> boundaryNear;
   std::vector<Vec4> boundary;  // sorted by cell, w = Psi_b
-  std::vector<float> boundaryAlpha;
+  std::vector<float> boundaryAlpha, boundaryInvReference, boundaryPressureTerm;
   std::vector<uint32_t> boundaryStart, boundaryEnd;
 
   Setup(std::vector<Vec3> points, int maxNeighbours, std::vector<Vec3> walls = {}) {
@@ -95,6 +96,11 @@ struct Setup {
       const Vec3 p = sortedWalls[b];
       boundary.push_back(Vec4{p.x, p.y, p.z, psi});
       boundaryAlpha.push_back(0.3f);
+      // Wall density's inputs: a reference sum near the rest lattice's, and a p_b/rho_b^2 of either sign
+      // of difference from the fluid's (WallPressureStage's output, for the force stage).
+      // (The rest lattice's sum beside a flat wall is about half of 1 / spacing^3.)
+      boundaryInvReference.push_back(1.0f / ((0.45f + 0.02f * static_cast<float>(b % 7)) / (kSpacing * kSpacing * kSpacing)));
+      boundaryPressureTerm.push_back(1e-3f * static_cast<float>(b % 5));
       int cx, cy, cz;
       g.CellOf(p, &cx, &cy, &cz);
       const uint32_t c = g.Linear(cx, cy, cz);
@@ -127,6 +133,8 @@ struct Setup {
     g.boundaryEnd = boundaryEnd.data();
     g.boundary = boundary.data();
     g.boundaryAlpha = boundaryAlpha.data();
+    g.boundaryInvReference = boundaryInvReference.data();
+    g.boundaryPressureTerm = boundaryPressureTerm.data();
     g.bodyCount = 0;
     return g;
   }
@@ -173,9 +181,10 @@ struct Setup {
 };
 
 /// Runs both traversals on copies of one set and compares them with each other and with brute force.
-void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what, bool reuse = false) {
+void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what, bool reuse = false,
+             const std::vector<Vec3>& walls = {}) {
   SCOPED_TRACE(what);
-  Setup perParticle(points, maxNeighbours), blocked(points, maxNeighbours);
+  Setup perParticle(points, maxNeighbours, walls), blocked(points, maxNeighbours, walls);
   const size_t n = perParticle.position.size();
   constexpr int kIdle = 3;
   if (reuse) {  // every third particle reuses this step (IC = 1), every fifth computes at IC = IDLE
@@ -187,7 +196,7 @@ void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::stri
   perParticle.RunPerParticle(reuse, kIdle);
   blocked.RunBlocked(reuse, kIdle);
   const CubicSpline k = perParticle.ph.kernel;
-  size_t overflowed = 0, checked = 0;
+  size_t overflowed = 0, checked = 0, nearWall = 0;
   for (size_t i = 0; i < n; ++i) {
     const bool computes = !reuse || perParticle.idle[i] < 0 || perParticle.idle[i] == kIdle;
     if (!computes) {  // untouched by both
@@ -223,7 +232,19 @@ void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::stri
     if (!borderline) {
       EXPECT_EQ(blocked.count[i], neighbours) << "particle " << i;
     }
-    const double brute = perParticle.ph.mass * sum;
+    double wallSum = 0.0;  // sum_b Psi_b W_ib
+    for (const Vec4& b : blocked.boundary) {
+      const Vec3 d = xi - Xyz(b);
+      const double r = std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.y) * d.y +
+                                 static_cast<double>(d.z) * d.z);
+      if (r < k.H) {
+        const double q = r / k.H;
+        wallSum += b.w * (q <= 0.5 ? k.sigma * (6.0 * (q * q * q - q * q) + 1.0) : k.sigma * 2.0 * std::pow(1.0 - q, 3));
+      }
+    }
+    if (wallSum > 0.0) ++nearWall;
+    EXPECT_EQ(blocked.position[i].w, perParticle.position[i].w) << "particle " << i << ": the near-wall flag";
+    const double brute = perParticle.ph.mass * sum + wallSum;
     EXPECT_NEAR(blocked.density[i], brute, 1e-5 * brute) << "particle " << i;
     // Each particle's sum adds the same terms in the same order; only a fused multiply-add in the
     // kernel's polynomial may round one term differently.
@@ -235,7 +256,32 @@ void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::stri
   if (maxNeighbours < 30) {
     EXPECT_GT(overflowed, 0u) << "the over-full case must overflow the list";
   }
+  if (!walls.empty()) {
+    EXPECT_GT(nearWall, checked / 5) << "the wall case must put particles near the walls";
+    EXPECT_LT(nearWall, checked) << "the wall case must leave particles away from the walls (lanes masked off)";
+  }
 }
+
+/// Wall particles: a floor sheet at the rest spacing, a side wall, and a denser patch of floor whose
+/// cells hold more than 16 wall particles (several lane blocks per cell); water 6 spacings deep over
+/// them, slightly compressed (so some wall particles see pressure and some none).
+struct WallScene {
+  std::vector<Vec3> walls, water;
+  WallScene() {
+    for (int z = 0; z < 16; ++z)
+      for (int x = 0; x < 18; ++x) {
+        walls.push_back(Vec3{(x + 0.5f) * kSpacing, 0.002f, (z + 0.5f) * kSpacing});
+        for (int y = 0; y < 6; ++y) {
+          water.push_back(Vec3{(x + 0.5f) * kSpacing + 0.0005f * static_cast<float>(y % 2), 0.0075f + y * 0.0098f,
+                               (z + 0.5f) * kSpacing});
+        }
+      }
+    for (int z = 0; z < 16; ++z)
+      for (int y = 0; y < 8; ++y) walls.push_back(Vec3{0.001f, (y + 0.5f) * kSpacing, (z + 0.5f) * kSpacing});
+    for (int z = 0; z < 10; ++z)
+      for (int x = 0; x < 10; ++x) walls.push_back(Vec3{0.04f + x * 0.004f, 0.0005f, 0.04f + z * 0.004f});
+  }
+};
 
 std::vector<Vec3> Random(size_t n, float lo, float hi, unsigned seed, float hiX = 0.0f) {
   std::mt19937 rng(seed);
@@ -248,9 +294,10 @@ std::vector<Vec3> Random(size_t n, float lo, float hi, unsigned seed, float hiX 
 /// ForceListStage against ForceStage and against the pair terms summed in double, on the densities
 /// and lists the blocked density stage left (no walls, no gravity: the fluid pair terms alone).
 void CompareForces(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what,
-                   const std::vector<Vec3>& walls = {}) {
+                   const std::vector<Vec3>& walls = {}, bool wallDensity = false) {
   SCOPED_TRACE(what);
   Setup s(points, maxNeighbours, walls);
+  s.ph.wallDensity = wallDensity;
   s.RunBlocked(false, 0);
   const size_t n = s.position.size();
   const ForceStage perParticle = s.Forces();
@@ -315,6 +362,73 @@ TEST(CpuStages, ForcesNearMirroredWallsMatchPerParticle) {
       for (int y = 0; y < 6; ++y) water.push_back(Vec3{(x + 0.5f) * kSpacing, 0.0075f + y * 0.0098f, (z + 0.5f) * kSpacing});
     }
   CompareForces(water, 64, "mirrored floor", walls);
+}
+
+TEST(CpuStages, ForcesNearWallsWithTheirOwnDensityMatchPerParticle) {
+  // Wall density: each wall particle's own p_b/rho_b^2 in the pair term; a floor, a side wall and a
+  // dense patch (more wall candidates than one batch of 16 per particle).
+  const WallScene scene;
+  CompareForces(scene.water, 64, "wall density", scene.walls, /*wallDensity=*/true);
+  CompareForces(scene.water, 64, "mirrored, side wall and dense patch", scene.walls);
+}
+
+TEST(CpuStages, DensityNearWallsMatchesPerParticleAndBruteForce) {
+  const WallScene scene;
+  Compare(scene.water, 64, "walls", /*reuse=*/false, scene.walls);
+  Compare(scene.water, 64, "walls, reuse", /*reuse=*/true, scene.walls);
+  // Random water over the walls: blocks whose two cells differ in having walls around.
+  Compare(Random(3000, 0.0f, 0.16f, 8, 0.18f), 64, "random over walls", /*reuse=*/false, scene.walls);
+}
+
+TEST(CpuStages, WallPressureBlocksMatchPerCellAndBruteForce) {
+  const WallScene scene;
+  struct Setup s(scene.water, 64, scene.walls);
+  s.ph.wallDensity = true;
+  std::vector<uint32_t> wallCells;
+  size_t fullest = 0;
+  for (size_t c = 0; c < s.boundaryStart.size(); ++c) {
+    if (s.boundaryStart[c] == kEmptyCell) continue;
+    wallCells.push_back(static_cast<uint32_t>(c));
+    fullest = std::max<size_t>(fullest, s.boundaryEnd[c] - s.boundaryStart[c]);
+  }
+  ASSERT_GT(fullest, static_cast<size_t>(kLanes)) << "a cell must hold more wall particles than one block";
+  const size_t nb = s.boundary.size();
+  std::vector<float> perCell(nb, -1.0f), blocked(nb, -1.0f);
+  const DensityStage d = s.Stage();
+  const WallPressureStage scalar{d.grid, d.fluid, s.ph, wallCells.data(), perCell.data()};
+  const WallPressureBlockStage simd{WallPressureStage{d.grid, d.fluid, s.ph, wallCells.data(), blocked.data()}};
+  for (int c = 0; c < static_cast<int>(wallCells.size()); ++c) {
+    scalar(c);
+    simd(c);
+  }
+  const CubicSpline k = s.ph.kernel;
+  size_t pressed = 0;
+  for (size_t b = 0; b < nb; ++b) {
+    double sum = 0.0;  // brute force: every fluid particle, in double
+    for (const Vec4& f : s.position) {
+      const Vec3 dx = Xyz(s.boundary[b]) - Xyz(f);
+      const double r = std::sqrt(static_cast<double>(dx.x) * dx.x + static_cast<double>(dx.y) * dx.y +
+                                 static_cast<double>(dx.z) * dx.z);
+      if (r < k.H) {
+        const double q = r / k.H;
+        sum += q <= 0.5 ? k.sigma * (6.0 * (q * q * q - q * q) + 1.0) : k.sigma * 2.0 * std::pow(1.0 - q, 3);
+      }
+    }
+    const double rho = s.ph.restDensity * sum * s.boundaryInvReference[b];
+    const double p = std::max(0.0, s.ph.stiffness * (std::pow(rho / s.ph.restDensity, 7.0) - 1.0));
+    const double expected = p > 0.0 ? p / (rho * rho) : 0.0;
+    if (expected > 0.0) ++pressed;
+    // The same terms in the same order; a fused multiply-add in the kernel may round one differently.
+    // Near rest p = B((rho/rho0)^7 - 1) turns a rounding of rho into 7 B / rho0 times as much pressure
+    // (relative to p, a thousand times more): so the bound is rho's float rounding (1e-6 of it, a sum
+    // of some 30 terms) carried through dp/drho, over rho^2.
+    const double rho0 = s.ph.restDensity;
+    const double rounding = 1e-6 * 7.0 * s.ph.stiffness / (rho0 * rho0);
+    EXPECT_NEAR(blocked[b], perCell[b], rounding) << "wall particle " << b;
+    EXPECT_NEAR(blocked[b], expected, rounding + 1e-4 * expected) << "wall particle " << b;
+  }
+  EXPECT_GT(pressed, nb / 10) << "some wall particles must carry pressure";
+  EXPECT_LT(pressed, nb) << "and some none (no fluid near, or the water not compressed there)";
 }
 
 TEST(CpuStages, ForcesMatchPerParticleAndBruteForce) {
