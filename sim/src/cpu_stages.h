@@ -1,9 +1,9 @@
 #pragma once
 // The CPU backend's SIMD traversals of the density and force stages (host-only; the CUDA backend runs
 // stages.h's DensityStage and ForceStage, a thread per particle). The physics is stages.h's: these
-// only arrange the same sums for 16-wide vector units.
+// only arrange the same sums for vector units (kLanes wide: 16 with AVX-512, 8 with AVX).
 //
-// Density (DensityBlockStage): one work item per block of up to 16 particles of a pair of grid cells
+// Density (DensityBlockStage): one work item per block of up to kLanes particles of a pair of grid cells
 // along x (particles are sorted by Morton code, so a pair is a contiguous run). Each candidate j of the cells around
 // the block is loaded once and evaluated for all the block's particles at once: the distance, the hit
 // mask, sqrt and the kernel (both pieces, selected per lane); only the neighbour-list appends are
@@ -12,15 +12,19 @@
 // particle's sum adds the same terms in the same order and its neighbour list is the same list; a
 // kernel value may differ in the last bit where the compiler fuses a multiply-add differently.
 //
-// Forces (ForceListStage): per particle, its neighbour list 16 at a time, the neighbours' fields
+// Forces (ForceListStage): per particle, its neighbour list kLanes at a time, the neighbours' fields
 // gathered into vectors, the pair terms of ForceStage in every lane, the lanes summed at the end. The
-// sum's order differs from ForceStage's serial one (rounding only); the walls, bodies, gravity and
-// the reuse guard are ForceStage::End itself.
+// sum's order differs from ForceStage's serial one (rounding only). The wall terms are summed the same
+// way, kLanes wall particles at a time from the particle's cells; the bodies, gravity and the reuse
+// guard are ForceStage::Store itself.
 //
-// Both are deterministic for any thread count (a particle's sums never depend on the schedule), and
+// Walls: the density blocks take the walls' kernel sums like the fluid's (each lane's terms in its own
+// scan's order), and WallPressureBlockStage the wall particles of one cell kLanes at a time.
+//
+// All are deterministic for any thread count (a particle's sums never depend on the schedule), and
 // the CPU runs them for every density and force evaluation, with reuse too (DensityBlockStage masks
 // the lanes that reuse and skips blocks without one), so reuse off and reuse with IDLE = 0 stay
-// bit-identical. tests/sim/cpu_stages_test.cpp compares both with the per-particle stages and with
+// bit-identical. tests/sim/cpu_stages_test.cpp compares each with the per-particle stages and with
 // brute force.
 #include <cmath>
 #include <cstdint>
@@ -48,26 +52,36 @@
 namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {
 
+// Lanes per SIMD value: one register of the widest unit where there is one (AVX-512: 16, AVX: 8),
+// else 16 in four SSE2 registers or in scalars. Measured on an AVX2 AMD EPYC (docs/performance.md,
+// "AVX2 machines"): 16 lanes in two 256-bit halves left the values spilling (16 ymm registers hold
+// eight of them) and every comparison, select and gather split in two; eight lanes in one register
+// made the whole step 1.23-1.3x faster, although a density block then holds 8 particles instead of 16.
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
 inline constexpr int kLanes = 16;
+#define SPHXR_LANE_BYTES 64
+#elif defined(__AVX__)
+inline constexpr int kLanes = 8;
+#define SPHXR_LANE_BYTES 32
+#else
+inline constexpr int kLanes = 16;
+#define SPHXR_LANE_BYTES 64
+#endif
 
-/// 16 floats in one SIMD value (GCC/Clang vector extension: AVX-512 one register, AVX two, SSE four).
-typedef float Lanes16 __attribute__((vector_size(64), aligned(64)));
-typedef int32_t LaneInts16 __attribute__((vector_size(64), aligned(64)));
+/// kLanes floats (ints) in one SIMD value (GCC/Clang vector extension).
+typedef float Lanes __attribute__((vector_size(SPHXR_LANE_BYTES), aligned(SPHXR_LANE_BYTES)));
+typedef int32_t LaneInts __attribute__((vector_size(SPHXR_LANE_BYTES), aligned(SPHXR_LANE_BYTES)));
+static_assert(sizeof(Lanes) == kLanes * sizeof(float));
 
-inline Lanes16 Splat16(float v) { return Lanes16{} + v; }
+inline Lanes Splat(float v) { return Lanes{} + v; }
 
-inline Lanes16 Sqrt16(Lanes16 a) {
+inline Lanes Sqrt(Lanes a) {
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
   // (Zero-masked with all lanes on: GCC 12's _mm512_sqrt_ps passes an undefined merge source that
   // -Wmaybe-uninitialized reports at every use.)
-  return reinterpret_cast<Lanes16>(_mm512_maskz_sqrt_ps(static_cast<__mmask16>(0xffff), reinterpret_cast<__m512>(a)));
+  return reinterpret_cast<Lanes>(_mm512_maskz_sqrt_ps(static_cast<__mmask16>(0xffff), reinterpret_cast<__m512>(a)));
 #elif defined(__AVX__)
-  __m256 h[2];
-  std::memcpy(h, &a, sizeof a);
-  h[0] = _mm256_sqrt_ps(h[0]);
-  h[1] = _mm256_sqrt_ps(h[1]);
-  std::memcpy(&a, h, sizeof a);
-  return a;
+  return reinterpret_cast<Lanes>(_mm256_sqrt_ps(reinterpret_cast<__m256>(a)));
 #elif defined(__SSE2__)
   __m128 h[4];
   std::memcpy(h, &a, sizeof a);
@@ -81,13 +95,11 @@ inline Lanes16 Sqrt16(Lanes16 a) {
 }
 
 /// Bit l set where the comparison result (all ones / zero per lane) is true.
-inline uint32_t Bits16(LaneInts16 c) {
+inline uint32_t Bits(LaneInts c) {
 #if defined(__AVX512DQ__)
   return static_cast<uint32_t>(_mm512_movepi32_mask(reinterpret_cast<__m512i>(c)));
 #elif defined(__AVX__)
-  __m256 h[2];
-  std::memcpy(h, &c, sizeof c);
-  return static_cast<uint32_t>(_mm256_movemask_ps(h[0])) | (static_cast<uint32_t>(_mm256_movemask_ps(h[1])) << 8);
+  return static_cast<uint32_t>(_mm256_movemask_ps(reinterpret_cast<__m256>(c)));
 #elif defined(__SSE2__)
   __m128 h[4];
   std::memcpy(h, &c, sizeof c);
@@ -101,110 +113,63 @@ inline uint32_t Bits16(LaneInts16 c) {
 #endif
 }
 
-/// Lane-wise comparisons (all ones where true), a bitwise and of two masks, and a select. With AVX-512 the
-/// vector operators are one instruction each. Without it GCC 12 lowers a comparison or a ?: of 64-byte
-/// vectors lane by lane (a scalar compare, a store of each 32-bit result, then a 128-bit reload that the
-/// store buffer cannot forward): measured on an AVX2 AMD EPYC, that made the density and force stages
-/// 2-3x slower than the same work in 256-bit halves. So the narrower tiers compare and select per half
-/// with the intrinsics. Same NaN semantics as the operators: <, <= are ordered (false for NaN), != is
-/// unordered (true for NaN); the results are bit for bit those of the operators.
-#if defined(__AVX512F__) && defined(__AVX512DQ__)
-inline LaneInts16 Less16(Lanes16 a, Lanes16 b) { return a < b; }
-inline LaneInts16 LessEq16(Lanes16 a, Lanes16 b) { return a <= b; }
-inline LaneInts16 NotEq16(Lanes16 a, Lanes16 b) { return a != b; }
-inline LaneInts16 And16(LaneInts16 a, LaneInts16 b) { return a & b; }
-inline Lanes16 Select16(LaneInts16 m, Lanes16 a, Lanes16 b) { return m ? a : b; }
-#elif defined(__AVX__)
-template <int kPredicate>
-inline LaneInts16 Compare16(Lanes16 a, Lanes16 b) {
-  __m256 x[2], y[2];
-  std::memcpy(x, &a, sizeof a);
-  std::memcpy(y, &b, sizeof b);
-  x[0] = _mm256_cmp_ps(x[0], y[0], kPredicate);
-  x[1] = _mm256_cmp_ps(x[1], y[1], kPredicate);
-  LaneInts16 out;
-  std::memcpy(&out, x, sizeof out);
-  return out;
-}
-inline LaneInts16 Less16(Lanes16 a, Lanes16 b) { return Compare16<_CMP_LT_OQ>(a, b); }
-inline LaneInts16 LessEq16(Lanes16 a, Lanes16 b) { return Compare16<_CMP_LE_OQ>(a, b); }
-inline LaneInts16 NotEq16(Lanes16 a, Lanes16 b) { return Compare16<_CMP_NEQ_UQ>(a, b); }
-inline LaneInts16 And16(LaneInts16 a, LaneInts16 b) {
-  __m256 x[2], y[2];
-  std::memcpy(x, &a, sizeof a);
-  std::memcpy(y, &b, sizeof b);
-  x[0] = _mm256_and_ps(x[0], y[0]);
-  x[1] = _mm256_and_ps(x[1], y[1]);
-  LaneInts16 out;
-  std::memcpy(&out, x, sizeof out);
-  return out;
-}
-inline Lanes16 Select16(LaneInts16 m, Lanes16 a, Lanes16 b) {
-  __m256 mm[2], x[2], y[2];
-  std::memcpy(mm, &m, sizeof m);
-  std::memcpy(x, &a, sizeof a);
-  std::memcpy(y, &b, sizeof b);
-  x[0] = _mm256_blendv_ps(y[0], x[0], mm[0]);  // a where the mask's sign bit is set (all ones)
-  x[1] = _mm256_blendv_ps(y[1], x[1], mm[1]);
-  Lanes16 out;
-  std::memcpy(&out, x, sizeof out);
-  return out;
-}
-#elif defined(__SSE2__)
+/// Lane-wise comparisons (all ones where true), a bitwise and of two masks, and a select. Where a value
+/// is one register (AVX-512, AVX) the vector operators are one instruction each. In the SSE2 tier's
+/// four registers GCC 12 lowers a comparison or a ?: lane by lane (a scalar compare, a store of each
+/// 32-bit result, then a 128-bit reload that the store buffer cannot forward; measured on an AVX2 EPYC
+/// with 16 lanes in two halves, that made the density and force stages 2-3x slower), so that tier
+/// compares and selects per quarter with the intrinsics. Same NaN semantics as the operators: <, <= are
+/// ordered (false for NaN), != is unordered (true for NaN); the results are bit for bit the operators'.
+#if defined(__SSE2__) && !defined(__AVX__)
 template <class Op>
-inline LaneInts16 Quarters16(Lanes16 a, Lanes16 b, Op op) {
+inline LaneInts Quarters(Lanes a, Lanes b, Op op) {
   __m128 x[4], y[4];
   std::memcpy(x, &a, sizeof a);
   std::memcpy(y, &b, sizeof b);
   for (int k = 0; k < 4; ++k) x[k] = op(x[k], y[k]);
-  LaneInts16 out;
+  LaneInts out;
   std::memcpy(&out, x, sizeof out);
   return out;
 }
-inline LaneInts16 Less16(Lanes16 a, Lanes16 b) { return Quarters16(a, b, [](__m128 x, __m128 y) { return _mm_cmplt_ps(x, y); }); }
-inline LaneInts16 LessEq16(Lanes16 a, Lanes16 b) { return Quarters16(a, b, [](__m128 x, __m128 y) { return _mm_cmple_ps(x, y); }); }
-inline LaneInts16 NotEq16(Lanes16 a, Lanes16 b) { return Quarters16(a, b, [](__m128 x, __m128 y) { return _mm_cmpneq_ps(x, y); }); }
-inline LaneInts16 And16(LaneInts16 a, LaneInts16 b) { return a & b; }
-inline Lanes16 Select16(LaneInts16 m, Lanes16 a, Lanes16 b) {
+inline LaneInts Less(Lanes a, Lanes b) { return Quarters(a, b, [](__m128 x, __m128 y) { return _mm_cmplt_ps(x, y); }); }
+inline LaneInts LessEq(Lanes a, Lanes b) { return Quarters(a, b, [](__m128 x, __m128 y) { return _mm_cmple_ps(x, y); }); }
+inline LaneInts NotEq(Lanes a, Lanes b) { return Quarters(a, b, [](__m128 x, __m128 y) { return _mm_cmpneq_ps(x, y); }); }
+inline LaneInts And(LaneInts a, LaneInts b) { return a & b; }
+inline Lanes Select(LaneInts m, Lanes a, Lanes b) {
   __m128 mm[4], x[4], y[4];
   std::memcpy(mm, &m, sizeof m);
   std::memcpy(x, &a, sizeof a);
   std::memcpy(y, &b, sizeof b);
   for (int k = 0; k < 4; ++k) x[k] = _mm_or_ps(_mm_and_ps(mm[k], x[k]), _mm_andnot_ps(mm[k], y[k]));
-  Lanes16 out;
+  Lanes out;
   std::memcpy(&out, x, sizeof out);
   return out;
 }
 #else
-inline LaneInts16 Less16(Lanes16 a, Lanes16 b) { return a < b; }
-inline LaneInts16 LessEq16(Lanes16 a, Lanes16 b) { return a <= b; }
-inline LaneInts16 NotEq16(Lanes16 a, Lanes16 b) { return a != b; }
-inline LaneInts16 And16(LaneInts16 a, LaneInts16 b) { return a & b; }
-inline Lanes16 Select16(LaneInts16 m, Lanes16 a, Lanes16 b) { return m ? a : b; }
+inline LaneInts Less(Lanes a, Lanes b) { return a < b; }
+inline LaneInts LessEq(Lanes a, Lanes b) { return a <= b; }
+inline LaneInts NotEq(Lanes a, Lanes b) { return a != b; }
+inline LaneInts And(LaneInts a, LaneInts b) { return a & b; }
+inline Lanes Select(LaneInts m, Lanes a, Lanes b) { return m ? a : b; }
 #endif
 
 /// Gathers base[index[l]] into lane l (AVX2 and AVX-512 have a gather instruction).
-inline Lanes16 Gather16(const float* base, LaneInts16 index) {
+inline Lanes Gather(const float* base, LaneInts index) {
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
   // (The masked form with a zero source: GCC 12's _mm512_i32gather_ps trips -Wmaybe-uninitialized.)
-  return reinterpret_cast<Lanes16>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), static_cast<__mmask16>(0xffff),
-                                                            reinterpret_cast<__m512i>(index), base, 4));
+  return reinterpret_cast<Lanes>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), static_cast<__mmask16>(0xffff),
+                                                          reinterpret_cast<__m512i>(index), base, 4));
 #elif defined(__AVX2__)
-  __m256i h[2];
-  std::memcpy(h, &index, sizeof index);
-  __m256 r[2] = {_mm256_i32gather_ps(base, h[0], 4), _mm256_i32gather_ps(base, h[1], 4)};
-  Lanes16 out;
-  std::memcpy(&out, r, sizeof out);
-  return out;
+  return reinterpret_cast<Lanes>(_mm256_i32gather_ps(base, reinterpret_cast<__m256i>(index), 4));
 #else
-  Lanes16 out;
+  Lanes out;
   for (int l = 0; l < kLanes; ++l) out[l] = base[index[l]];
   return out;
 #endif
 }
 
-/// The sum of the 16 lanes, in lane order.
-inline float Sum16(Lanes16 v) {
+/// The sum of the lanes, in lane order.
+inline float SumLanes(Lanes v) {
   float s = 0.0f;
   for (int l = 0; l < kLanes; ++l) s += v[l];
   return s;
@@ -212,16 +177,16 @@ inline float Sum16(Lanes16 v) {
 
 /// CubicSpline::W(r) (kernel.h) in every lane from q = r / H: both pieces, each lane's own, and 0 where
 /// `valid` is off or q >= 1.
-inline Lanes16 KernelW16(const CubicSpline& k, Lanes16 q, LaneInts16 valid) {
-  const Lanes16 t = 1.0f - q;
-  const Lanes16 w = Select16(LessEq16(q, Splat16(0.5f)), k.sigma * (6.0f * (q * q * q - q * q) + 1.0f),
+inline Lanes KernelWLanes(const CubicSpline& k, Lanes q, LaneInts valid) {
+  const Lanes t = 1.0f - q;
+  const Lanes w = Select(LessEq(q, Splat(0.5f)), k.sigma * (6.0f * (q * q * q - q * q) + 1.0f),
                              k.sigma * 2.0f * t * t * t);
-  return Select16(And16(valid, Less16(q, Splat16(1.0f))), w, Splat16(0.0f));
+  return Select(And(valid, Less(q, Splat(1.0f))), w, Splat(0.0f));
 }
 
 /// The pair of cells along x that a density block is drawn from: cells 2m and 2m + 1 of a row, whose
 /// Morton codes differ in the lowest bit only, so their particles are one contiguous run (`first`,
-/// `end`). A block of up to 16 particles from the pair fills the vector better than one cell's ~8, and
+/// `end`). A block of up to kLanes particles from the pair fills the vector better than one cell's ~8, and
 /// the pair's 4 x 3 x 3 cells around it are 36 instead of twice 27.
 struct CellPair {
   int x0, x1;  // the pair's cells along x (x1 == x0 when the grid ends)
@@ -238,7 +203,7 @@ SPHXR_INLINE CellPair PairOf(const GridView& g, int cx, int cy, int cz) {
   return p;
 }
 
-/// Whether particle i starts a block: it is the first of its cell pair, or 16, 32, ... after the first.
+/// Whether particle i starts a block: it is the first of its cell pair, or kLanes, 2 kLanes, ... after it.
 /// Its cell comes from the step's sorted Morton keys (CellCodeStage), not from its position again.
 struct DensityBlockStart {
   GridView grid;
@@ -320,16 +285,16 @@ struct BlockCells {
 
 /// sum_j w_j W(|x_l - x_j|) in every lane l over the particles j of `points` that `cells` reaches, in
 /// its order (w_j = `points[j].w`, or 1 when `weighted` is false). Lanes far away (1e30) never hit.
-inline Lanes16 KernelSum16(const CubicSpline& k, const BlockCells& cells, const uint32_t* start, const uint32_t* end,
-                           const Vec4* points, bool weighted, Lanes16 px, Lanes16 py, Lanes16 pz) {
-  Lanes16 sum = Splat16(0.0f);
+inline Lanes KernelSumLanes(const CubicSpline& k, const BlockCells& cells, const uint32_t* start, const uint32_t* end,
+                           const Vec4* points, bool weighted, Lanes px, Lanes py, Lanes pz) {
+  Lanes sum = Splat(0.0f);
   cells.ForEach(start, end, [&](uint32_t j) {
     const Vec4 pj = points[j];
-    const Lanes16 dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
-    const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
-    const LaneInts16 within = Less16(r2, Splat16(k.H2));
-    if (Bits16(within) == 0) return;
-    const Lanes16 w = KernelW16(k, Sqrt16(r2) * k.invH, within);
+    const Lanes dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
+    const Lanes r2 = dx * dx + dy * dy + dz * dz;
+    const LaneInts within = Less(r2, Splat(k.H2));
+    if (Bits(within) == 0) return;
+    const Lanes w = KernelWLanes(k, Sqrt(r2) * k.invH, within);
     sum += weighted ? pj.w * w : w;
   });
   return sum;
@@ -337,13 +302,13 @@ inline Lanes16 KernelSum16(const CubicSpline& k, const BlockCells& cells, const 
 
 /// CubicSpline::GradFactor in every lane from q = r / H and r (0 where `pair` is off or q >= 1; r > 0
 /// where it is used).
-inline Lanes16 GradFactor16(const CubicSpline& k, Lanes16 q, Lanes16 r, LaneInts16 pair) {
-  const Lanes16 t = 1.0f - q;
-  return Select16(And16(pair, Less16(q, Splat16(1.0f))),
-                  Select16(LessEq16(q, Splat16(0.5f)), k.gradA * (3.0f * q - 2.0f), -k.gradB * t * t / r), Splat16(0.0f));
+inline Lanes GradFactorLanes(const CubicSpline& k, Lanes q, Lanes r, LaneInts pair) {
+  const Lanes t = 1.0f - q;
+  return Select(And(pair, Less(q, Splat(1.0f))),
+                  Select(LessEq(q, Splat(0.5f)), k.gradA * (3.0f * q - 2.0f), -k.gradB * t * t / r), Splat(0.0f));
 }
 
-/// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to 16
+/// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to kLanes
 /// particles or the end of its cell pair). With reuse (`idle` set), only the lanes that compute this
 /// step (ComputesThisStep) are written; a block without one costs nothing. The walls' sums
 /// (DensityStage::WallSum) are taken the same way, for the lanes whose cell has wall particles around.
@@ -368,7 +333,7 @@ struct DensityBlockStage {
     }
     if (computing == 0) return;
 
-    Lanes16 px = Splat16(1e30f), py = px, pz = px;
+    Lanes px = Splat(1e30f), py = px, pz = px;
     uint32_t found[kLanes] = {};
     BlockCells cells(g, pair.x0, pair.x1, cy, cz);
     for (int l = 0; l < kLanes; ++l) {
@@ -381,16 +346,16 @@ struct DensityBlockStage {
       }  // other lanes stay far away, never a hit (their squared distance overflows to +inf)
     }
     const CubicSpline k = stage.ph.kernel;
-    Lanes16 sum = Splat16(0.0f);
+    Lanes sum = Splat(0.0f);
     const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
     cells.ForEach(g.fluidStart, g.fluidEnd, [&](uint32_t j) {
       const Vec4 pj = position[j];
-      const Lanes16 dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
-      const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts16 within = Less16(r2, Splat16(k.H2));
-      uint32_t hits = Bits16(within);
+      const Lanes dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
+      const Lanes r2 = dx * dx + dy * dy + dz * dz;
+      const LaneInts within = Less(r2, Splat(k.H2));
+      uint32_t hits = Bits(within);
       if (hits == 0) return;
-      sum += KernelW16(k, Sqrt16(r2) * k.invH, within);
+      sum += KernelWLanes(k, Sqrt(r2) * k.invH, within);
       while (hits != 0) {  // the neighbour lists: every hit but the particle itself
         const int l = __builtin_ctz(hits);
         hits &= hits - 1u;
@@ -402,10 +367,10 @@ struct DensityBlockStage {
     });
     // The walls: the lanes whose own cell has a wall particle in its 27 cells (WallSum's test); the
     // others keep 0, as WallSum gives them.
-    Lanes16 wall = Splat16(0.0f);
+    Lanes wall = Splat(0.0f);
     const bool near0 = g.boundaryNear[g.Linear(pair.x0, cy, cz)] != 0, near1 = g.boundaryNear[g.Linear(pair.x1, cy, cz)] != 0;
     if (near0 || near1) {
-      Lanes16 wx = px, wy = py, wz = pz;
+      Lanes wx = px, wy = py, wz = pz;
       if (!(near0 && near1)) {
         for (int l = 0; l < kLanes; ++l) {
           if (!(computing & (1u << l))) continue;
@@ -414,7 +379,7 @@ struct DensityBlockStage {
           if (!g.boundaryNear[g.Linear(lx, ly, lz)]) wx[l] = wy[l] = wz[l] = 1e30f;
         }
       }
-      wall = KernelSum16(k, cells, g.boundaryStart, g.boundaryEnd, g.boundary, true, wx, wy, wz);
+      wall = KernelSumLanes(k, cells, g.boundaryStart, g.boundaryEnd, g.boundary, true, wx, wy, wz);
     }
     for (int l = 0; l < lanes; ++l) {
       if (computing & (1u << l)) {
@@ -424,9 +389,9 @@ struct DensityBlockStage {
   }
 };
 
-/// ForceStage for particle i with its fluid neighbours summed 16 at a time from the neighbour list
-/// (a list that overflowed falls back to ForceStage's own cell scan), and its wall particles 16 at a
-/// time from its cells (ForceStage::End's wall terms).
+/// ForceStage for particle i with its fluid neighbours summed kLanes at a time from the neighbour list
+/// (a list that overflowed falls back to ForceStage's own cell scan), and its wall particles kLanes at
+/// a time from its cells (ForceStage::End's wall terms).
 struct ForceListStage {
   ForceStage stage;
 
@@ -447,77 +412,77 @@ struct ForceListStage {
     const float* position = reinterpret_cast<const float*>(f.position);  // Vec4: x y z w
     const float* velocity = reinterpret_cast<const float*>(f.velocity);
     const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(capacity);
-    const Lanes16 zero = Splat16(0.0f);
-    Lanes16 ax = zero, ay = zero, az = zero, pSum = zero, wSum = zero;
+    const Lanes zero = Splat(0.0f);
+    Lanes ax = zero, ay = zero, az = zero, pSum = zero, wSum = zero;
     for (uint32_t base = 0; base < found; base += kLanes) {
-      LaneInts16 index;
+      LaneInts index;
       for (int l = 0; l < kLanes; ++l) {
         // Lanes past the list read particle i itself: r2 = 0, which the pair test excludes.
         index[l] = static_cast<int32_t>(base + static_cast<uint32_t>(l) < found ? slots[base + l] : static_cast<uint32_t>(i));
       }
-      const LaneInts16 at = index * 4;
-      const Lanes16 dx = P.xi.x - Gather16(position, at), dy = P.xi.y - Gather16(position + 1, at),
-                    dz = P.xi.z - Gather16(position + 2, at);
-      const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts16 pair = And16(Less16(r2, Splat16(k.H2)), NotEq16(r2, zero));
-      if (Bits16(pair) == 0) continue;
-      const Lanes16 rhoj = Gather16(f.density, index);
-      const Lanes16 r = Sqrt16(r2);
-      const Lanes16 q = r * k.invH;
-      const Lanes16 grad = GradFactor16(k, q, r, pair);
+      const LaneInts at = index * 4;
+      const Lanes dx = P.xi.x - Gather(position, at), dy = P.xi.y - Gather(position + 1, at),
+                    dz = P.xi.z - Gather(position + 2, at);
+      const Lanes r2 = dx * dx + dy * dy + dz * dz;
+      const LaneInts pair = And(Less(r2, Splat(k.H2)), NotEq(r2, zero));
+      if (Bits(pair) == 0) continue;
+      const Lanes rhoj = Gather(f.density, index);
+      const Lanes r = Sqrt(r2);
+      const Lanes q = r * k.invH;
+      const Lanes grad = GradFactorLanes(k, q, r, pair);
       if (P.shepard) {  // CubicSpline::W / rho_j
-        const Lanes16 wj = KernelW16(k, q, pair) / rhoj;
-        pSum += Gather16(f.pressure, index) * wj;
+        const Lanes wj = KernelWLanes(k, q, pair) / rhoj;
+        pSum += Gather(f.pressure, index) * wj;
         wSum += wj;
       }
-      Lanes16 term = P.pTermI + Gather16(f.pressureTerm, index);
-      const Lanes16 vx = (P.vi.x - Gather16(velocity, at)) * dx + (P.vi.y - Gather16(velocity + 1, at)) * dy +
-                         (P.vi.z - Gather16(velocity + 2, at)) * dz;
-      term = Select16(Less16(vx, zero), term - viscFluid * vx / ((r2 + eps) * (P.rhoi + rhoj)), term);
-      const Lanes16 s = ph.mass * term * grad;
+      Lanes term = P.pTermI + Gather(f.pressureTerm, index);
+      const Lanes vx = (P.vi.x - Gather(velocity, at)) * dx + (P.vi.y - Gather(velocity + 1, at)) * dy +
+                         (P.vi.z - Gather(velocity + 2, at)) * dz;
+      term = Select(Less(vx, zero), term - viscFluid * vx / ((r2 + eps) * (P.rhoi + rhoj)), term);
+      const Lanes s = ph.mass * term * grad;
       ax -= dx * s;
       ay -= dy * s;
       az -= dz * s;
     }
     if (P.shepard) {
-      P.pAverage += Sum16(pSum);
-      P.weight += Sum16(wSum);
+      P.pAverage += SumLanes(pSum);
+      P.weight += SumLanes(wSum);
     }
     if (P.nearWall) Walls(P, &ax, &ay, &az);
-    stage.Store(i, P, Vec3{Sum16(ax), Sum16(ay), Sum16(az)});
+    stage.Store(i, P, Vec3{SumLanes(ax), SumLanes(ay), SumLanes(az)});
   }
 
   /// ForceStage::End's wall terms, added into the lanes: the wall particles of i's cells (its own
-  /// ForEachInCells scan) collected 16 at a time.
-  void Walls(const ForceParticle& P, Lanes16* ax, Lanes16* ay, Lanes16* az) const {
+  /// ForEachInCells scan) collected kLanes at a time.
+  void Walls(const ForceParticle& P, Lanes* ax, Lanes* ay, Lanes* az) const {
     const GridView& g = stage.grid;
     const Physics& ph = stage.ph;
     const CubicSpline k = ph.kernel;
     const float eps = 0.01f * ph.smoothing * ph.smoothing;
     const ForceStage::WallTerms w = stage.Walls(P);
     const float* boundary = reinterpret_cast<const float*>(g.boundary);  // Vec4: x y z Psi
-    const Lanes16 zero = Splat16(0.0f);
-    Lanes16 laneNumber;
+    const Lanes zero = Splat(0.0f);
+    Lanes laneNumber;
     for (int l = 0; l < kLanes; ++l) laneNumber[l] = static_cast<float>(l);
-    LaneInts16 index;
+    LaneInts index;
     int n = 0;
     auto flush = [&]() {
       for (int l = n; l < kLanes; ++l) index[l] = index[0];  // padding, masked off below
-      const LaneInts16 at = index * 4;
-      const Lanes16 dx = P.xi.x - Gather16(boundary, at), dy = P.xi.y - Gather16(boundary + 1, at),
-                    dz = P.xi.z - Gather16(boundary + 2, at);
-      const Lanes16 r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts16 pair = And16(And16(Less16(r2, Splat16(k.H2)), NotEq16(r2, zero)),
-                                    Less16(laneNumber, Splat16(static_cast<float>(n))));
+      const LaneInts at = index * 4;
+      const Lanes dx = P.xi.x - Gather(boundary, at), dy = P.xi.y - Gather(boundary + 1, at),
+                    dz = P.xi.z - Gather(boundary + 2, at);
+      const Lanes r2 = dx * dx + dy * dy + dz * dz;
+      const LaneInts pair = And(And(Less(r2, Splat(k.H2)), NotEq(r2, zero)),
+                                    Less(laneNumber, Splat(static_cast<float>(n))));
       n = 0;
-      if (Bits16(pair) == 0) return;
-      const Lanes16 r = Sqrt16(r2);
-      const Lanes16 grad = GradFactor16(k, r * k.invH, r, pair);
-      Lanes16 term = ph.wallDensity ? ph.boundaryGradScale * (P.pTermI + Gather16(g.boundaryPressureTerm, index))
-                                    : Splat16(w.pressureTerm);
-      const Lanes16 vx = P.vi.x * dx + P.vi.y * dy + P.vi.z * dz;  // static walls: v_b = 0
-      term = Select16(Less16(vx, zero), term - Gather16(g.boundaryAlpha, index) * w.viscosity * vx / (r2 + eps), term);
-      const Lanes16 s = Gather16(boundary + 3, at) * term * grad;
+      if (Bits(pair) == 0) return;
+      const Lanes r = Sqrt(r2);
+      const Lanes grad = GradFactorLanes(k, r * k.invH, r, pair);
+      Lanes term = ph.wallDensity ? ph.boundaryGradScale * (P.pTermI + Gather(g.boundaryPressureTerm, index))
+                                    : Splat(w.pressureTerm);
+      const Lanes vx = P.vi.x * dx + P.vi.y * dy + P.vi.z * dz;  // static walls: v_b = 0
+      term = Select(Less(vx, zero), term - Gather(g.boundaryAlpha, index) * w.viscosity * vx / (r2 + eps), term);
+      const Lanes s = Gather(boundary + 3, at) * term * grad;
       *ax -= dx * s;
       *ay -= dy * s;
       *az -= dz * s;
@@ -530,7 +495,7 @@ struct ForceListStage {
   }
 };
 
-/// WallPressureStage for the wall particles of cell `cells[k]`, 16 at a time: each lane's kernel sum
+/// WallPressureStage for the wall particles of cell `cells[k]`, kLanes at a time: each lane's kernel sum
 /// over the fluid around the cell, in the order of its own scan.
 struct WallPressureBlockStage {
   WallPressureStage stage;
@@ -548,7 +513,7 @@ struct WallPressureBlockStage {
     const int cz = static_cast<int>(c / (static_cast<uint32_t>(g.nx) * static_cast<uint32_t>(g.ny)));
     for (uint32_t first = s; first < e; first += kLanes) {
       const int lanes = static_cast<int>(e - first < static_cast<uint32_t>(kLanes) ? e - first : kLanes);
-      Lanes16 px = Splat16(1e30f), py = px, pz = px;
+      Lanes px = Splat(1e30f), py = px, pz = px;
       BlockCells cells(g, cx, cx, cy, cz);
       for (int l = 0; l < lanes; ++l) {
         const Vec4 p = g.boundary[first + l];
@@ -557,7 +522,7 @@ struct WallPressureBlockStage {
         pz[l] = p.z;
         cells.Add(p);
       }
-      const Lanes16 sum = KernelSum16(stage.ph.kernel, cells, g.fluidStart, g.fluidEnd, stage.fluid.position, false, px, py, pz);
+      const Lanes sum = KernelSumLanes(stage.ph.kernel, cells, g.fluidStart, g.fluidEnd, stage.fluid.position, false, px, py, pz);
       for (int l = 0; l < lanes; ++l) stage.out[first + l] = stage.FromSum(static_cast<int>(first) + l, sum[l]);
     }
   }
