@@ -157,7 +157,7 @@ class BackendImpl final : public Backend {
     if (physics.wallDensity && !m_wallCells.empty()) {
       const WallPressureStage wallPressure{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)};
       const int wallCells = static_cast<int>(m_wallCells.size());
-      if constexpr (Traits::kSimdStages) {  // the CPU: 16 wall particles of a cell at once (cpu_stages.h)
+      if constexpr (Traits::kSimdStages) {  // the CPU: kLanes wall particles of a cell at once (cpu_stages.h)
         thrust::for_each_n(policy, first, wallCells, typename Traits::WallPressureBlockStage{wallPressure});
       } else {
         thrust::for_each_n(policy, first, wallCells, wallPressure);

@@ -1,7 +1,7 @@
 #pragma once
 // The CPU backend's SIMD traversals of the density and force stages (host-only; the CUDA backend runs
 // stages.h's DensityStage and ForceStage, a thread per particle). The physics is stages.h's: these
-// only arrange the same sums for vector units (kLanes wide: 16 with AVX-512, 8 with AVX).
+// only arrange the same sums for vector units (kLanes wide: 8 with AVX, else 16; see kLanes).
 //
 // Density (DensityBlockStage): one work item per block of up to kLanes particles of a pair of grid cells
 // along x (particles are sorted by Morton code, so a pair is a contiguous run). Each candidate j of the cells around
@@ -52,11 +52,11 @@
 namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {
 
-// Lanes per SIMD value: one register of the widest unit where there is one (AVX-512: 16, AVX: 8),
-// else 16 in four SSE2 registers or in scalars. Measured on an AVX2 AMD EPYC (docs/performance.md,
+// Lanes per SIMD value: one register of the widest unit where there is one (AVX-512 with DQ: 16;
+// AVX or AVX2, and AVX-512 without DQ: 8), else 16 in four SSE2 registers or in scalars. Measured on an AVX2 AMD EPYC (docs/performance.md,
 // "AVX2 machines"): 16 lanes in two 256-bit halves left the values spilling (16 ymm registers hold
 // eight of them) and every comparison, select and gather split in two; eight lanes in one register
-// made the whole step 1.23-1.3x faster, although a density block then holds 8 particles instead of 16.
+// made the whole step 1.23-1.4x faster, although a density block then holds 8 particles instead of 16.
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
 inline constexpr int kLanes = 16;
 #define SPHXR_LANE_BYTES 64
@@ -114,7 +114,8 @@ inline uint32_t Bits(LaneInts c) {
 }
 
 /// Lane-wise comparisons (all ones where true), a bitwise and of two masks, and a select. Where a value
-/// is one register (AVX-512, AVX) the vector operators are one instruction each. In the SSE2 tier's
+/// is one register (AVX-512, AVX) the float operators are one instruction each (AVX without AVX2
+/// splits the integer ones, a cost in speed only). In the SSE2 tier's
 /// four registers GCC 12 lowers a comparison or a ?: lane by lane (a scalar compare, a store of each
 /// 32-bit result, then a 128-bit reload that the store buffer cannot forward; measured on an AVX2 EPYC
 /// with 16 lanes in two halves, that made the density and force stages 2-3x slower), so that tier
@@ -186,8 +187,9 @@ inline Lanes KernelWLanes(const CubicSpline& k, Lanes q, LaneInts valid) {
 
 /// The pair of cells along x that a density block is drawn from: cells 2m and 2m + 1 of a row, whose
 /// Morton codes differ in the lowest bit only, so their particles are one contiguous run (`first`,
-/// `end`). A block of up to kLanes particles from the pair fills the vector better than one cell's ~8, and
-/// the pair's 4 x 3 x 3 cells around it are 36 instead of twice 27.
+/// `end`). With 16 lanes a block from the pair fills the vector better than one cell's ~8; with 8 a
+/// pair's run still gives fewer part-filled blocks than each cell alone, and the pair's 4 x 3 x 3 cells
+/// around it are 36 instead of twice 27.
 struct CellPair {
   int x0, x1;  // the pair's cells along x (x1 == x0 when the grid ends)
   uint32_t first, end;
@@ -527,6 +529,8 @@ struct WallPressureBlockStage {
     }
   }
 };
+
+#undef SPHXR_LANE_BYTES
 
 }  // namespace SPHXR_CPU_TIER
 }  // namespace sphxr::sim

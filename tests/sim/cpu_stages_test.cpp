@@ -1,7 +1,7 @@
 // The CPU backend's SIMD stages (sim/src/cpu_stages.h) against the per-particle stages of stages.h (the
 // CUDA backend's) and against brute-force O(n^2) sums in double. Density blocks: the same neighbour
 // lists in the same order, the same densities to float rounding, on random, clustered, cell-border and
-// over-full sets (more than 16 particles in a cell, more neighbours than list slots), with and without
+// over-full sets (more than kLanes particles in a cell, more neighbours than list slots), with and without
 // reuse masking some particles out, and with walls (their kernel sums). Forces: the neighbour-list sum
 // and the wall terms (mirrored and wall density). Wall pressure: the blocks of 16 wall particles.
 #include <gtest/gtest.h>
@@ -292,7 +292,8 @@ std::vector<Vec3> Random(size_t n, float lo, float hi, unsigned seed, float hiX 
 }
 
 /// ForceListStage against ForceStage and against the pair terms summed in double, on the densities
-/// and lists the blocked density stage left (no walls, no gravity: the fluid pair terms alone).
+/// and lists the blocked density stage left (no gravity; the particles away from walls against the
+/// fluid pair terms alone in double, those near walls against ForceStage only).
 void CompareForces(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what,
                    const std::vector<Vec3>& walls = {}, bool wallDensity = false) {
   SCOPED_TRACE(what);
@@ -366,7 +367,7 @@ TEST(CpuStages, ForcesNearMirroredWallsMatchPerParticle) {
 
 TEST(CpuStages, ForcesNearWallsWithTheirOwnDensityMatchPerParticle) {
   // Wall density: each wall particle's own p_b/rho_b^2 in the pair term; a floor, a side wall and a
-  // dense patch (more wall candidates than one batch of 16 per particle).
+  // dense patch (more wall candidates than one batch of kLanes per particle).
   const WallScene scene;
   CompareForces(scene.water, 64, "wall density", scene.walls, /*wallDensity=*/true);
   CompareForces(scene.water, 64, "mirrored, side wall and dense patch", scene.walls);
