@@ -287,19 +287,27 @@ struct BlockCells {
 
 /// sum_j w_j W(|x_l - x_j|) in every lane l over the particles j of `points` that `cells` reaches, in
 /// its order (w_j = `points[j].w`, or 1 when `weighted` is false). Lanes far away (1e30) never hit.
+/// onHits(j, bits) sees each candidate within some lane's support (bit l: lane l).
+template <class OnHits>
 inline Lanes KernelSumLanes(const CubicSpline& k, const BlockCells& cells, const uint32_t* start, const uint32_t* end,
-                           const Vec4* points, bool weighted, Lanes px, Lanes py, Lanes pz) {
+                            const Vec4* points, bool weighted, Lanes px, Lanes py, Lanes pz, OnHits&& onHits) {
   Lanes sum = Splat(0.0f);
   cells.ForEach(start, end, [&](uint32_t j) {
     const Vec4 pj = points[j];
     const Lanes dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
     const Lanes r2 = dx * dx + dy * dy + dz * dz;
     const LaneInts within = Less(r2, Splat(k.H2));
-    if (Bits(within) == 0) return;
+    const uint32_t hits = Bits(within);
+    if (hits == 0) return;
     const Lanes w = KernelWLanes(k, Sqrt(r2) * k.invH, within);
     sum += weighted ? pj.w * w : w;
+    onHits(j, hits);
   });
   return sum;
+}
+inline Lanes KernelSumLanes(const CubicSpline& k, const BlockCells& cells, const uint32_t* start, const uint32_t* end,
+                            const Vec4* points, bool weighted, Lanes px, Lanes py, Lanes pz) {
+  return KernelSumLanes(k, cells, start, end, points, weighted, px, py, pz, [](uint32_t, uint32_t) {});
 }
 
 /// CubicSpline::GradFactor in every lane from q = r / H and r (0 where `pair` is off or q >= 1; r > 0
@@ -348,16 +356,9 @@ struct DensityBlockStage {
       }  // other lanes stay far away, never a hit (their squared distance overflows to +inf)
     }
     const CubicSpline k = stage.ph.kernel;
-    Lanes sum = Splat(0.0f);
     const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
-    cells.ForEach(g.fluidStart, g.fluidEnd, [&](uint32_t j) {
-      const Vec4 pj = position[j];
-      const Lanes dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
-      const Lanes r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts within = Less(r2, Splat(k.H2));
-      uint32_t hits = Bits(within);
-      if (hits == 0) return;
-      sum += KernelWLanes(k, Sqrt(r2) * k.invH, within);
+    const Lanes sum = KernelSumLanes(k, cells, g.fluidStart, g.fluidEnd, position, false, px, py, pz,
+                                     [&](uint32_t j, uint32_t hits) {
       while (hits != 0) {  // the neighbour lists: every hit but the particle itself
         const int l = __builtin_ctz(hits);
         hits &= hits - 1u;
@@ -510,9 +511,8 @@ struct WallPressureBlockStage {
       for (uint32_t b = s; b < e; ++b) stage.out[b] = 0.0f;
       return;
     }
-    const int cx = static_cast<int>(c % static_cast<uint32_t>(g.nx));
-    const int cy = static_cast<int>((c / static_cast<uint32_t>(g.nx)) % static_cast<uint32_t>(g.ny));
-    const int cz = static_cast<int>(c / (static_cast<uint32_t>(g.nx) * static_cast<uint32_t>(g.ny)));
+    int cx, cy, cz;
+    g.CellCoords(static_cast<int>(c), &cx, &cy, &cz);
     for (uint32_t first = s; first < e; first += kLanes) {
       const int lanes = static_cast<int>(e - first < static_cast<uint32_t>(kLanes) ? e - first : kLanes);
       Lanes px = Splat(1e30f), py = px, pz = px;

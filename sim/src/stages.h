@@ -94,6 +94,12 @@ struct GridView {
   SPHXR_HD SPHXR_INLINE uint32_t Linear(int cx, int cy, int cz) const {
     return static_cast<uint32_t>(cx + nx * (cy + ny * cz));
   }
+  /// The cell coordinates of linear index c (Linear's inverse).
+  SPHXR_HD SPHXR_INLINE void CellCoords(int c, int* cx, int* cy, int* cz) const {
+    *cx = c % nx;
+    *cy = (c / nx) % ny;
+    *cz = c / (nx * ny);
+  }
 };
 
 /// Calls f(j, xi - xj) for every particle j of `points` (ranges start/end) in the 27 cells around xi.
@@ -223,7 +229,8 @@ struct CellRangeStage {
 // ---- cells near the boundary (once): any boundary particle in the 27 cells around cell c ------------
 /// Whether any of the 27 cells around linear cell c (within the grid) is non-empty in `start`.
 SPHXR_HD SPHXR_INLINE bool AnyInNeighbourCells(const GridView& grid, const uint32_t* start, int c) {
-  const int cx = c % grid.nx, cy = (c / grid.nx) % grid.ny, cz = c / (grid.nx * grid.ny);
+  int cx, cy, cz;
+  grid.CellCoords(c, &cx, &cy, &cz);
   bool any = false;
   for (int z = cz - 1; z <= cz + 1; ++z)
     for (int y = cy - 1; y <= cy + 1; ++y)

@@ -156,8 +156,8 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   //   to the 0.1, the maximum loosened to 0.3 spacing: this case measures the plain solver from
   //   the lattice, which the bound is not about. Loosened again to 0.4 on 2026-12-01: with the
   //   CPU stages' force sums in eight lanes (another rounding, another trajectory) one rattling
-  //   particle moved 0.317 spacing in the window on the AVX2 EPYC, the median stayed under 0.1. Why it rattles: the simple cubic start is not a
-  //   stable rest state under pressure (bench/lattice_stability.py), nor is the free surface of the
+  //   particle moved 0.317 spacing in the window on the AVX2 EPYC, the median stayed under 0.1.
+  //   Why it rattles: the simple cubic start is not a stable rest state under pressure (bench/lattice_stability.py), nor is the free surface of the
   //   lattice (bench/surface_stability.py), so the water keeps sliding into lower-energy arrangements
   //   (docs/physics.md, "Why still water rattles" and the ninth session).
   // - mirrored (the default elsewhere): the wall pressure p_b = p_i is not the derivative of any energy
