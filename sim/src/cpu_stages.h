@@ -29,6 +29,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #if defined(__AVX512F__) || defined(__AVX__) || defined(__SSE2__)
 #include <immintrin.h>
@@ -154,19 +155,52 @@ inline LaneInts And(LaneInts a, LaneInts b) { return a & b; }
 inline Lanes Select(LaneInts m, Lanes a, Lanes b) { return m ? a : b; }
 #endif
 
-/// Gathers base[index[l]] into lane l (AVX2 and AVX-512 have a gather instruction).
+/// Gathers base[index[l]] into lane l (with AVX-512's gather instruction).
 inline Lanes Gather(const float* base, LaneInts index) {
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
   // (The masked form with a zero source: GCC 12's _mm512_i32gather_ps trips -Wmaybe-uninitialized.)
   return reinterpret_cast<Lanes>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), static_cast<__mmask16>(0xffff),
                                                           reinterpret_cast<__m512i>(index), base, 4));
-#elif defined(__AVX2__)
-  return reinterpret_cast<Lanes>(_mm256_i32gather_ps(base, reinterpret_cast<__m256i>(index), 4));
+#elif defined(__AVX__)
+  // Eight loads put together in registers, not AVX2's gather instruction: on the AVX2 EPYC (Zen 3) the
+  // force stage is 1.1-1.15x faster so (docs/performance.md, "Transposed loads").
+  return reinterpret_cast<Lanes>(_mm256_set_ps(base[index[7]], base[index[6]], base[index[5]], base[index[4]],
+                                               base[index[3]], base[index[2]], base[index[1]], base[index[0]]));
 #else
   Lanes out;
   for (int l = 0; l < kLanes; ++l) out[l] = base[index[l]];
   return out;
 #endif
+}
+
+/// x, y, z (and w, where asked for) of the Vec4s base[index[l]] (base: x y z w per point) into lane l:
+/// the same values as Gathers of base, base + 1, ... at index * 4. On AVX the eight points are loaded
+/// whole (16 bytes each, two to a register) and transposed in registers, 8 loads and 7-8 shuffles instead
+/// of three or four gather instructions, whose latency the force loop waited on (AVX2 EPYC: the force
+/// stage 1.6-2x faster, docs/performance.md "Transposed loads").
+inline void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z, Lanes* w) {
+#if defined(__AVX__) && !defined(__AVX512DQ__)
+  auto row = [&](int l) {  // points l and l + 4 in the low and high halves
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + 4 * static_cast<ptrdiff_t>(index[l]))),
+                                _mm_loadu_ps(base + 4 * static_cast<ptrdiff_t>(index[l + 4])), 1);
+  };
+  const __m256 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);  // x0 x1 y0 y1 | x2 x3 y2 y3
+  const __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);  // z0 z1 w0 w1 | z2 z3 w2 w3
+  *x = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0)));
+  *y = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2)));
+  *z = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+  if (w) *w = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+#else
+  const LaneInts at = index * 4;
+  *x = Gather(base, at);
+  *y = Gather(base + 1, at);
+  *z = Gather(base + 2, at);
+  if (w) *w = Gather(base + 3, at);
+#endif
+}
+inline void GatherXyz(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z) {
+  GatherXyzw(base, index, x, y, z, nullptr);
 }
 
 /// The sum of the lanes, in lane order.
@@ -287,7 +321,7 @@ struct BlockCells {
 
 /// sum_j w_j W(|x_l - x_j|) in every lane l over the particles j of `points` that `cells` reaches, in
 /// its order (w_j = `points[j].w`, or 1 when `weighted` is false). Lanes far away (1e30) never hit.
-/// onHits(j, bits) sees each candidate within some lane's support (bit l: lane l).
+/// onHits(j, within) sees each candidate within some lane's support (within: all ones in those lanes).
 template <class OnHits>
 inline Lanes KernelSumLanes(const CubicSpline& k, const BlockCells& cells, const uint32_t* start, const uint32_t* end,
                             const Vec4* points, bool weighted, Lanes px, Lanes py, Lanes pz, OnHits&& onHits) {
@@ -297,17 +331,16 @@ inline Lanes KernelSumLanes(const CubicSpline& k, const BlockCells& cells, const
     const Lanes dx = px - pj.x, dy = py - pj.y, dz = pz - pj.z;
     const Lanes r2 = dx * dx + dy * dy + dz * dz;
     const LaneInts within = Less(r2, Splat(k.H2));
-    const uint32_t hits = Bits(within);
-    if (hits == 0) return;
+    if (Bits(within) == 0) return;
     const Lanes w = KernelWLanes(k, Sqrt(r2) * k.invH, within);
     sum += weighted ? pj.w * w : w;
-    onHits(j, hits);
+    onHits(j, within);
   });
   return sum;
 }
 inline Lanes KernelSumLanes(const CubicSpline& k, const BlockCells& cells, const uint32_t* start, const uint32_t* end,
                             const Vec4* points, bool weighted, Lanes px, Lanes py, Lanes pz) {
-  return KernelSumLanes(k, cells, start, end, points, weighted, px, py, pz, [](uint32_t, uint32_t) {});
+  return KernelSumLanes(k, cells, start, end, points, weighted, px, py, pz, [](uint32_t, LaneInts) {});
 }
 
 /// CubicSpline::GradFactor in every lane from q = r / H and r (0 where `pair` is off or q >= 1; r > 0
@@ -344,7 +377,6 @@ struct DensityBlockStage {
     if (computing == 0) return;
 
     Lanes px = Splat(1e30f), py = px, pz = px;
-    uint32_t found[kLanes] = {};
     BlockCells cells(g, pair.x0, pair.x1, cy, cz);
     for (int l = 0; l < kLanes; ++l) {
       if (computing & (1u << l)) {
@@ -356,18 +388,37 @@ struct DensityBlockStage {
       }  // other lanes stay far away, never a hit (their squared distance overflows to +inf)
     }
     const CubicSpline k = stage.ph.kernel;
+    // The neighbour lists, without a branch per hit: every candidate that hits some lane is written to
+    // every lane's list at that lane's count, and the count moves on where it is a neighbour (a hit that
+    // is not the particle itself), so the next candidate overwrites the others. A lane writes into a
+    // scratch list with one spare slot (where it writes once its list is full: the count goes on, past
+    // the capacity, and the force stage then scans); the lists are copied out at the end. Before (one
+    // store per set bit, the counts in memory) the appends were ~35 % of the stage on the AVX2 EPYC.
     const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
+    const uint32_t stride = capacity + 1;
+    thread_local std::vector<uint32_t> scratch;
+    if (scratch.size() < static_cast<size_t>(kLanes) * stride) scratch.resize(static_cast<size_t>(kLanes) * stride);
+    uint32_t* const lists = scratch.data();
+    LaneInts laneList, self, count = LaneInts{};
+    for (int l = 0; l < kLanes; ++l) {
+      laneList[l] = static_cast<int32_t>(static_cast<uint32_t>(l) * stride);
+      self[l] = static_cast<int32_t>(first + static_cast<uint32_t>(l));
+    }
+    const LaneInts full = LaneInts{} + static_cast<int32_t>(capacity);
     const Lanes sum = KernelSumLanes(k, cells, g.fluidStart, g.fluidEnd, position, false, px, py, pz,
-                                     [&](uint32_t j, uint32_t hits) {
-      while (hits != 0) {  // the neighbour lists: every hit but the particle itself
-        const int l = __builtin_ctz(hits);
-        hits &= hits - 1u;
-        const uint32_t i = first + static_cast<uint32_t>(l);
-        if (j == i) continue;
-        if (found[l] < capacity) stage.Slots(static_cast<int>(i))[found[l]] = j;
-        ++found[l];
-      }
+                                     [&](uint32_t j, LaneInts within) {
+      const LaneInts at = laneList + (count < full ? count : full);
+      for (int l = 0; l < kLanes; ++l) lists[at[l]] = j;
+      count -= within & (self != static_cast<int32_t>(j));  // -1 where a neighbour: the count + 1
     });
+    uint32_t found[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      found[l] = static_cast<uint32_t>(count[l]);
+      if (computing & (1u << l)) {
+        const uint32_t n = found[l] < capacity ? found[l] : capacity;
+        std::memcpy(stage.Slots(static_cast<int>(first) + l), lists + static_cast<size_t>(l) * stride, n * sizeof(uint32_t));
+      }
+    }
     // The walls: the lanes whose own cell has a wall particle in its 27 cells (WallSum's test); the
     // others keep 0, as WallSum gives them.
     Lanes wall = Splat(0.0f);
@@ -423,9 +474,9 @@ struct ForceListStage {
         // Lanes past the list read particle i itself: r2 = 0, which the pair test excludes.
         index[l] = static_cast<int32_t>(base + static_cast<uint32_t>(l) < found ? slots[base + l] : static_cast<uint32_t>(i));
       }
-      const LaneInts at = index * 4;
-      const Lanes dx = P.xi.x - Gather(position, at), dy = P.xi.y - Gather(position + 1, at),
-                    dz = P.xi.z - Gather(position + 2, at);
+      Lanes xj, yj, zj;
+      GatherXyz(position, index, &xj, &yj, &zj);
+      const Lanes dx = P.xi.x - xj, dy = P.xi.y - yj, dz = P.xi.z - zj;
       const Lanes r2 = dx * dx + dy * dy + dz * dz;
       const LaneInts pair = And(Less(r2, Splat(k.H2)), NotEq(r2, zero));
       if (Bits(pair) == 0) continue;
@@ -439,8 +490,9 @@ struct ForceListStage {
         wSum += wj;
       }
       Lanes term = P.pTermI + Gather(f.pressureTerm, index);
-      const Lanes vx = (P.vi.x - Gather(velocity, at)) * dx + (P.vi.y - Gather(velocity + 1, at)) * dy +
-                         (P.vi.z - Gather(velocity + 2, at)) * dz;
+      Lanes ux, uy, uz;
+      GatherXyz(velocity, index, &ux, &uy, &uz);
+      const Lanes vx = (P.vi.x - ux) * dx + (P.vi.y - uy) * dy + (P.vi.z - uz) * dz;
       term = Select(Less(vx, zero), term - viscFluid * vx / ((r2 + eps) * (P.rhoi + rhoj)), term);
       const Lanes s = ph.mass * term * grad;
       ax -= dx * s;
@@ -471,9 +523,9 @@ struct ForceListStage {
     int n = 0;
     auto flush = [&]() {
       for (int l = n; l < kLanes; ++l) index[l] = index[0];  // padding, masked off below
-      const LaneInts at = index * 4;
-      const Lanes dx = P.xi.x - Gather(boundary, at), dy = P.xi.y - Gather(boundary + 1, at),
-                    dz = P.xi.z - Gather(boundary + 2, at);
+      Lanes xb, yb, zb, psi;
+      GatherXyzw(boundary, index, &xb, &yb, &zb, &psi);
+      const Lanes dx = P.xi.x - xb, dy = P.xi.y - yb, dz = P.xi.z - zb;
       const Lanes r2 = dx * dx + dy * dy + dz * dz;
       const LaneInts pair = And(And(Less(r2, Splat(k.H2)), NotEq(r2, zero)),
                                     Less(laneNumber, Splat(static_cast<float>(n))));
@@ -485,7 +537,7 @@ struct ForceListStage {
                                     : Splat(w.pressureTerm);
       const Lanes vx = P.vi.x * dx + P.vi.y * dy + P.vi.z * dz;  // static walls: v_b = 0
       term = Select(Less(vx, zero), term - Gather(g.boundaryAlpha, index) * w.viscosity * vx / (r2 + eps), term);
-      const Lanes s = Gather(boundary + 3, at) * term * grad;
+      const Lanes s = psi * term * grad;
       *ax -= dx * s;
       *ay -= dy * s;
       *az -= dz * s;
