@@ -134,7 +134,10 @@ class BackendImpl final : public Backend {
     const FluidView fv = Fluid();
     int computing = n;
     if (physics.reuseEnabled) {
-      thrust::for_each_n(policy, first, n, ActivityStage{View(), fv, physics});
+      const int cells = static_cast<int>(m_fluidStart.size());
+      m_cellCount.resize(cells);
+      thrust::for_each_n(policy, first, cells, CellCountStage{View(), Raw(m_cellCount)});
+      thrust::for_each_n(policy, first, n, ActivityStage{View(), fv, physics, Raw(m_cellCount)});
       m_computeList.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),
                                  ComputesThisStep{Raw(m_fluid.idle), physics.reuseIdle});
@@ -464,6 +467,7 @@ class BackendImpl final : public Backend {
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
+  Vector<uint32_t> m_cellCount;    // reuse: fluid + wall particles per cell (CellCountStage)
   Vector<uint32_t> m_blockStart;   // CPU density blocks: first particle of each (cpu_stages.h)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;

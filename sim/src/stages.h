@@ -320,10 +320,25 @@ struct BoundaryVolumeStage {
 // acceleration changed by more than the tolerance), active for -1 - IC more steps before it is
 // classified again. After this stage, "computes this step" is exactly IC < 0 or IC == IDLE
 // (ComputesThisStep).
+/// Fluid plus wall particles of each grid cell (reuse only): the activity stage's crowding sums these
+/// over 27 cells instead of reading four range bounds per cell per particle. On the AVX2 EPYC the
+/// activity stage took 2.3 ms of a 39 ms one-thread `deep_tank` step before (docs/reuse.md).
+struct CellCountStage {
+  GridView grid;
+  uint32_t* count;
+  SPHXR_HD void operator()(int c) const {
+    uint32_t n = 0;
+    if (grid.fluidStart[c] != kEmptyCell) n += grid.fluidEnd[c] - grid.fluidStart[c];
+    if (grid.boundaryStart[c] != kEmptyCell) n += grid.boundaryEnd[c] - grid.boundaryStart[c];
+    count[c] = n;
+  }
+};
+
 struct ActivityStage {
   GridView grid;
   FluidView fluid;
   Physics ph;
+  const uint32_t* cellCount;  // CellCountStage
   SPHXR_HD void operator()(int i) const {
     // Paddles: a particle near a moving boundary always computes (its neighbourhood changes every step).
     if (grid.MovingNear(Xyz(fluid.position[i]))) {
@@ -348,15 +363,13 @@ struct ActivityStage {
         for (int x = cx - 1; x <= cx + 1; ++x) {
           ++cells;  // cells outside the grid count as empty: a particle there is at an edge, keep it active
           if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
-          // Wall particles count too: water along a wall is crowded, not sparse, although the cells
-          // beyond the wall hold no fluid.
-          const uint32_t c = grid.Linear(x, y, z);
-          if (grid.fluidStart[c] != kEmptyCell) particles += grid.fluidEnd[c] - grid.fluidStart[c];
-          if (grid.boundaryStart[c] != kEmptyCell) particles += grid.boundaryEnd[c] - grid.boundaryStart[c];
+          // Wall particles count too (CellCountStage): water along a wall is crowded, not sparse,
+          // although the cells beyond the wall hold no fluid.
+          particles += cellCount[grid.Linear(x, y, z)];
         }
     const float meanCount = static_cast<float>(particles) / static_cast<float>(cells);
     const float act = ph.reuseDelta1 * fluid.pressure[i] * ph.reuseInvPressureScale +
-                      ph.reuseDelta2 * ph.reuseCellCount / fmaxf(meanCount, 1e-6f);
+                      ph.reuseDelta2 * ph.reuseCellCount / AtLeast(meanCount, 1e-6f);
     fluid.idle[i] = (act < ph.reuseThreshold && ph.reuseIdle > 0) ? ph.reuseIdle : -1;
   }
 };
