@@ -135,9 +135,9 @@ class BackendImpl final : public Backend {
     int computing = n;
     if (physics.reuseEnabled) {
       const int cells = static_cast<int>(m_fluidStart.size());
-      m_cellCount.resize(cells);
-      thrust::for_each_n(policy, first, cells, CellCountStage{View(), Raw(m_cellCount)});
-      thrust::for_each_n(policy, first, n, ActivityStage{View(), fv, physics, Raw(m_cellCount)});
+      m_cellCrowd.resize(cells);
+      thrust::for_each_n(policy, first, cells, CellCrowdStage{View(), Raw(m_cellCrowd)});
+      thrust::for_each_n(policy, first, n, ActivityStage{View(), fv, physics, Raw(m_cellCrowd)});
       m_computeList.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),
                                  ComputesThisStep{Raw(m_fluid.idle), physics.reuseIdle});
@@ -467,7 +467,7 @@ class BackendImpl final : public Backend {
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
-  Vector<uint32_t> m_cellCount;    // reuse: fluid + wall particles per cell (CellCountStage)
+  Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each fluid cell
   Vector<uint32_t> m_blockStart;   // CPU density blocks: first particle of each (cpu_stages.h)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;

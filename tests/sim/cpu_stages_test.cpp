@@ -4,9 +4,11 @@
 // over-full sets (more than kLanes particles in a cell, more neighbours than list slots), with and without
 // reuse masking some particles out, and with walls (their kernel sums). Forces: the neighbour-list sum
 // and the wall terms (mirrored and wall density). Wall pressure: the blocks of 16 wall particles.
+// Reuse's crowding (CellCrowdStage, ActivityStage; both backends' stages) against counting by brute force.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -489,6 +491,56 @@ TEST(CpuStages, DensityOddRowEndAndOutsideTheGridMatch) {
 
 TEST(CpuStages, DensityReuseMasksLanesThatDoNotCompute) {
   Compare(Random(3000, 0.0f, 0.16f, 3), 64, "random, reuse", /*reuse=*/true);
+}
+
+
+// Reuse's crowding N_i (ActivityStage): the particles, fluid and wall, of the 27 cells around each
+// particle's cell, counted once per cell by CellCrowdStage (both backends' stage), against counting
+// every particle's cell by brute force; and the classification that reads it.
+TEST(Activity, CrowdCountsTheParticlesOfThe27CellsAroundAndClassifiesByIt) {
+  const WallScene scene;
+  std::vector<Vec3> water = scene.water;
+  // Sparse water above the pool and some beyond the grid's edges (CellOf clamps it into edge cells).
+  for (const Vec3& p : Random(400, 0.0f, 0.16f, 9, 0.18f)) water.push_back(Vec3{p.x, 0.07f + 0.5f * p.y, p.z});
+  for (const Vec3& p : Random(40, -0.01f, 0.17f, 10, 0.19f)) water.push_back(p);
+  struct Setup s(water, 64, scene.walls);
+  const GridView g = s.Grid();
+  std::vector<uint32_t> crowd(s.start.size(), 0xdeadbeefu);
+  const CellCrowdStage crowdStage{g, crowd.data()};
+  for (int c = 0; c < static_cast<int>(crowd.size()); ++c) crowdStage(c);
+
+  auto cellOf = [&](Vec3 p) {
+    int c[3];
+    g.CellOf(p, &c[0], &c[1], &c[2]);
+    return std::array<int, 3>{c[0], c[1], c[2]};
+  };
+  auto within = [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
+    return std::abs(a[0] - b[0]) <= 1 && std::abs(a[1] - b[1]) <= 1 && std::abs(a[2] - b[2]) <= 1;
+  };
+  FluidView f = s.Stage().fluid;
+  s.ph.reuseDelta1 = 0.0f;  // crowding alone: ACT_i = N_CPN / N_i
+  s.ph.reuseDelta2 = 1.0f;
+  s.ph.reuseCellCount = 8.0f;
+  s.ph.reuseThreshold = 1.3f;
+  s.ph.reuseIdle = 3;
+  s.ph.reuseInvPressureScale = 1.0f;
+  const ActivityStage activity{g, f, s.ph, crowd.data()};
+  size_t inactive = 0, active = 0;
+  for (size_t i = 0; i < s.position.size(); ++i) {
+    const std::array<int, 3> ci = cellOf(Xyz(s.position[i]));
+    uint32_t expected = 0;
+    for (const Vec4& q : s.position) expected += within(ci, cellOf(Xyz(q))) ? 1u : 0u;
+    for (const Vec4& b : s.boundary) expected += within(ci, cellOf(Xyz(b))) ? 1u : 0u;
+    ASSERT_EQ(crowd[g.Linear(ci[0], ci[1], ci[2])], expected) << "particle " << i;
+    activity(static_cast<int>(i));
+    // Inactive (IC = IDLE) where the mean count of the 27 cells exceeds N_CPN / T.
+    const bool crowded = 8.0 / (static_cast<double>(expected) / 27.0) < 1.3;
+    ASSERT_EQ(s.idle[i], crowded ? 3 : -1) << "particle " << i << ", " << expected << " around";
+    ++(crowded ? inactive : active);
+  }
+  // Both outcomes occur: the pool is crowded, the sparse water and the strays are not.
+  EXPECT_GT(inactive, 500u);
+  EXPECT_GT(active, 100u);
 }
 
 }  // namespace

@@ -108,7 +108,7 @@ struct ParticleCounts {
   int64_t gridCells = 0;
   int64_t neighbourSlots = 0;  // per fluid particle (4 bytes each)
   int64_t bodyParticles = 0;   // of the moving bodies (paddles)
-  bool reuse = false;          // the compacted list of computing particles, the cell counts
+  bool reuse = false;          // the compacted list of computing particles, the cells' crowding
   bool wallDensity = false;    // the walls' own pressure and the list of wall cells
 };
 ParticleCounts CountParticles(const SceneSetup& scene);
