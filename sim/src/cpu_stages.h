@@ -6,14 +6,14 @@
 // Density (DensityBlockStage): one work item per block of up to kLanes particles of a pair of grid cells
 // along x (particles are sorted by Morton code, so a pair is a contiguous run). Each candidate j of the cells around
 // the block is loaded once and evaluated for all the block's particles at once: the distance, the hit
-// mask, sqrt and the kernel (both pieces, selected per lane); only the neighbour-list appends are
-// scalar, one per hit. The per-particle DensityStage does the same one candidate and one particle at a
+// mask, sqrt and the kernel (both pieces, selected per lane); the neighbour-list appends write the
+// candidate to every lane's scratch list and advance the lanes' counts by the hit mask. The per-particle DensityStage does the same one candidate and one particle at a
 // time, with a branch per candidate and per kernel piece. Same cells, same candidate order: each
 // particle's sum adds the same terms in the same order and its neighbour list is the same list; a
 // kernel value may differ in the last bit where the compiler fuses a multiply-add differently.
 //
 // Forces (ForceListStage): per particle, its neighbour list kLanes at a time, the neighbours' fields
-// gathered into vectors, the pair terms of ForceStage in every lane, the lanes summed at the end. The
+// loaded into vectors (GatherXyz, Gather), the pair terms of ForceStage in every lane, the lanes summed at the end. The
 // sum's order differs from ForceStage's serial one (rounding only). The wall terms are summed the same
 // way, kLanes wall particles at a time from the particle's cells; the bodies, gravity and the reuse
 // guard are ForceStage::Store itself.
@@ -27,6 +27,7 @@
 // bit-identical. tests/sim/cpu_stages_test.cpp compares each with the per-particle stages and with
 // brute force.
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -181,12 +182,14 @@ inline Lanes Gather(const float* base, LaneInts index) {
 inline void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z, Lanes* w) {
 #if defined(__AVX__) && !defined(__AVX512DQ__)
   auto row = [&](int l) {  // points l and l + 4 in the low and high halves
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + 4 * static_cast<ptrdiff_t>(index[l]))),
-                                _mm_loadu_ps(base + 4 * static_cast<ptrdiff_t>(index[l + 4])), 1);
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + 4 * static_cast<std::ptrdiff_t>(index[l]))),
+                                _mm_loadu_ps(base + 4 * static_cast<std::ptrdiff_t>(index[l + 4])), 1);
   };
   const __m256 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
-  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);  // x0 x1 y0 y1 | x2 x3 y2 y3
-  const __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);  // z0 z1 w0 w1 | z2 z3 w2 w3
+  // Per 128-bit half (points 0-3 low, 4-7 high): t0 = x0 x1 y0 y1 | x4 x5 y4 y5, t1 = x2 x3 y2 y3 | ...,
+  // t2 = z0 z1 w0 w1 | z4 z5 w4 w5, t3 = z2 z3 w2 w3 | ...; the shuffles take a pair from each.
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);
+  const __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);
   *x = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0)));
   *y = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2)));
   *z = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0)));

@@ -313,13 +313,6 @@ struct BoundaryVolumeStage {
 };
 
 // ---- stage 3b: activity (reuse on) ---------------------------------------------------------------
-// Idle count IC: -1 active. A particle with IC > 0 reuses this step (density, pressure, acceleration
-// stay as they are) and counts down; at IC = 0, or when active, it computes this step and is classified
-// with its previous pressure and the crowding of its cells: ACT_i < T gives IC = IDLE, else -1. So a
-// particle never reuses more than IDLE consecutive steps. IC < -1: flagged by the force stage (its
-// acceleration changed by more than the tolerance), active for -1 - IC more steps before it is
-// classified again. After this stage, "computes this step" is exactly IC < 0 or IC == IDLE
-// (ComputesThisStep).
 /// The particles, fluid and wall, in the 27 cells around each cell that holds fluid (reuse only): the
 /// activity stage's crowding N_i, once per cell instead of once per particle. Cells outside the grid
 /// count as empty; a cell without fluid is left as it was (no particle reads it). On the AVX2 EPYC the
@@ -346,6 +339,13 @@ struct CellCrowdStage {
   }
 };
 
+// Idle count IC: -1 active. A particle with IC > 0 reuses this step (density, pressure, acceleration
+// stay as they are) and counts down; at IC = 0, or when active, it computes this step and is classified
+// with its previous pressure and the crowding of its cells: ACT_i < T gives IC = IDLE, else -1. So a
+// particle never reuses more than IDLE consecutive steps. IC < -1: flagged by the force stage (its
+// acceleration changed by more than the tolerance), active for -1 - IC more steps before it is
+// classified again. After this stage, "computes this step" is exactly IC < 0 or IC == IDLE
+// (ComputesThisStep).
 struct ActivityStage {
   GridView grid;
   FluidView fluid;
