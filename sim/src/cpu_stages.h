@@ -6,9 +6,9 @@
 // Density (DensityBlockStage): one work item per block of up to kLanes particles of a pair of grid cells
 // along x (particles are sorted by Morton code, so a pair is a contiguous run). Each candidate j of the cells around
 // the block is loaded once and evaluated for all the block's particles at once: the distance, the hit
-// mask, sqrt and the kernel (both pieces, selected per lane); the neighbour-list appends write the
-// candidate to every lane's scratch list and advance the lanes' counts by the hit mask. The per-particle DensityStage does the same one candidate and one particle at a
-// time, with a branch per candidate and per kernel piece. Same cells, same candidate order: each
+// mask, sqrt and the kernel (both pieces, selected per lane); the neighbour-list appends are scalar
+// (kVectorAppends: on AVX without a branch per hit). The per-particle DensityStage does the same one
+// candidate and one particle at a time, with a branch per candidate and per kernel piece. Same cells, same candidate order: each
 // particle's sum adds the same terms in the same order and its neighbour list is the same list; a
 // kernel value may differ in the last bit where the compiler fuses a multiply-add differently.
 //
@@ -68,6 +68,17 @@ inline constexpr int kLanes = 8;
 #else
 inline constexpr int kLanes = 16;
 #define SPHXR_LANE_BYTES 64
+#endif
+
+/// The density blocks' neighbour-list appends: branch-free into scratch lists (a store per lane per
+/// candidate that hits, the counts in a vector) in the 8-lane AVX tier, where it made the density stage
+/// 1.2-1.3x faster on the AVX2 EPYC; one store per hit elsewhere. In the SSE2 tier's 16 lanes (four
+/// registers) the vector counts made the stage 1.15-1.35x slower there (docs/performance.md,
+/// "Transposed loads"); the AVX-512 tier is not measured.
+#if defined(__AVX__) && !defined(__AVX512DQ__)
+inline constexpr bool kVectorAppends = true;
+#else
+inline constexpr bool kVectorAppends = false;
 #endif
 
 /// kLanes floats (ints) in one SIMD value (GCC/Clang vector extension).
@@ -179,7 +190,7 @@ inline Lanes Gather(const float* base, LaneInts index) {
 /// whole (16 bytes each, two to a register) and transposed in registers, 8 loads and 7-8 shuffles instead
 /// of three or four gather instructions, whose latency the force loop waited on (AVX2 EPYC: the force
 /// stage 1.6-2x faster, docs/performance.md "Transposed loads").
-inline void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z, Lanes* w) {
+SPHXR_INLINE void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z, Lanes* w) {
 #if defined(__AVX__) && !defined(__AVX512DQ__)
   auto row = [&](int l) {  // points l and l + 4 in the low and high halves
     return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + 4 * static_cast<std::ptrdiff_t>(index[l]))),
@@ -202,7 +213,7 @@ inline void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes* y, La
   if (w) *w = Gather(base + 3, at);
 #endif
 }
-inline void GatherXyz(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z) {
+SPHXR_INLINE void GatherXyz(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z) {
   GatherXyzw(base, index, x, y, z, nullptr);
 }
 
@@ -391,36 +402,49 @@ struct DensityBlockStage {
       }  // other lanes stay far away, never a hit (their squared distance overflows to +inf)
     }
     const CubicSpline k = stage.ph.kernel;
-    // The neighbour lists, without a branch per hit: every candidate that hits some lane is written to
-    // every lane's list at that lane's count, and the count moves on where it is a neighbour (a hit that
-    // is not the particle itself), so the next candidate overwrites the others. A lane writes into a
-    // scratch list with one spare slot (where it writes once its list is full: the count goes on, past
-    // the capacity, and the force stage then scans); the lists are copied out at the end. Before (one
-    // store per set bit, the counts in memory) the appends were ~35 % of the stage on the AVX2 EPYC.
     const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
-    const uint32_t stride = capacity + 1;
-    thread_local std::vector<uint32_t> scratch;
-    if (scratch.size() < static_cast<size_t>(kLanes) * stride) scratch.resize(static_cast<size_t>(kLanes) * stride);
-    uint32_t* const lists = scratch.data();
-    LaneInts laneList, self, count = LaneInts{};
-    for (int l = 0; l < kLanes; ++l) {
-      laneList[l] = static_cast<int32_t>(static_cast<uint32_t>(l) * stride);
-      self[l] = static_cast<int32_t>(first + static_cast<uint32_t>(l));
-    }
-    const LaneInts full = LaneInts{} + static_cast<int32_t>(capacity);
-    const Lanes sum = KernelSumLanes(k, cells, g.fluidStart, g.fluidEnd, position, false, px, py, pz,
-                                     [&](uint32_t j, LaneInts within) {
-      const LaneInts at = laneList + (count < full ? count : full);
-      for (int l = 0; l < kLanes; ++l) lists[at[l]] = j;
-      count -= within & (self != static_cast<int32_t>(j));  // -1 where a neighbour: the count + 1
-    });
-    uint32_t found[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-      found[l] = static_cast<uint32_t>(count[l]);
-      if (computing & (1u << l)) {
-        const uint32_t n = found[l] < capacity ? found[l] : capacity;
-        std::memcpy(stage.Slots(static_cast<int>(first) + l), lists + static_cast<size_t>(l) * stride, n * sizeof(uint32_t));
+    uint32_t found[kLanes] = {};
+    Lanes sum;
+    if constexpr (kVectorAppends) {
+      // The neighbour lists without a branch per hit: every candidate that hits some lane is written to
+      // every lane's list at that lane's count, and the count moves on where it is a neighbour (a hit
+      // that is not the particle itself), so the next candidate overwrites the others. A lane writes
+      // into a scratch list with one spare slot (where it writes once its list is full: the count goes
+      // on, past the capacity, and the force stage then scans); the lists are copied out at the end.
+      const uint32_t stride = capacity + 1;
+      thread_local std::vector<uint32_t> scratch;
+      if (scratch.size() < static_cast<size_t>(kLanes) * stride) scratch.resize(static_cast<size_t>(kLanes) * stride);
+      uint32_t* const lists = scratch.data();
+      LaneInts laneList, self, count = LaneInts{};
+      for (int l = 0; l < kLanes; ++l) {
+        laneList[l] = static_cast<int32_t>(static_cast<uint32_t>(l) * stride);
+        self[l] = static_cast<int32_t>(first + static_cast<uint32_t>(l));
       }
+      const LaneInts full = LaneInts{} + static_cast<int32_t>(capacity);
+      sum = KernelSumLanes(k, cells, g.fluidStart, g.fluidEnd, position, false, px, py, pz, [&](uint32_t j, LaneInts within) {
+        const LaneInts at = laneList + (count < full ? count : full);
+        for (int l = 0; l < kLanes; ++l) lists[at[l]] = j;
+        count -= within & (self != static_cast<int32_t>(j));  // -1 where a neighbour: the count + 1
+      });
+      for (int l = 0; l < kLanes; ++l) {
+        found[l] = static_cast<uint32_t>(count[l]);
+        if (computing & (1u << l)) {
+          const uint32_t n = found[l] < capacity ? found[l] : capacity;
+          std::memcpy(stage.Slots(static_cast<int>(first) + l), lists + static_cast<size_t>(l) * stride, n * sizeof(uint32_t));
+        }
+      }
+    } else {
+      sum = KernelSumLanes(k, cells, g.fluidStart, g.fluidEnd, position, false, px, py, pz, [&](uint32_t j, LaneInts within) {
+        uint32_t hits = Bits(within);
+        while (hits != 0) {  // the neighbour lists: every hit but the particle itself
+          const int l = __builtin_ctz(hits);
+          hits &= hits - 1u;
+          const uint32_t i = first + static_cast<uint32_t>(l);
+          if (j == i) continue;
+          if (found[l] < capacity) stage.Slots(static_cast<int>(i))[found[l]] = j;
+          ++found[l];
+        }
+      });
     }
     // The walls: the lanes whose own cell has a wall particle in its 27 cells (WallSum's test); the
     // others keep 0, as WallSum gives them.
