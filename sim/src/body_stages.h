@@ -81,12 +81,9 @@ struct MovingNearStage {
   SPHXR_HD void operator()(int k) const {
     const int cx = lo[0] + k % dims[0], cy = lo[1] + (k / dims[0]) % dims[1], cz = lo[2] + k / (dims[0] * dims[1]);
     uint8_t near = 0;
-    for (int z = cz - 1; z <= cz + 1; ++z)
-      for (int y = cy - 1; y <= cy + 1; ++y)
-        for (int x = cx - 1; x <= cx + 1; ++x) {
-          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
-          if (grid.bodyStart[grid.Linear(x, y, z)] != kEmptyCell) near = 1;
-        }
+    ForEachCellAround(grid, cx, cy, cz, [&](uint32_t n) {
+      if (grid.bodyStart[n] != kEmptyCell) near = 1;
+    });
     out[grid.Linear(cx, cy, cz)] = near;
   }
 };

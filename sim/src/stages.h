@@ -226,18 +226,27 @@ struct CellRangeStage {
   }
 };
 
+/// f(n) for the linear index n of each of the 27 cells around cell (cx, cy, cz) that lie in the grid,
+/// in z, y, x order.
+template <class F>
+SPHXR_HD SPHXR_INLINE void ForEachCellAround(const GridView& grid, int cx, int cy, int cz, F&& f) {
+  for (int z = cz - 1; z <= cz + 1; ++z)
+    for (int y = cy - 1; y <= cy + 1; ++y)
+      for (int x = cx - 1; x <= cx + 1; ++x) {
+        if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
+        f(grid.Linear(x, y, z));
+      }
+}
+
 // ---- cells near the boundary (once): any boundary particle in the 27 cells around cell c ------------
 /// Whether any of the 27 cells around linear cell c (within the grid) is non-empty in `start`.
 SPHXR_HD SPHXR_INLINE bool AnyInNeighbourCells(const GridView& grid, const uint32_t* start, int c) {
   int cx, cy, cz;
   grid.CellCoords(c, &cx, &cy, &cz);
   bool any = false;
-  for (int z = cz - 1; z <= cz + 1; ++z)
-    for (int y = cy - 1; y <= cy + 1; ++y)
-      for (int x = cx - 1; x <= cx + 1; ++x) {
-        if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
-        if (start[grid.Linear(x, y, z)] != kEmptyCell) any = true;
-      }
+  ForEachCellAround(grid, cx, cy, cz, [&](uint32_t n) {
+    if (start[n] != kEmptyCell) any = true;
+  });
   return any;
 }
 
@@ -325,16 +334,12 @@ struct CellCrowdStage {
     int cx, cy, cz;
     grid.CellCoords(c, &cx, &cy, &cz);
     uint32_t particles = 0;
-    for (int z = cz - 1; z <= cz + 1; ++z)
-      for (int y = cy - 1; y <= cy + 1; ++y)
-        for (int x = cx - 1; x <= cx + 1; ++x) {
-          if (x < 0 || y < 0 || z < 0 || x >= grid.nx || y >= grid.ny || z >= grid.nz) continue;
-          // Wall particles count too: water along a wall is crowded, not sparse, although the cells
-          // beyond the wall hold no fluid.
-          const uint32_t n = grid.Linear(x, y, z);
-          if (grid.fluidStart[n] != kEmptyCell) particles += grid.fluidEnd[n] - grid.fluidStart[n];
-          if (grid.boundaryStart[n] != kEmptyCell) particles += grid.boundaryEnd[n] - grid.boundaryStart[n];
-        }
+    ForEachCellAround(grid, cx, cy, cz, [&](uint32_t n) {
+      // Wall particles count too: water along a wall is crowded, not sparse, although the cells beyond
+      // the wall hold no fluid.
+      if (grid.fluidStart[n] != kEmptyCell) particles += grid.fluidEnd[n] - grid.fluidStart[n];
+      if (grid.boundaryStart[n] != kEmptyCell) particles += grid.boundaryEnd[n] - grid.boundaryStart[n];
+    });
     crowd[c] = particles;
   }
 };
@@ -369,9 +374,7 @@ struct ActivityStage {
     int cx, cy, cz;
     grid.CellOf(Xyz(fluid.position[i]), &cx, &cy, &cz);
     // The mean over all 27 cells, those outside the grid as empty: a particle there is at an edge.
-    const uint32_t particles = crowd[grid.Linear(cx, cy, cz)];
-    const int cells = 27;
-    const float meanCount = static_cast<float>(particles) / static_cast<float>(cells);
+    const float meanCount = static_cast<float>(crowd[grid.Linear(cx, cy, cz)]) / 27.0f;
     const float act = ph.reuseDelta1 * fluid.pressure[i] * ph.reuseInvPressureScale +
                       ph.reuseDelta2 * ph.reuseCellCount / AtLeast(meanCount, 1e-6f);
     fluid.idle[i] = (act < ph.reuseThreshold && ph.reuseIdle > 0) ? ph.reuseIdle : -1;
