@@ -23,7 +23,11 @@ namespace {
 struct Trace {
   std::vector<double> total;  // every `every` steps, from step 0
   double maxKinetic = 0.0;
-  int64_t clamped = 0;  // domain clamps: they take energy out, so the conserving run must have none
+  int64_t clamped = 0;  // domain clamps (IntegrateStage)
+  // The kinetic energy the clamps took out: each clamped particle's 1/2 m (|v + a dt|^2 - |v'|^2), v its
+  // velocity before the step and v' after the clamp. (The clamp also moves it back by at most its
+  // outward speed times dt, a displacement of order 1e-7 m here, whose energy is left out.)
+  double clampedEnergy = 0.0;
 };
 
 Trace RunAndMeasure(const SceneSetup& scene, int steps, int every) {
@@ -32,13 +36,31 @@ Trace RunAndMeasure(const SceneSetup& scene, int steps, int every) {
   Trace t;
   HostBoundary walls;
   solver->DownloadBoundary(&walls);
+  const double mass = solver->ParticleMass();
+  std::vector<Vec4> before;  // velocities by particle id at the start of the step
+  HostFluid fluid;
   for (int k = 0; k <= steps; ++k) {
     if (k > 0) {
       EXPECT_TRUE(solver->Step().ok());
+      const float dt = solver->LastStep().dt;
+      solver->Download(&fluid);
+      int64_t flagged = 0;
+      for (size_t i = 0; i < fluid.size(); ++i) {
+        const Vec4& a = fluid.acceleration[i];
+        if (a.w == 0.0f) continue;  // IntegrateStage's clamp flag
+        ++flagged;
+        const Vec4& v0 = before[fluid.id[i]];
+        const Vec4& v1 = fluid.velocity[i];
+        const double ux = v0.x + a.x * dt, uy = v0.y + a.y * dt, uz = v0.z + a.z * dt;
+        t.clampedEnergy += 0.5 * mass * ((ux * ux + uy * uy + uz * uz) - (double(v1.x) * v1.x + double(v1.y) * v1.y + double(v1.z) * v1.z));
+      }
+      EXPECT_EQ(flagged, solver->LastStep().clamped) << "step " << k;
+    } else {
+      solver->Download(&fluid);
     }
+    before.resize(fluid.size());
+    for (size_t i = 0; i < fluid.size(); ++i) before[fluid.id[i]] = fluid.velocity[i];
     if (k % every) continue;
-    HostFluid fluid;
-    solver->Download(&fluid);
     const EnergySummary e = SphEnergy(scene, solver->ParticleMass(), fluid, walls);
     t.total.push_back(e.Total());
     t.maxKinetic = std::max(t.maxKinetic, e.kinetic);
@@ -62,15 +84,20 @@ TEST(Energy, WallDensityWithoutViscosityConservesItToTheIntegratorsError) {
   SceneSetup halfStep = test::SmallRestTank(SceneSetup::WallPressure::kWallDensity, 0.0f);
   halfStep.params.fixedDt = 0.0002f;  // the same 0.8 s, sampled at the same times
   const Trace h = RunAndMeasure(halfStep, 4000, 200);
-  std::printf("wall_density, alpha 0: max |E - E0| %.3e J (half step %.3e J), max kinetic %.3e J\n", MaxDeviation(t),
-              MaxDeviation(h), t.maxKinetic);
+  std::printf("wall_density, alpha 0: max |E - E0| %.3e J (half step %.3e J), max kinetic %.3e J; clamps %lld / %lld taking "
+              "out %.3e / %.3e J\n",
+              MaxDeviation(t), MaxDeviation(h), t.maxKinetic, static_cast<long long>(t.clamped),
+              static_cast<long long>(h.clamped), t.clampedEnergy, h.clampedEnergy);
   RecordProperty("max_deviation_over_max_kinetic", std::to_string(MaxDeviation(t) / t.maxKinetic));
   RecordProperty("half_step_deviation_ratio", std::to_string(MaxDeviation(h) / MaxDeviation(t)));
   ASSERT_GT(t.maxKinetic, 1e-3) << "the column must have moved (it settles under its weight)";
-  EXPECT_EQ(t.clamped, 0);
-  EXPECT_EQ(h.clamped, 0);
-  EXPECT_LT(MaxDeviation(t), 0.03 * t.maxKinetic);
-  EXPECT_LT(MaxDeviation(h), 0.65 * MaxDeviation(t)) << "the deviation must shrink with the step";
+  // A clamp takes energy out, which could hide energy the step puts in; so E must stay within the bound
+  // with whatever the clamps took added to its deviation. (The test asked for no clamp at all until
+  // 2026-12-02. Without viscosity a surface particle may graze a wall, where the walls push back only
+  // as much as its pressure, about zero at the surface: on the AVX-512 tier's rounding one does, for 6
+  // steps at 0.76 s, taking out 5.0e-6 J against a deviation of 1.7e-4 J; on the AVX tier none does.)
+  EXPECT_LT(MaxDeviation(t) + t.clampedEnergy, 0.03 * t.maxKinetic) << t.clamped << " clamps";
+  EXPECT_LT(MaxDeviation(h) + h.clampedEnergy, 0.65 * MaxDeviation(t)) << "the deviation must shrink with the step";
 }
 
 TEST(Energy, MirroredWallsDoNotConserveIt) {
