@@ -7,7 +7,7 @@
 // along x (particles are sorted by Morton code, so a pair is a contiguous run). Each candidate j of the cells around
 // the block is loaded once and evaluated for all the block's particles at once: the distance, the hit
 // mask, sqrt and the kernel (both pieces, selected per lane); the neighbour-list appends are scalar
-// (kVectorAppends: on AVX without a branch per hit). The per-particle DensityStage does the same one
+// (kVectorAppends: on AVX and AVX-512 without a branch per hit). The per-particle DensityStage does the same one
 // candidate and one particle at a time, with a branch per candidate and per kernel piece. Same cells, same candidate order: each
 // particle's sum adds the same terms in the same order and its neighbour list is the same list; a
 // kernel value may differ in the last bit where the compiler fuses a multiply-add differently.
@@ -71,11 +71,11 @@ inline constexpr int kLanes = 16;
 #endif
 
 /// The density blocks' neighbour-list appends: branch-free into scratch lists (a store per lane per
-/// candidate that hits, the counts in a vector) in the 8-lane AVX tier, where it made the density stage
-/// 1.2-1.3x faster on the AVX2 EPYC; one store per hit elsewhere. In the SSE2 tier's 16 lanes (four
-/// registers) the vector counts made the stage 1.15-1.35x slower there (docs/performance.md,
-/// "Transposed loads"); the AVX-512 tier is not measured.
-#if defined(__AVX__) && !defined(__AVX512DQ__)
+/// candidate that hits, the counts in a vector) in the AVX and AVX-512 tiers, where it made the density
+/// stage 1.2-1.3x faster on the AVX2 EPYC (Zen 3) and 1.05-1.1x on the AVX-512 EPYC (Zen 5); one store
+/// per hit in the SSE2 and scalar tiers. In the SSE2 tier's 16 lanes (four registers) the vector counts
+/// made the stage 1.15-1.35x slower (docs/performance.md, "Transposed loads", "The AVX-512 tier on Zen 5").
+#if defined(__AVX__)
 inline constexpr bool kVectorAppends = true;
 #else
 inline constexpr bool kVectorAppends = false;
@@ -167,12 +167,15 @@ inline LaneInts And(LaneInts a, LaneInts b) { return a & b; }
 inline Lanes Select(LaneInts m, Lanes a, Lanes b) { return m ? a : b; }
 #endif
 
-/// Gathers base[index[l]] into lane l (with AVX-512's gather instruction).
+/// Gathers base[index[l]] into lane l (scalar loads put together; no tier uses a gather instruction).
 inline Lanes Gather(const float* base, LaneInts index) {
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
-  // (The masked form with a zero source: GCC 12's _mm512_i32gather_ps trips -Wmaybe-uninitialized.)
-  return reinterpret_cast<Lanes>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), static_cast<__mmask16>(0xffff),
-                                                          reinterpret_cast<__m512i>(index), base, 4));
+  // Sixteen loads put together in registers, not the gather instruction: on the AVX-512 EPYC (Zen 5)
+  // the force stage is 1.1x faster so (docs/performance.md, "The AVX-512 tier on Zen 5").
+  return reinterpret_cast<Lanes>(_mm512_set_ps(base[index[15]], base[index[14]], base[index[13]], base[index[12]],
+                                               base[index[11]], base[index[10]], base[index[9]], base[index[8]],
+                                               base[index[7]], base[index[6]], base[index[5]], base[index[4]],
+                                               base[index[3]], base[index[2]], base[index[1]], base[index[0]]));
 #elif defined(__AVX__)
   // Eight loads put together in registers, not AVX2's gather instruction: on the AVX2 EPYC (Zen 3) the
   // force stage is 1.1-1.15x faster so (docs/performance.md, "Transposed loads").
@@ -189,7 +192,8 @@ inline Lanes Gather(const float* base, LaneInts index) {
 /// the same values as Gathers of base, base + 1, ... at index * 4. On AVX the eight points are loaded
 /// whole (16 bytes each, two to a register) and transposed in registers, 8 loads and 7-8 shuffles instead
 /// of three or four gather instructions, whose latency the force loop waited on (AVX2 EPYC: the force
-/// stage 1.6-2x faster, docs/performance.md "Transposed loads").
+/// stage 1.6-2x faster, docs/performance.md "Transposed loads"). AVX-512 does the same with 16 points,
+/// four to a register (AVX-512 EPYC, Zen 5: the force stage 1.5x faster, "The AVX-512 tier on Zen 5").
 SPHXR_INLINE void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z, Lanes* w) {
 #if defined(__AVX__) && !defined(__AVX512DQ__)
   auto row = [&](int l) {  // points l and l + 4 in the low and high halves
@@ -205,6 +209,23 @@ SPHXR_INLINE void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes*
   *y = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2)));
   *z = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0)));
   if (w) *w = reinterpret_cast<Lanes>(_mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+#elif defined(__AVX512F__) && defined(__AVX512DQ__)
+  auto point = [&](int l) { return _mm_loadu_ps(base + 4 * static_cast<std::ptrdiff_t>(index[l])); };
+  auto row = [&](int l) {  // points l, l + 4, l + 8, l + 12 in the four 128-bit quarters
+    __m512 r = _mm512_zextps128_ps512(point(l));
+    r = _mm512_insertf32x4(r, point(l + 4), 1);
+    r = _mm512_insertf32x4(r, point(l + 8), 2);
+    return _mm512_insertf32x4(r, point(l + 12), 3);
+  };
+  const __m512 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+  // (Zero-masked with all lanes on: GCC 12's _mm512_unpack*_ps pass an undefined merge source, as in Sqrt.)
+  const __mmask16 all = 0xffff;
+  const __m512 t0 = _mm512_maskz_unpacklo_ps(all, r0, r1), t1 = _mm512_maskz_unpacklo_ps(all, r2, r3);
+  const __m512 t2 = _mm512_maskz_unpackhi_ps(all, r0, r1), t3 = _mm512_maskz_unpackhi_ps(all, r2, r3);
+  *x = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0)));
+  *y = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2)));
+  *z = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+  if (w) *w = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2)));
 #else
   const LaneInts at = index * 4;
   *x = Gather(base, at);
