@@ -26,6 +26,7 @@
 #include "sim_worker.h"  // app/src: SimWorker, InteropSurface
 #include "sphxr/render/interop.h"
 #include "support.h"
+#include "xvfb.h"
 
 namespace sphxr::test {
 namespace {
@@ -191,45 +192,6 @@ TEST(DesktopFallbackTest, NoDisplayMeansOneLineAndAHeadlessRun) {
   EXPECT_NE(r.out.find("sphxr summary: small"), std::string::npos) << r.out;
 }
 
-/// A private X server for the test (Xvfb on a free display number), killed at the end.
-class Xvfb {
- public:
-  Xvfb() {
-    for (int n = 90; n < 140; ++n) {
-      if (std::filesystem::exists("/tmp/.X11-unix/X" + std::to_string(n)) ||
-          std::filesystem::exists("/tmp/.X" + std::to_string(n) + "-lock")) {
-        continue;
-      }
-      m_pid = fork();
-      if (m_pid == 0) {
-        const std::string display = ":" + std::to_string(n);
-        execlp("Xvfb", "Xvfb", display.c_str(), "-screen", "0", "1024x768x24", "-nolisten", "tcp", (char*)nullptr);
-        _exit(127);
-      }
-      for (int i = 0; i < 100; ++i) {
-        if (std::filesystem::exists("/tmp/.X11-unix/X" + std::to_string(n))) {
-          m_display = ":" + std::to_string(n);
-          return;
-        }
-        int status;
-        if (waitpid(m_pid, &status, WNOHANG) == m_pid) break;  // it exited: try the next number
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      }
-    }
-  }
-  ~Xvfb() {
-    if (m_pid > 0) {
-      kill(m_pid, SIGTERM);
-      waitpid(m_pid, nullptr, 0);
-    }
-  }
-  const std::string& Display() const { return m_display; }
-  bool Alive() const { return m_pid > 0 && waitpid(m_pid, nullptr, WNOHANG) == 0; }
-
- private:
-  pid_t m_pid = -1;
-  std::string m_display;
-};
 
 
 glm::vec3 V(sim::Vec3 v) { return {v.x, v.y, v.z}; }

@@ -25,6 +25,7 @@ extern "C" Display* glfwGetX11Display(void);
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -33,6 +34,7 @@ extern "C" Display* glfwGetX11Display(void);
 
 #include "sphxr/common/log.h"
 #include "sphxr/xr/session.h"
+#include "xvfb.h"
 
 namespace sphxr::xr::test {
 
@@ -88,43 +90,18 @@ class DisplayEnvironment : public ::testing::Environment {
       std::filesystem::remove_all(TempRoot());
     if (s_window) glfwDestroyWindow(s_window);
     glfwTerminate();
-    if (m_xvfb > 0) {
-      kill(m_xvfb, SIGTERM);
-      int status = 0;
-      waitpid(m_xvfb, &status, 0);
-    }
+    m_xvfb.reset();
   }
   static GLFWwindow* window() { return s_window; }
 
  private:
-  // Xvfb picks a free display itself and writes its number to -displayfd: no race between tests
-  // started at once.
+  // Our own Xvfb (tests/xvfb.h: it picks a free display itself, no race between tests started at once).
   void StartXvfb() {
-    int fds[2];
-    ASSERT_EQ(pipe(fds), 0);
-    pid_t pid = fork();
-    if (pid == 0) {
-      prctl(PR_SET_PDEATHSIG, SIGTERM);  // a crashed test takes its Xvfb with it
-      close(fds[0]);
-      if (!freopen("/dev/null", "w", stderr)) _exit(126);
-      std::string fd = std::to_string(fds[1]);
-      execlp("Xvfb", "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "320x240x24", "-nolisten", "tcp", nullptr);
-      _exit(127);
-    }
-    close(fds[1]);
-    std::string number;
-    char c;
-    while (read(fds[0], &c, 1) == 1 && c != '\n') number += c;
-    close(fds[0]);
-    if (number.empty()) {
-      int status = 0;
-      waitpid(pid, &status, 0);
-      FAIL() << "could not start Xvfb (install xvfb, or set DISPLAY)";
-    }
-    m_xvfb = pid;
-    setenv("DISPLAY", (":" + number).c_str(), 1);
+    m_xvfb = std::make_unique<sphxr::test::Xvfb>("320x240x24");
+    ASSERT_FALSE(m_xvfb->Display().empty()) << "could not start Xvfb (install xvfb, or set DISPLAY)";
+    setenv("DISPLAY", m_xvfb->Display().c_str(), 1);
   }
-  pid_t m_xvfb = -1;
+  std::unique_ptr<sphxr::test::Xvfb> m_xvfb;
   static inline GLFWwindow* s_window = nullptr;
 };
 
