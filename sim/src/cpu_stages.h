@@ -218,14 +218,15 @@ SPHXR_INLINE void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes*
     return _mm512_insertf32x4(r, point(l + 12), 3);
   };
   const __m512 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
-  // (Zero-masked with all lanes on: GCC 12's _mm512_unpack*_ps pass an undefined merge source, as in Sqrt.)
+  // (Zero-masked with all lanes on: GCC 12's _mm512_unpack*_ps and _mm512_shuffle_ps pass an undefined
+  // merge source, as in Sqrt.)
   const __mmask16 all = 0xffff;
   const __m512 t0 = _mm512_maskz_unpacklo_ps(all, r0, r1), t1 = _mm512_maskz_unpacklo_ps(all, r2, r3);
   const __m512 t2 = _mm512_maskz_unpackhi_ps(all, r0, r1), t3 = _mm512_maskz_unpackhi_ps(all, r2, r3);
-  *x = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0)));
-  *y = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2)));
-  *z = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0)));
-  if (w) *w = reinterpret_cast<Lanes>(_mm512_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+  *x = reinterpret_cast<Lanes>(_mm512_maskz_shuffle_ps(all, t0, t1, _MM_SHUFFLE(1, 0, 1, 0)));
+  *y = reinterpret_cast<Lanes>(_mm512_maskz_shuffle_ps(all, t0, t1, _MM_SHUFFLE(3, 2, 3, 2)));
+  *z = reinterpret_cast<Lanes>(_mm512_maskz_shuffle_ps(all, t2, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+  if (w) *w = reinterpret_cast<Lanes>(_mm512_maskz_shuffle_ps(all, t2, t3, _MM_SHUFFLE(3, 2, 3, 2)));
 #else
   const LaneInts at = index * 4;
   *x = Gather(base, at);
