@@ -279,7 +279,8 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     }
     const xr::EventResult ev = app.session->PollEvents();
     for (xr::SessionState state : ev.transitions) {
-      outcome->states += (outcome->states.empty() ? "" : " ") + std::string(xr::SessionStateName(state));
+      if (!outcome->states.empty()) outcome->states += ' ';
+      outcome->states += xr::SessionStateName(state);  // (appended, not a + b: GCC 12's -Wrestrict misfired there)
     }
     if (ev.exit) {
       outcome->lost = ev.lost;
