@@ -11,6 +11,24 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+# The presets as sim/src/params.cpp has them now (delta1, delta2, threshold, idle, accel_tolerance). A
+# preset row of the CSV whose parameters differ was measured under an older value of that preset and is
+# drawn hollow; a sweep row with a preset's current parameters is drawn as that preset.
+PRESETS = {"accurate": (0.25, 1.0, 1.2, 1, 0.3), "balanced": (0.25, 1.0, 1.3, 3, 0.3), "fast": (0.25, 1.0, 1.5, 5, 2.0)}
+COLOURS = {"accurate": "tab:green", "balanced": "tab:blue", "fast": "tab:red"}
+
+
+def params(r):
+    return (float(r["delta1"]), float(r["delta2"]), float(r["threshold"]), int(r["idle"]), float(r["accel_tolerance"]))
+
+
+def current_preset(r):
+    for name, p in PRESETS.items():
+        if all(abs(a - b) < 1e-6 for a, b in zip(params(r), p)):
+            return name
+    return None
+
+
 def main():
     src, dst = sys.argv[1], sys.argv[2]
     rows = list(csv.DictReader(open(src)))
@@ -29,9 +47,12 @@ def main():
             ax.plot(x, 1.0 / float(r["active_fraction"]), "_", ms=10, color="tab:purple",
                     label="1 / active fraction (work bound)" if r is rs[0] else None)
             guard_off = float(r["accel_tolerance"]) == 0.0
-            if r["setting"] in ("accurate", "balanced", "fast"):
-                ax.plot(x, y, "o", ms=9, color={"accurate": "tab:green", "balanced": "tab:blue",
-                                                  "fast": "tab:red"}[r["setting"]], label=r["setting"])
+            now = current_preset(r)
+            if r["setting"] in PRESETS and now != r["setting"]:  # a preset's older parameters
+                ax.plot(x, y, "o", ms=9, mfc="none", color=COLOURS[r["setting"]],
+                        label="%s before (tolerance %g g)" % (r["setting"], float(r["accel_tolerance"])))
+            elif now is not None:
+                ax.plot(x, y, "o", ms=9, color=COLOURS[now], label=now)
             elif guard_off:
                 ax.plot(x, y, "x", ms=9, color="k", label="guard off (T 1.2, IDLE 1)")
             else:
