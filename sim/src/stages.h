@@ -627,6 +627,11 @@ struct ForceStage {
   }
 };
 
+// acceleration.w after a step: 1 clamped into the domain (IntegrateStage), 2 pushed out of a moving
+// body (PushOutStage, body_stages.h), 3 both. StepReductionOp counts them; tests read them too.
+SPHXR_HD SPHXR_INLINE bool WasClamped(float w) { return w == 1.0f || w == 3.0f; }
+SPHXR_HD SPHXR_INLINE bool WasPushed(float w) { return w >= 2.0f; }
+
 // ---- stage 6: symplectic Euler and domain clamp --------------------------------------------------
 struct IntegrateStage {
   FluidView fluid;
@@ -732,9 +737,8 @@ struct StepReductionOp {
     const float err = fluid.density[i] * invRestDensity - 1.0f;
     r.maxDensityError = fabsf(err);
     r.sumCompression = err > 0.0f ? err : 0.0f;
-    // acceleration.w: 1 clamped into the domain, 2 pushed out of a moving body, 3 both.
-    r.clamped = (a.w == 1.0f || a.w == 3.0f) ? 1 : 0;
-    r.pushed = a.w >= 2.0f ? 1 : 0;
+    r.clamped = WasClamped(a.w) ? 1 : 0;
+    r.pushed = WasPushed(a.w) ? 1 : 0;
     return r;
   }
 };

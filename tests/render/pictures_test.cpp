@@ -2,8 +2,6 @@
 // desktop window under a private Xvfb (opens, draws, the panel draws, scripted input moves the hand,
 // keys act, closes cleanly). Images are kept under the build tree's test-artifacts/.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>

@@ -15,6 +15,7 @@
 
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
+#include "stages.h"  // sim/src: WasClamped, the clamp flag's encoding
 #include "test_scenes.h"
 
 namespace sphxr::sim {
@@ -36,7 +37,7 @@ Trace RunAndMeasure(const SceneSetup& scene, int steps, int every) {
   Trace t;
   HostBoundary walls;
   solver->DownloadBoundary(&walls);
-  const double mass = solver->ParticleMass();
+  const float mass = solver->ParticleMass();
   std::vector<Vec4> before;  // velocities by particle id at the start of the step
   HostFluid fluid;
   for (int k = 0; k <= steps; ++k) {
@@ -47,7 +48,7 @@ Trace RunAndMeasure(const SceneSetup& scene, int steps, int every) {
       int64_t flagged = 0;
       for (size_t i = 0; i < fluid.size(); ++i) {
         const Vec4& a = fluid.acceleration[i];
-        if (!(a.w == 1.0f || a.w == 3.0f)) continue;  // clamped (IntegrateStage; 3: also pushed out of a body)
+        if (!WasClamped(a.w)) continue;
         ++flagged;
         const Vec4& v0 = before[fluid.id[i]];
         const Vec4& v1 = fluid.velocity[i];
@@ -61,7 +62,7 @@ Trace RunAndMeasure(const SceneSetup& scene, int steps, int every) {
     before.resize(fluid.size());
     for (size_t i = 0; i < fluid.size(); ++i) before[fluid.id[i]] = fluid.velocity[i];
     if (k % every) continue;
-    const EnergySummary e = SphEnergy(scene, solver->ParticleMass(), fluid, walls);
+    const EnergySummary e = SphEnergy(scene, mass, fluid, walls);
     t.total.push_back(e.Total() + t.clampedEnergy);
     t.maxKinetic = std::max(t.maxKinetic, e.kinetic);
   }

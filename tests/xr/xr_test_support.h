@@ -14,9 +14,6 @@ extern "C" Display* glfwGetX11Display(void);
 #undef Always
 #include <png.h>
 
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
