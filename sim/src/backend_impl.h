@@ -161,7 +161,7 @@ class BackendImpl final : public Backend {
       const WallPressureStage wallPressure{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)};
       const int wallCells = static_cast<int>(m_wallCells.size());
       if constexpr (Traits::kSimdStages) {  // the CPU: kLanes wall particles of a cell at once (cpu_stages.h)
-        thrust::for_each_n(policy, first, wallCells, typename Traits::WallPressureBlockStage{wallPressure});
+        Traits::ForEachGuided(wallCells, 8, typename Traits::WallPressureBlockStage{wallPressure});
       } else {
         thrust::for_each_n(policy, first, wallCells, wallPressure);
       }
@@ -174,10 +174,10 @@ class BackendImpl final : public Backend {
       auto end = thrust::copy_if(policy, first, first + n, m_blockStart.begin(),
                                  typename Traits::DensityBlockStart{View(), Raw(m_keys)});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
-      thrust::for_each_n(policy, first, blocks,
-                         typename Traits::DensityBlockStage{density, Raw(m_blockStart),
-                                                            physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr,
-                                                            physics.reuseIdle});
+      Traits::ForEachGuided(blocks, 8,
+                            typename Traits::DensityBlockStage{density, Raw(m_blockStart),
+                                                               physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr,
+                                                               physics.reuseIdle});
     } else {
       overComputing(density);
     }
@@ -186,8 +186,13 @@ class BackendImpl final : public Backend {
     // 5. forces
     if (bodies && m_bodyPressureTerm.size() != static_cast<size_t>(n)) m_bodyPressureTerm.resize(n);
     const ForceStage forces{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr};
-    if constexpr (Traits::kSimdStages) {
-      overComputing(typename Traits::ForceListStage{forces});  // SIMD over each neighbour list (cpu_stages.h)
+    if constexpr (Traits::kSimdStages) {  // SIMD over each neighbour list (cpu_stages.h)
+      const typename Traits::ForceListStage simd{forces};
+      if (physics.reuseEnabled) {
+        Traits::ForEachGuided(computing, 32, OverList<typename Traits::ForceListStage>{Raw(m_computeList), simd});
+      } else {
+        Traits::ForEachGuided(n, 32, simd);
+      }
     } else {
       overComputing(forces);
     }
