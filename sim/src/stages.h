@@ -322,24 +322,35 @@ struct BoundaryVolumeStage {
 };
 
 // ---- stage 3b: activity (reuse on) ---------------------------------------------------------------
-/// The particles, fluid and wall, in the 27 cells around each cell that holds fluid (reuse only): the
-/// activity stage's crowding N_i, once per cell instead of once per particle. Cells outside the grid
-/// count as empty; a cell without fluid is left as it was (no particle reads it). On the AVX2 EPYC the
-/// per-particle sums took 2.3 ms of a 39 ms one-thread `deep_tank` step (docs/reuse.md).
+/// Each cell's particles, fluid and wall (reuse only; every cell, empty ones 0): what CellCrowdStage sums.
+/// Wall particles count too: water along a wall is crowded, not sparse, although the cells beyond the
+/// wall hold no fluid.
+struct CellCountStage {
+  GridView grid;
+  uint32_t* count;
+  SPHXR_HD void operator()(int c) const {
+    uint32_t particles = 0;
+    if (grid.fluidStart[c] != kEmptyCell) particles += grid.fluidEnd[c] - grid.fluidStart[c];
+    if (grid.boundaryStart[c] != kEmptyCell) particles += grid.boundaryEnd[c] - grid.boundaryStart[c];
+    count[c] = particles;
+  }
+};
+
+/// The particles in the 27 cells around each cell that holds fluid (reuse only): the activity stage's
+/// crowding N_i, once per cell instead of once per particle, summed from CellCountStage's counts (one
+/// load per cell instead of the four range bounds). Cells outside the grid count as empty; a cell
+/// without fluid is left as it was (no particle reads it). On the AVX2 EPYC the per-particle sums took
+/// 2.3 ms of a 39 ms one-thread `deep_tank` step (docs/reuse.md).
 struct CellCrowdStage {
   GridView grid;
+  const uint32_t* count;  // CellCountStage
   uint32_t* crowd;
   SPHXR_HD void operator()(int c) const {
     if (grid.fluidStart[c] == kEmptyCell) return;
     int cx, cy, cz;
     grid.CellCoords(c, &cx, &cy, &cz);
     uint32_t particles = 0;
-    ForEachCellAround(grid, cx, cy, cz, [&](uint32_t n) {
-      // Wall particles count too: water along a wall is crowded, not sparse, although the cells beyond
-      // the wall hold no fluid.
-      if (grid.fluidStart[n] != kEmptyCell) particles += grid.fluidEnd[n] - grid.fluidStart[n];
-      if (grid.boundaryStart[n] != kEmptyCell) particles += grid.boundaryEnd[n] - grid.boundaryStart[n];
-    });
+    ForEachCellAround(grid, cx, cy, cz, [&](uint32_t n) { particles += count[n]; });
     crowd[c] = particles;
   }
 };

@@ -4,7 +4,7 @@
 // over-full sets (more than kLanes particles in a cell, more neighbours than list slots), with and without
 // reuse masking some particles out, and with walls (their kernel sums). Forces: the neighbour-list sum
 // and the wall terms (mirrored and wall density). Wall pressure: the blocks of 16 wall particles.
-// Reuse's crowding (CellCrowdStage, ActivityStage; both backends' stages) against counting by brute force.
+// Reuse's crowding (CellCountStage, CellCrowdStage, ActivityStage; both backends' stages) against counting by brute force.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -495,7 +495,7 @@ TEST(CpuStages, DensityReuseMasksLanesThatDoNotCompute) {
 
 
 // Reuse's crowding N_i (ActivityStage): the particles, fluid and wall, of the 27 cells around each
-// particle's cell, counted once per cell by CellCrowdStage (both backends' stage), against counting
+// particle's cell, counted per cell by CellCountStage and summed once per cell by CellCrowdStage (both backends' stages), against counting
 // every particle's cell by brute force; and the classification that reads it.
 TEST(Activity, CrowdCountsTheParticlesOfThe27CellsAroundAndClassifiesByIt) {
   const WallScene scene;
@@ -505,8 +505,10 @@ TEST(Activity, CrowdCountsTheParticlesOfThe27CellsAroundAndClassifiesByIt) {
   for (const Vec3& p : Random(40, -0.01f, 0.17f, 10, 0.19f)) water.push_back(p);
   struct Setup s(water, 64, scene.walls);
   const GridView g = s.Grid();
-  std::vector<uint32_t> crowd(s.start.size(), 0xdeadbeefu);
-  const CellCrowdStage crowdStage{g, crowd.data()};
+  std::vector<uint32_t> count(s.start.size(), 0xdeadbeefu), crowd(s.start.size(), 0xdeadbeefu);
+  const CellCountStage countStage{g, count.data()};
+  for (int c = 0; c < static_cast<int>(count.size()); ++c) countStage(c);
+  const CellCrowdStage crowdStage{g, count.data(), crowd.data()};
   for (int c = 0; c < static_cast<int>(crowd.size()); ++c) crowdStage(c);
 
   auto cellOf = [&](Vec3 p) {
