@@ -23,6 +23,7 @@
 //     largest relative deviation over the sample times (dam break only);
 //   - max_speed, lost/clamped counts, NaN: the run's health.
 // --csv writes one row per run (docs/reuse.csv); bench/plot_reuse.py draws docs/reuse.png.
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -206,6 +207,8 @@ struct Sample {
   float front;
 };
 
+constexpr int kStages = static_cast<int>(sim::Stage::kCount);
+
 struct Result {
   Setting setting;
   int fluid = 0;
@@ -217,6 +220,8 @@ struct Result {
   double surfaceRms = 0, frontDev = 0;
   double loadStart = 0, loadEnd = 0;
   double pairedRefMs = std::nan("");  // median step of the lock-step reference (NaN: unpaired)
+  std::array<double, kStages> stageMs{};          // mean ms per step in each stage (sim::Stage)
+  std::array<double, kStages> pairedRefStageMs{};  // the same for the lock-step reference (0: unpaired)
 };
 
 struct SceneCase {
@@ -292,6 +297,10 @@ class Runner {
     m_r->stepMs = Median(m_stepMs);
     m_r->active = m_stepMs.empty() ? 1.0 : m_activeSum / static_cast<double>(m_stepMs.size());
     m_r->meanErr = m_errTime > 0 ? m_errSum / m_errTime : 0.0;
+    const sim::Totals& totals = m_solver->GetTotals();
+    for (int k = 0; k < kStages; ++k) {
+      m_r->stageMs[k] = totals.steps > 0 ? 1e3 * totals.stageSeconds[k] / static_cast<double>(totals.steps) : 0.0;
+    }
   }
 
  private:
@@ -341,6 +350,7 @@ bool Run(const SceneCase& sc, const Setting& setting, int threads, bool paired, 
   if (paired) {
     ref.Finish();
     r->pairedRefMs = refResult.stepMs;
+    r->pairedRefStageMs = refResult.stageMs;
   }
   return true;
 }
@@ -443,6 +453,18 @@ int main(int argc, char** argv) {
             << r.active << ',' << r.meanErr << ',' << r.peakErr << ',' << r.surfaceRms << ','
             << (sc.dam ? r.frontDev : std::nan("")) << ',' << r.maxSpeed << ',' << r.clamped << ','
             << (r.finite ? 1 : 0) << ',' << r.loadStart << ',' << r.loadEnd << '\n';
+      }
+    }
+    // Where the time goes: each stage's mean per step, the run against its lock-step reference.
+    if (!args.unpaired) {
+      std::printf("stages, mean ms per step: the run (reference in lock-step)\n%-9s", "setting");
+      for (int k = 0; k < kStages; ++k) std::printf(" %15s", sim::StageName(static_cast<sim::Stage>(k)));
+      std::printf("\n");
+      for (const Result& r : results) {
+        if (!std::isfinite(r.pairedRefMs)) continue;
+        std::printf("%-9s", r.setting.name.c_str());
+        for (int k = 0; k < kStages; ++k) std::printf(" %6.3f (%6.3f)", r.stageMs[k], r.pairedRefStageMs[k]);
+        std::printf("\n");
       }
     }
     std::fflush(stdout);
