@@ -49,7 +49,7 @@ namespace sphxr::bench {
 namespace {
 
 struct Setting {
-  std::string name;  // "off", a preset name, or "sweep"
+  std::string name;  // "off", a preset name, "sweep" or "custom"
   bool enabled = false;
   float delta1 = 1, delta2 = 1, threshold = 1.2f;
   int idle = 3;
@@ -65,11 +65,12 @@ struct Args {
   bool unpaired = false;
   bool presetsOnly = false;
   bool help = false;
+  std::vector<Setting> custom;  // --setting: these instead of the sweep and the presets
 };
 
 const char* kUsage =
     "usage: sphxr_bench_reuse [--quick] [--threads N] [--csv FILE] [--scene deep_tank|dam_break_1m] [--time T]\n"
-    "                          [--presets] [--unpaired]\n"
+    "                          [--presets] [--unpaired] [--setting D1,D2,T,IDLE,TOL]...\n"
     "  --quick         off, the three presets and 2 more settings, to t = 0.1 s (a smoke run)\n"
     "  --threads N     CPU backend threads (default 0 = all cores)\n"
     "  --csv FILE      write one row per run to FILE (overwritten; only a file with this bench's header)\n"
@@ -77,7 +78,32 @@ const char* kUsage =
     "  --time T        simulated seconds per run (default 0.3 deep_tank, 0.5 dam_break_1m)\n"
     "  --presets       off and the three presets only (no sweep)\n"
     "  --unpaired      no lock-step reference: half the time, but the speed-up is then against reference runs\n"
-    "                  made minutes apart (noise on a shared machine)\n";
+    "                  made minutes apart (noise on a shared machine)\n"
+    "  --setting D1,D2,T,IDLE,TOL  run this setting (delta1, delta2, threshold, idle steps, accel tolerance\n"
+    "                  in g; 0 = guard off) instead of the sweep and the presets; repeatable\n";
+
+/// "D1,D2,T,IDLE,TOL" (--setting) into a reuse-on setting named "custom"; false unless it is five
+/// finite numbers from 0 (up to 1e9, as the scene's reuse section allows), IDLE a whole number to 1000.
+bool ParseSetting(const std::string& text, Setting* out) {
+  double v[5];
+  size_t at = 0;
+  for (int k = 0; k < 5; ++k) {
+    const size_t comma = k < 4 ? text.find(',', at) : text.size();
+    if (comma == std::string::npos) return false;
+    const std::string field = text.substr(at, comma - at);
+    if (!ParseNumber(field.c_str(), &v[k]) || !(v[k] >= 0.0 && v[k] <= 1e9)) return false;
+    at = comma + 1;
+  }
+  if (v[3] != std::floor(v[3]) || v[3] > 1000) return false;
+  out->name = "custom";
+  out->enabled = true;
+  out->delta1 = static_cast<float>(v[0]);
+  out->delta2 = static_cast<float>(v[1]);
+  out->threshold = static_cast<float>(v[2]);
+  out->idle = static_cast<int>(v[3]);
+  out->tolerance = static_cast<float>(v[4]);
+  return true;
+}
 
 /// Prints the usage to stderr; false, for ParseArgs to return.
 bool Usage() {
@@ -117,6 +143,16 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       out->presetsOnly = true;
     } else if (a == "--unpaired") {
       out->unpaired = true;
+    } else if (a == "--setting" && next(&v)) {
+      Setting setting;
+      if (!ParseSetting(v, &setting)) {
+        std::fprintf(stderr,
+                     "sphxr_bench_reuse: --setting %s: must be D1,D2,T,IDLE,TOL (numbers from 0, IDLE a whole "
+                     "number of steps from 0 to 1000)\n",
+                     v.c_str());
+        return false;
+      }
+      out->custom.push_back(setting);
     } else if (a == "--help" || a == "-h") {
       out->help = true;
     } else {
@@ -149,7 +185,8 @@ Setting Preset(const char* name) {
 
 /// The sweep: one factor at a time around (delta1 0.25, delta2 1, T 1.3, IDLE 3, tolerance 1 g), the
 /// guard off once (to show why it exists), then the presets.
-std::vector<Setting> Settings(bool quick, bool presetsOnly) {
+std::vector<Setting> Settings(bool quick, bool presetsOnly, const std::vector<Setting>& custom) {
+  if (!custom.empty()) return custom;
   std::vector<Setting> s;
   if (quick && !presetsOnly) {
     s = {Sweep(1, 1, 1.2f, 1, 0.0f), Sweep(0.25f, 1, 1.3f, 3, 1.0f)};
@@ -414,7 +451,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s: reference (reuse off) to t = %g s ...\n", sc.name.c_str(), sc.time);
     if (!Run(sc, off, args.threads, false, &ref)) return 1;
     std::vector<Result> results;
-    for (const Setting& s : Settings(args.quick, args.presetsOnly)) {
+    for (const Setting& s : Settings(args.quick, args.presetsOnly, args.custom)) {
       std::fprintf(stderr, "%s: %s delta1 %g delta2 %g T %g IDLE %d tolerance %g ...\n", sc.name.c_str(),
                    s.name.c_str(), s.delta1, s.delta2, s.threshold, s.idle, s.tolerance);
       Result r;
@@ -457,12 +494,14 @@ int main(int argc, char** argv) {
     }
     // Where the time goes: each stage's mean per step, the run against its lock-step reference.
     if (!args.unpaired) {
-      std::printf("stages, mean ms per step: the run (reference in lock-step)\n%-9s", "setting");
+      std::printf("stages, mean ms per step: the run (reference in lock-step)\n%-9s %6s %6s %6s %5s %5s", "setting",
+                  "delta1", "delta2", "T", "IDLE", "tol");
       for (int k = 0; k < kStages; ++k) std::printf(" %15s", sim::StageName(static_cast<sim::Stage>(k)));
       std::printf("\n");
       for (const Result& r : results) {
         if (!std::isfinite(r.pairedRefMs)) continue;
-        std::printf("%-9s", r.setting.name.c_str());
+        std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f", r.setting.name.c_str(), r.setting.delta1, r.setting.delta2,
+                    r.setting.threshold, r.setting.idle, r.setting.tolerance);
         for (int k = 0; k < kStages; ++k) std::printf(" %6.3f (%6.3f)", r.stageMs[k], r.pairedRefStageMs[k]);
         std::printf("\n");
       }

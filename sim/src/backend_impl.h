@@ -151,7 +151,7 @@ class BackendImpl final : public Backend {
     // skipped particles cost nothing.
     auto overComputing = [&](const auto& stage) {
       using S = std::decay_t<decltype(stage)>;
-      if (physics.reuseEnabled) {
+      if (computing < n) {  // reuse skips some: the compacted list (with every particle it is 0..n-1)
         thrust::for_each_n(policy, first, computing, OverList<S>{Raw(m_computeList), stage});
       } else {
         thrust::for_each_n(policy, first, n, stage);
@@ -190,7 +190,7 @@ class BackendImpl final : public Backend {
     const ForceStage forces{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr};
     if constexpr (Traits::kSimdStages) {  // SIMD over each neighbour list (cpu_stages.h)
       const typename Traits::ForceListStage simd{forces};
-      if (physics.reuseEnabled) {
+      if (computing < n) {  // reuse skips some: the compacted list (with every particle it is 0..n-1)
         Traits::ForEachGuided(computing, 32, OverList<typename Traits::ForceListStage>{Raw(m_computeList), simd});
       } else {
         Traits::ForEachGuided(n, 32, simd);
