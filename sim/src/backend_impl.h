@@ -137,8 +137,15 @@ class BackendImpl final : public Backend {
       const int cells = static_cast<int>(m_fluidStart.size());
       m_cellCount.resize(cells);
       m_cellCrowd.resize(cells);
-      thrust::for_each_n(policy, first, cells, CellCountStage{View(), Raw(m_cellCount)});
-      thrust::for_each_n(policy, first, cells, CellCrowdStage{View(), Raw(m_cellCount), Raw(m_cellCrowd)});
+      const GridView grid = View();
+      const int rows = grid.ny * grid.nz;
+      uint32_t* count = Raw(m_cellCount);
+      uint32_t* crowd = Raw(m_cellCrowd);
+      thrust::for_each_n(policy, first, cells, CellCountStage{grid, count});
+      // The 27-cell sums in three passes (x, y, z), the two buffers in turn; the crowding ends in m_cellCrowd.
+      thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
+      thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, crowd, count, 1});
+      thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 2});
       thrust::for_each_n(policy, first, n, ActivityStage{View(), fv, physics, Raw(m_cellCrowd)});
       m_computeList.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),
@@ -474,8 +481,8 @@ class BackendImpl final : public Backend {
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
-  Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell
-  Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each fluid cell
+  Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell; scratch of the 27-cell sums
+  Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each cell
   Vector<uint32_t> m_blockStart;   // CPU density blocks: first particle of each (cpu_stages.h)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;

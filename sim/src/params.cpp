@@ -56,13 +56,13 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
   // bodies: each fluid particle's pressure term for the reaction (4). Boundary: 16 B, plus its sort at
   // start-up (~40 B transient) and the host copy (16); with wall_density its pressure term (4). Grid:
   // 4 ranges of 4 B and the near-boundary flag per cell; with bodies their 2 ranges and near flag (9),
-  // with wall_density the wall-cell list's first size (4), with reuse the cells' crowding (4). Bodies'
+  // with wall_density the wall-cell list's first size (4), with reuse the cells' counts and crowding (8). Bodies'
   // own particles: body frame, index and alpha (24), sorted world copies of position, velocity and
   // force (48), keys, order and owner (12).
   const int64_t perFluid = 68 + 8 + 28 + 8 + 4 + 68 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 4 : 0) +
                            (counts.bodyParticles > 0 ? 4 : 0);
   const int64_t perBoundary = 16 + 40 + 16 + (counts.wallDensity ? 4 : 0);
-  const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0) + (counts.reuse ? 4 : 0);
+  const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0) + (counts.reuse ? 8 : 0);
   return counts.fluid * perFluid + counts.boundary * perBoundary + counts.gridCells * perCell +
          counts.bodyParticles * (24 + 48 + 12);
 }

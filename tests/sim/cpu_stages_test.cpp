@@ -4,7 +4,7 @@
 // over-full sets (more than kLanes particles in a cell, more neighbours than list slots), with and without
 // reuse masking some particles out, and with walls (their kernel sums). Forces: the neighbour-list sum
 // and the wall terms (mirrored and wall density). Wall pressure: the blocks of 16 wall particles.
-// Reuse's crowding (CellCountStage, CellCrowdStage, ActivityStage; both backends' stages) against counting by brute force.
+// Reuse's crowding (CellCountStage, CellBoxSumStage, ActivityStage; both backends' stages) against counting by brute force.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -495,7 +495,7 @@ TEST(CpuStages, DensityReuseMasksLanesThatDoNotCompute) {
 
 
 // Reuse's crowding N_i (ActivityStage): the particles, fluid and wall, of the 27 cells around each
-// particle's cell, counted per cell by CellCountStage and summed once per cell by CellCrowdStage (both backends' stages), against counting
+// particle's cell, counted per cell by CellCountStage and summed over the 27 cells by CellBoxSumStage's three passes (both backends' stages), against counting
 // every particle's cell by brute force; and the classification that reads it.
 TEST(Activity, CrowdCountsTheParticlesOfThe27CellsAroundAndClassifiesByIt) {
   const WallScene scene;
@@ -508,8 +508,10 @@ TEST(Activity, CrowdCountsTheParticlesOfThe27CellsAroundAndClassifiesByIt) {
   std::vector<uint32_t> count(s.start.size(), 0xdeadbeefu), crowd(s.start.size(), 0xdeadbeefu);
   const CellCountStage countStage{g, count.data()};
   for (int c = 0; c < static_cast<int>(count.size()); ++c) countStage(c);
-  const CellCrowdStage crowdStage{g, count.data(), crowd.data()};
-  for (int c = 0; c < static_cast<int>(crowd.size()); ++c) crowdStage(c);
+  for (int axis = 0; axis < 3; ++axis) {  // the backend's three passes, the two buffers in turn
+    const CellBoxSumStage pass{g, axis == 1 ? crowd.data() : count.data(), axis == 1 ? count.data() : crowd.data(), axis};
+    for (int row = 0; row < g.ny * g.nz; ++row) pass(row);
+  }
 
   auto cellOf = [&](Vec3 p) {
     int c[3];
