@@ -54,7 +54,7 @@ def main():
             elif now is not None:
                 ax.plot(x, y, "o", ms=9, color=COLOURS[now], label=now)
             elif guard_off:
-                ax.plot(x, y, "x", ms=9, color="k", label="guard off (T 1.2, IDLE 1)")
+                ax.plot(x, y, "x", ms=9, color="k", label="guard off (T %g, IDLE %d)" % (float(r["threshold"]), int(r["idle"])))
             else:
                 ax.plot(x, y, ".", ms=7, color="0.5")
         ax.axhline(1.0, color="0.7", lw=0.8)

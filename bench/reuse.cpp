@@ -80,28 +80,40 @@ const char* kUsage =
     "  --unpaired      no lock-step reference: half the time, but the speed-up is then against reference runs\n"
     "                  made minutes apart (noise on a shared machine)\n"
     "  --setting D1,D2,T,IDLE,TOL  run this setting (delta1, delta2, threshold, idle steps, accel tolerance\n"
-    "                  in g; 0 = guard off) instead of the sweep and the presets; repeatable\n";
+    "                  in g; 0 = guard off) instead of the sweep and the presets (also with --presets or\n"
+    "                  --quick); repeatable. Each run is named \"custom\"; its parameters are in the row.\n"
+    "The printout ends each scene with every stage's mean ms per step for each paired run and its\n"
+    "reference (not with --unpaired, which has no reference to set beside it).\n";
 
 /// "D1,D2,T,IDLE,TOL" (--setting) into a reuse-on setting named "custom"; false unless it is five
-/// finite numbers from 0 (up to 1e9, as the scene's reuse section allows), IDLE a whole number to 1000.
+/// decimal numbers from 0 to 1e9 (as the scene's reuse section allows) that stay what they say as floats
+/// (1e-50 would become 0, and a tolerance of 0 turns the guard off), IDLE a whole number to 1000.
 bool ParseSetting(const std::string& text, Setting* out) {
-  double v[5];
+  float v[5];
   size_t at = 0;
   for (int k = 0; k < 5; ++k) {
     const size_t comma = k < 4 ? text.find(',', at) : text.size();
     if (comma == std::string::npos) return false;
     const std::string field = text.substr(at, comma - at);
-    if (!ParseNumber(field.c_str(), &v[k]) || !(v[k] >= 0.0 && v[k] <= 1e9)) return false;
     at = comma + 1;
+    // Digits, a point and an exponent only: no sign, space, hex, inf or nan.
+    if (field.empty() || field.find_first_not_of("0123456789.eE+-") != std::string::npos || field[0] == '+' ||
+        field[0] == '-') {
+      return false;
+    }
+    double d = 0.0;
+    if (!ParseNumber(field.c_str(), &d) || d > 1e9) return false;
+    v[k] = static_cast<float>(d);
+    if (d > 0.0 && !(v[k] > 0.0f)) return false;  // a positive number too small for a float
   }
-  if (v[3] != std::floor(v[3]) || v[3] > 1000) return false;
+  if (v[3] != std::floor(v[3]) || v[3] > 1000.0f) return false;
   out->name = "custom";
   out->enabled = true;
-  out->delta1 = static_cast<float>(v[0]);
-  out->delta2 = static_cast<float>(v[1]);
-  out->threshold = static_cast<float>(v[2]);
+  out->delta1 = v[0];
+  out->delta2 = v[1];
+  out->threshold = v[2];
   out->idle = static_cast<int>(v[3]);
-  out->tolerance = static_cast<float>(v[4]);
+  out->tolerance = v[4];
   return true;
 }
 
