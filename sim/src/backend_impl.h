@@ -146,7 +146,7 @@ class BackendImpl final : public Backend {
       thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
       thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, crowd, count, 1});
       thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 2});
-      thrust::for_each_n(policy, first, n, ActivityStage{View(), fv, physics, Raw(m_cellCrowd)});
+      thrust::for_each_n(policy, first, n, ActivityStage{grid, fv, physics, crowd});
       m_computeList.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),
                                  ComputesThisStep{Raw(m_fluid.idle), physics.reuseIdle});
@@ -154,14 +154,24 @@ class BackendImpl final : public Backend {
       if (Status s = lap(Stage::kActivity); !s) return s;
     }
 
-    // Density and forces run over every particle, or with reuse over the compacted list only:
-    // skipped particles cost nothing.
-    auto overComputing = [&](const auto& stage) {
-      using S = std::decay_t<decltype(stage)>;
-      if (computing < n) {  // reuse skips some: the compacted list (with every particle it is 0..n-1)
-        thrust::for_each_n(policy, first, computing, OverList<S>{Raw(m_computeList), stage});
+    // The per-particle and per-block loops: the CPU's SIMD stages in guided chunks of at least `chunk`
+    // items (backend_cpu.cpp), every other stage one thrust::for_each_n.
+    auto loop = [&](int count, int chunk, const auto& stage) {
+      if constexpr (Traits::kSimdStages) {
+        Traits::ForEachGuided(count, chunk, stage);
       } else {
-        thrust::for_each_n(policy, first, n, stage);
+        (void)chunk;
+        thrust::for_each_n(policy, first, count, stage);
+      }
+    };
+    // Density and forces run over every particle, or with reuse over the compacted list only:
+    // skipped particles cost nothing. With every particle computing the list is 0..n-1: no indirection.
+    auto overComputing = [&](int chunk, const auto& stage) {
+      using S = std::decay_t<decltype(stage)>;
+      if (computing < n) {
+        loop(computing, chunk, OverList<S>{Raw(m_computeList), stage});
+      } else {
+        loop(n, chunk, stage);
       }
     };
 
@@ -170,9 +180,9 @@ class BackendImpl final : public Backend {
       const WallPressureStage wallPressure{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)};
       const int wallCells = static_cast<int>(m_wallCells.size());
       if constexpr (Traits::kSimdStages) {  // the CPU: kLanes wall particles of a cell at once (cpu_stages.h)
-        Traits::ForEachGuided(wallCells, 8, typename Traits::WallPressureBlockStage{wallPressure});
+        loop(wallCells, 8, typename Traits::WallPressureBlockStage{wallPressure});
       } else {
-        thrust::for_each_n(policy, first, wallCells, wallPressure);
+        loop(wallCells, 8, wallPressure);
       }
     }
     // 4. density and pressure. The CPU runs it in cell blocks (cpu_stages.h), with reuse masking the
@@ -183,27 +193,21 @@ class BackendImpl final : public Backend {
       auto end = thrust::copy_if(policy, first, first + n, m_blockStart.begin(),
                                  typename Traits::DensityBlockStart{View(), Raw(m_keys)});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
-      Traits::ForEachGuided(blocks, 8,
-                            typename Traits::DensityBlockStage{density, Raw(m_blockStart),
-                                                               physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr,
-                                                               physics.reuseIdle});
+      loop(blocks, 8,
+           typename Traits::DensityBlockStage{density, Raw(m_blockStart),
+                                              physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr, physics.reuseIdle});
     } else {
-      overComputing(density);
+      overComputing(32, density);
     }
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // 5. forces
     if (bodies && m_bodyPressureTerm.size() != static_cast<size_t>(n)) m_bodyPressureTerm.resize(n);
     const ForceStage forces{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr};
-    if constexpr (Traits::kSimdStages) {  // SIMD over each neighbour list (cpu_stages.h)
-      const typename Traits::ForceListStage simd{forces};
-      if (computing < n) {  // reuse skips some: the compacted list (with every particle it is 0..n-1)
-        Traits::ForEachGuided(computing, 32, OverList<typename Traits::ForceListStage>{Raw(m_computeList), simd});
-      } else {
-        Traits::ForEachGuided(n, 32, simd);
-      }
+    if constexpr (Traits::kSimdStages) {
+      overComputing(32, typename Traits::ForceListStage{forces});  // SIMD over each neighbour list (cpu_stages.h)
     } else {
-      overComputing(forces);
+      overComputing(32, forces);
     }
     if (Status s = lap(Stage::kForces); !s) return s;
 
