@@ -191,10 +191,10 @@ class BackendImpl final : public Backend {
     if constexpr (Traits::kSimdStages) {
       m_blockStart.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_blockStart.begin(),
-                                 typename Traits::DensityBlockStart{View(), Raw(m_keys)});
+                                 typename Traits::DensityBlockStart{View(), Raw(m_keys), n});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
       loop(blocks, 8,
-           typename Traits::DensityBlockStage{density, Raw(m_blockStart),
+           typename Traits::DensityBlockStage{density, Raw(m_keys), Raw(m_blockStart),
                                               physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr, physics.reuseIdle});
     } else {
       overComputing(32, density);

@@ -255,11 +255,14 @@ inline Lanes KernelWLanes(const CubicSpline& k, Lanes q, LaneInts valid) {
   return Select(And(valid, Less(q, Splat(1.0f))), w, Splat(0.0f));
 }
 
-/// The pair of cells along x that a density block is drawn from: cells 2m and 2m + 1 of a row, whose
-/// Morton codes differ in the lowest bit only, so their particles are one contiguous run (`first`,
-/// `end`). With 16 lanes a block from the pair fills the vector better than one cell's ~8; with 8 a
-/// pair's run still gives fewer part-filled blocks than each cell alone, and the pair's 4 x 3 x 3 cells
-/// around it are 36 instead of twice 27.
+/// The pair of cells along x that a density block is drawn from where its particles are many: cells
+/// 2m and 2m + 1 of a row, whose Morton codes differ in the lowest bit only, so their particles are one
+/// contiguous run (`first`, `end`). With 16 lanes a block from the pair fills the vector better than one
+/// cell's ~8, and the pair's 4 x 3 x 3 cells around it are 36 instead of twice 27. A pair of more than
+/// kLanes is cut into runs of kLanes, from the pair's first particle or, where that makes fewer
+/// candidate loads, from each cell's (`single`): a block's candidates scale with the cells around it,
+/// so the cut costs 36 per pair block and 27 per cell block (17 particles, 8 + 9: two pair blocks, 72,
+/// or two cell blocks, 54; 40, 20 + 20: three pair blocks, 108, or four cell blocks, 108).
 struct CellPair {
   int x0, x1;  // the pair's cells along x (x1 == x0 when the grid ends)
   uint32_t first, end;
@@ -275,43 +278,128 @@ SPHXR_INLINE CellPair PairOf(const GridView& g, int cx, int cy, int cz) {
   return p;
 }
 
-/// Whether particle i starts a block: it is the first of its cell pair, or kLanes, 2 kLanes, ... after it.
-/// Its cell comes from the step's sorted Morton keys (CellCodeStage), not from its position again.
+/// The run that the blocks of cell (cx, cy, cz)'s particles are cut from when their 2 x 2 x 1 box holds
+/// more than kLanes (BlockBoxOf): the pair's, or the cell's own (x0 == x1 == cx) where that is cheaper.
+/// `pairsOnly`: always the pair's (the layout before the boxes; for benchmarks).
+SPHXR_INLINE CellPair CutRunOf(const GridView& g, int cx, int cy, int cz, bool pairsOnly) {
+  const CellPair pair = PairOf(g, cx, cy, cz);
+  const uint32_t n = pair.end - pair.first;
+  if (pairsOnly || n <= static_cast<uint32_t>(kLanes) || pair.x1 == pair.x0) return pair;
+  const uint32_t c0 = g.Linear(pair.x0, cy, cz), c1 = g.Linear(pair.x1, cy, cz);
+  if (g.fluidStart[c0] == kEmptyCell || g.fluidStart[c1] == kEmptyCell) return pair;
+  auto blocks = [](uint32_t m) { return (m + static_cast<uint32_t>(kLanes) - 1) / static_cast<uint32_t>(kLanes); };
+  const uint32_t n0 = g.fluidEnd[c0] - g.fluidStart[c0], n1 = g.fluidEnd[c1] - g.fluidStart[c1];
+  if (27 * (blocks(n0) + blocks(n1)) >= 36 * blocks(n)) return pair;
+  const uint32_t c = cx == pair.x0 ? c0 : c1;
+  return CellPair{cx, cx, g.fluidStart[c], g.fluidEnd[c]};
+}
+
+/// Where particles are few (spray, a thin sheet, the surface), a pair holds two or three and its block
+/// leaves most lanes empty. Cells whose Morton codes agree above the lowest m bits form a box
+/// (m = 1: 2 x 1 x 1 cells, the pair; 2: 2 x 2 x 1; 3: 2 x 2 x 2; 4: 4 x 2 x 2; 5: 4 x 4 x 2; 6: 4 x 4 x 4)
+/// and their particles one contiguous run of the sorted keys. A block is the largest such box, up to
+/// level kMaxBlockLevel, whose run fits in kLanes; where not even the 2 x 2 x 1 box fits, the pair's
+/// or the cell's run cut into kLanes (CutRunOf). Every particle of a box finds the same box (the boxes of one level tile the grid,
+/// and a box that fits holds only boxes that fit), so the blocks tile the particles.
+inline constexpr int kMaxBlockLevel = 6;
+
+struct BlockBox {
+  int level;             // m: 1 for the cut runs (CutRunOf)
+  uint32_t first, end;   // the box's run (level 1: the whole run it is cut from)
+  int x0, x1, y0, y1, z0, z1;  // its cells, clamped to the grid
+};
+
+/// The block box of particle i (keys: the sorted Morton keys of the n particles). `pairsOnly`: every
+/// block from a pair, cut from the pair's first (the layout before the boxes; for benchmarks, results
+/// bit for bit the same).
+SPHXR_INLINE BlockBox BlockBoxOf(const GridView& g, const uint32_t* keys, int n, int i, bool pairsOnly) {
+  const uint32_t key = keys[i];
+  int lo = i, hi = i + 1, level = 1;
+  for (int m = 2; m <= (pairsOnly ? 1 : kMaxBlockLevel); ++m) {  // widen the run level by level while it fits
+    const uint32_t top = key >> m;
+    int a = lo, b = hi;
+    while (a > 0 && (keys[a - 1] >> m) == top && b - a <= kLanes) --a;
+    while (b < n && (keys[b] >> m) == top && b - a <= kLanes) ++b;
+    if (b - a > kLanes) break;
+    lo = a;
+    hi = b;
+    level = m;
+  }
+  uint32_t cx, cy, cz;
+  MortonDecode(key >> level << level, &cx, &cy, &cz);
+  BlockBox box;
+  box.level = level;
+  box.x0 = static_cast<int>(cx);
+  box.y0 = static_cast<int>(cy);
+  box.z0 = static_cast<int>(cz);
+  const int sx = 1 << ((level + 2) / 3), sy = 1 << ((level + 1) / 3), sz = 1 << (level / 3);
+  box.x1 = box.x0 + sx - 1 < g.nx ? box.x0 + sx - 1 : g.nx - 1;
+  box.y1 = box.y0 + sy - 1 < g.ny ? box.y0 + sy - 1 : g.ny - 1;
+  box.z1 = box.z0 + sz - 1 < g.nz ? box.z0 + sz - 1 : g.nz - 1;
+  if (level == 1) {
+    const CellPair run = CutRunOf(g, static_cast<int>(MortonCompact(key)), box.y0, box.z0, pairsOnly);
+    box.x0 = run.x0;
+    box.x1 = run.x1;
+    box.first = run.first;
+    box.end = run.end;
+  } else {
+    box.first = static_cast<uint32_t>(lo);
+    box.end = static_cast<uint32_t>(hi);
+  }
+  return box;
+}
+
+/// Whether particle i starts a density block: the first of its box, or (a pair's cut runs) kLanes,
+/// 2 kLanes, ... after the pair's first. Its cell comes from the step's sorted Morton keys
+/// (CellCodeStage), not from its position again. A particle that is not its cell's first can start a
+/// block only as a cut (its box's first is some cell's first), so only cells' firsts look for a box.
 struct DensityBlockStart {
   GridView grid;
   const uint32_t* keys;  // sorted
+  int count;             // particles
+  bool pairsOnly = false;  // BlockBoxOf's
   bool operator()(int i) const {
-    uint32_t cx, cy, cz;
-    MortonDecode(keys[i], &cx, &cy, &cz);
-    const CellPair pair = PairOf(grid, static_cast<int>(cx), static_cast<int>(cy), static_cast<int>(cz));
-    return (static_cast<uint32_t>(i) - pair.first) % kLanes == 0;
+    const uint32_t key = keys[i];
+    if (i > 0 && keys[i - 1] == key) {
+      uint32_t cx, cy, cz;
+      MortonDecode(key, &cx, &cy, &cz);
+      const CellPair run = CutRunOf(grid, static_cast<int>(cx), static_cast<int>(cy), static_cast<int>(cz), pairsOnly);
+      return (static_cast<uint32_t>(i) - run.first) % kLanes == 0;
+    }
+    const BlockBox box = BlockBoxOf(grid, keys, count, i, pairsOnly);
+    return (static_cast<uint32_t>(i) - box.first) % kLanes == 0;
   }
 };
 
-/// The cells around a block of lanes whose particles lie in one box of cells (x0..x1, cy, cz) of the
-/// grid: the box's 27 (one cell) or 36 (a pair) neighbour cells, less those no lane can reach. Each
-/// lane's position, clamped to the box (as ForEachInCells clamps to a particle's cell), widens the
-/// block's extent per axis; a cell a cell size (>= the support) or more from that extent holds no
-/// particle within any lane's support. The cells are visited in ForEachInCells' order (z, y, x), so
-/// each lane meets its candidates in the order its own scan would.
+/// The cells around a block of lanes whose particles lie in one box of cells (x0..x1, y0..y1, z0..z1)
+/// of the grid: the box's neighbour cells (27 around one cell, 36 around a pair, up to 216 around a
+/// 4 x 4 x 4 box), less those no lane can reach. Each lane's position, clamped to the box (as
+/// ForEachInCells clamps to a particle's cell), widens the block's extent per axis; a cell a cell size
+/// (>= the support) or more from that extent holds no particle within any lane's support. The cells
+/// are visited in ForEachInCells' order (z, y, x), so each lane meets its candidates in the order its
+/// own scan would: its own 27 cells come in that order among the box's, and the other cells hold no
+/// particle within its support.
 struct BlockCells {
   const GridView* g;
-  int x0, x1, cy, cz;
+  int x0, x1, y0, y1, z0, z1;
   float origin[3], extent[3], lo[3], hi[3];
 
-  BlockCells(const GridView& grid, int boxX0, int boxX1, int boxY, int boxZ)
-      : g(&grid), x0(boxX0), x1(boxX1), cy(boxY), cz(boxZ) {
+  BlockCells(const GridView& grid, int boxX0, int boxX1, int boxY0, int boxY1, int boxZ0, int boxZ1)
+      : g(&grid), x0(boxX0), x1(boxX1), y0(boxY0), y1(boxY1), z0(boxZ0), z1(boxZ1) {
     const float cs = grid.cellSize;
     origin[0] = grid.origin.x + static_cast<float>(x0) * cs;
-    origin[1] = grid.origin.y + static_cast<float>(cy) * cs;
-    origin[2] = grid.origin.z + static_cast<float>(cz) * cs;
+    origin[1] = grid.origin.y + static_cast<float>(y0) * cs;
+    origin[2] = grid.origin.z + static_cast<float>(z0) * cs;
     extent[0] = static_cast<float>(x1 - x0 + 1) * cs;
-    extent[1] = extent[2] = cs;
+    extent[1] = static_cast<float>(y1 - y0 + 1) * cs;
+    extent[2] = static_cast<float>(z1 - z0 + 1) * cs;
     for (int a = 0; a < 3; ++a) {
       lo[a] = extent[a];
       hi[a] = 0.0f;
     }
   }
+  BlockCells(const GridView& grid, const BlockBox& box)
+      : BlockCells(grid, box.x0, box.x1, box.y0, box.y1, box.z0, box.z1) {}
   /// Widens the extent by one lane's position.
   void Add(const Vec4& p) {
     const float local[3] = {p.x - origin[0], p.y - origin[1], p.z - origin[2]};
@@ -326,7 +414,7 @@ struct BlockCells {
   void ForEach(const uint32_t* start, const uint32_t* end, F&& f) const {
     const GridView& grid = *g;
     const float cs = grid.cellSize;
-    const int base[3] = {x0, cy, cz};
+    const int base[3] = {x0, y0, z0};
     // Squared distance along `axis` from the block's extent to cell c.
     auto gap = [&](int axis, int c) {
       const float cellLo = static_cast<float>(c - base[axis]) * cs, cellHi = cellLo + cs;
@@ -334,12 +422,12 @@ struct BlockCells {
       return d * d;
     };
     const float reach2 = cs * cs;
-    const int z0 = cz > 0 ? cz - 1 : 0, z1 = cz < grid.nz - 1 ? cz + 1 : cz;
-    const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy < grid.ny - 1 ? cy + 1 : cy;
+    const int za = z0 > 0 ? z0 - 1 : 0, zb = z1 < grid.nz - 1 ? z1 + 1 : z1;
+    const int ya = y0 > 0 ? y0 - 1 : 0, yb = y1 < grid.ny - 1 ? y1 + 1 : y1;
     const int xa = x0 > 0 ? x0 - 1 : 0, xb = x1 < grid.nx - 1 ? x1 + 1 : x1;
-    for (int z = z0; z <= z1; ++z) {
+    for (int z = za; z <= zb; ++z) {
       const float dz2 = gap(2, z);
-      for (int y = y0; y <= y1; ++y) {
+      for (int y = ya; y <= yb; ++y) {
         const float dyz2 = dz2 + gap(1, y);
         if (dyz2 >= reach2) continue;
         const uint32_t row = grid.Linear(0, y, z);
@@ -387,24 +475,24 @@ inline Lanes GradFactorLanes(const CubicSpline& k, Lanes q, Lanes r, LaneInts pa
                   Select(LessEq(q, Splat(0.5f)), k.gradA * (3.0f * q - 2.0f), -k.gradB * t * t / r), Splat(0.0f));
 }
 
-/// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to kLanes
-/// particles or the end of its cell pair). With reuse (`idle` set), only the lanes that compute this
+/// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to the
+/// end of its box's run, or kLanes particles of its pair's: BlockBoxOf). With reuse (`idle` set), only the lanes that compute this
 /// step (ComputesThisStep) are written; a block without one costs nothing. The walls' sums
 /// (DensityStage::WallSum) are taken the same way, for the lanes whose cell has wall particles around.
 struct DensityBlockStage {
   DensityStage stage;
+  const uint32_t* keys;        // the sorted Morton keys (DensityBlockStart's)
   const uint32_t* blockStart;
   const int32_t* idle = nullptr;  // reuse: the idle counts; nullptr: every particle computes
   int32_t idleSteps = 0;
+  bool pairsOnly = false;  // DensityBlockStart's
 
   void operator()(int b) const {
     const GridView& g = stage.grid;
     const Vec4* position = stage.fluid.position;
     const uint32_t first = blockStart[b];
-    int cx, cy, cz;
-    g.CellOf(Xyz(position[first]), &cx, &cy, &cz);
-    const CellPair pair = PairOf(g, cx, cy, cz);
-    const int lanes = static_cast<int>(pair.end - first < static_cast<uint32_t>(kLanes) ? pair.end - first : kLanes);
+    const BlockBox box = BlockBoxOf(g, keys, stage.fluid.count, static_cast<int>(first), pairsOnly);
+    const int lanes = static_cast<int>(box.end - first < static_cast<uint32_t>(kLanes) ? box.end - first : kLanes);
     uint32_t computing = 0;
     const ComputesThisStep computes{idle, idleSteps};
     for (int l = 0; l < lanes; ++l) {
@@ -413,7 +501,7 @@ struct DensityBlockStage {
     if (computing == 0) return;
 
     Lanes px = Splat(1e30f), py = px, pz = px;
-    BlockCells cells(g, pair.x0, pair.x1, cy, cz);
+    BlockCells cells(g, box);
     for (int l = 0; l < kLanes; ++l) {
       if (computing & (1u << l)) {
         const Vec4 p = position[first + l];
@@ -471,10 +559,17 @@ struct DensityBlockStage {
     // The walls: the lanes whose own cell has a wall particle in its 27 cells (WallSum's test); the
     // others keep 0, as WallSum gives them.
     Lanes wall = Splat(0.0f);
-    const bool near0 = g.boundaryNear[g.Linear(pair.x0, cy, cz)] != 0, near1 = g.boundaryNear[g.Linear(pair.x1, cy, cz)] != 0;
-    if (near0 || near1) {
+    bool anyNear = false, allNear = true;
+    for (int z = box.z0; z <= box.z1; ++z)
+      for (int y = box.y0; y <= box.y1; ++y)
+        for (int x = box.x0; x <= box.x1; ++x) {
+          const bool near = g.boundaryNear[g.Linear(x, y, z)] != 0;
+          anyNear = anyNear || near;
+          allNear = allNear && near;
+        }
+    if (anyNear) {
       Lanes wx = px, wy = py, wz = pz;
-      if (!(near0 && near1)) {
+      if (!allNear) {
         for (int l = 0; l < kLanes; ++l) {
           if (!(computing & (1u << l))) continue;
           int lx, ly, lz;
@@ -617,7 +712,7 @@ struct WallPressureBlockStage {
     for (uint32_t first = s; first < e; first += kLanes) {
       const int lanes = static_cast<int>(e - first < static_cast<uint32_t>(kLanes) ? e - first : kLanes);
       Lanes px = Splat(1e30f), py = px, pz = px;
-      BlockCells cells(g, cx, cx, cy, cz);
+      BlockCells cells(g, cx, cx, cy, cy, cz, cz);
       for (int l = 0; l < lanes; ++l) {
         const Vec4 p = g.boundary[first + l];
         px[l] = p.x;

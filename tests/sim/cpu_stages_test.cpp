@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <random>
 #include <string>
@@ -167,17 +168,30 @@ struct Setup {
     }
   }
 
-  void RunBlocked(bool reuse, int idleSteps) {
-    const int n = static_cast<int>(position.size());
-    std::vector<uint32_t> keys;  // the sorted Morton keys, as the backend's sort leaves them
+  /// The sorted Morton keys, as the backend's sort leaves them.
+  std::vector<uint32_t> Keys() {
     const GridView g = Grid();
+    std::vector<uint32_t> keys;
     for (const Vec4& p : position) keys.push_back(CellKey(g, Xyz(p)));
-    const DensityBlockStart isStart{g, keys.data()};
+    return keys;
+  }
+
+  /// The first particle of each density block (DensityBlockStart).
+  std::vector<uint32_t> BlockStarts(const std::vector<uint32_t>& keys, bool pairsOnly) {
+    const int n = static_cast<int>(position.size());
+    const DensityBlockStart isStart{Grid(), keys.data(), n, pairsOnly};
     std::vector<uint32_t> blocks;
     for (int i = 0; i < n; ++i) {
       if (isStart(i)) blocks.push_back(static_cast<uint32_t>(i));
     }
-    const DensityBlockStage s{Stage(), blocks.data(), reuse ? idle.data() : nullptr, idleSteps};
+    return blocks;
+  }
+
+  void RunBlocked(bool reuse, int idleSteps, bool pairsOnly = false) {
+    const std::vector<uint32_t> keys = Keys();
+    const std::vector<uint32_t> blocks = BlockStarts(keys, pairsOnly);
+    const DensityBlockStage s{Stage(), keys.data(), blocks.data(), reuse ? idle.data() : nullptr, idleSteps,
+                              pairsOnly};
     for (int b = 0; b < static_cast<int>(blocks.size()); ++b) s(b);
   }
 };
@@ -186,17 +200,29 @@ struct Setup {
 void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what, bool reuse = false,
              const std::vector<Vec3>& walls = {}) {
   SCOPED_TRACE(what);
-  Setup perParticle(points, maxNeighbours, walls), blocked(points, maxNeighbours, walls);
+  Setup perParticle(points, maxNeighbours, walls), blocked(points, maxNeighbours, walls),
+      pairs(points, maxNeighbours, walls);
   const size_t n = perParticle.position.size();
   constexpr int kIdle = 3;
   if (reuse) {  // every third particle reuses this step (IC = 1), every fifth computes at IC = IDLE
     for (size_t i = 0; i < n; ++i) {
       const int32_t ic = i % 3 == 0 ? 1 : (i % 5 == 0 ? kIdle : -1);
-      perParticle.idle[i] = blocked.idle[i] = ic;
+      perParticle.idle[i] = blocked.idle[i] = pairs.idle[i] = ic;
     }
   }
   perParticle.RunPerParticle(reuse, kIdle);
   blocked.RunBlocked(reuse, kIdle);
+  pairs.RunBlocked(reuse, kIdle, /*pairsOnly=*/true);
+  // The boxes and the pairs-only layout give every lane the same candidates in the same order: the
+  // same bits, not just close.
+  for (size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(blocked.count[i], pairs.count[i]) << "particle " << i;
+    ASSERT_EQ(std::memcmp(&blocked.density[i], &pairs.density[i], sizeof(float)), 0)
+        << "particle " << i << ": " << blocked.density[i] << " against " << pairs.density[i] << " (pairs only)";
+    ASSERT_EQ(std::memcmp(&blocked.pressure[i], &pairs.pressure[i], sizeof(float)), 0) << "particle " << i;
+    ASSERT_EQ(std::memcmp(&blocked.position[i].w, &pairs.position[i].w, sizeof(float)), 0) << "particle " << i;
+  }
+  ASSERT_EQ(blocked.index, pairs.index);
   const CubicSpline k = perParticle.ph.kernel;
   size_t overflowed = 0, checked = 0, nearWall = 0;
   for (size_t i = 0; i < n; ++i) {
@@ -491,6 +517,87 @@ TEST(CpuStages, DensityOddRowEndAndOutsideTheGridMatch) {
 
 TEST(CpuStages, DensityReuseMasksLanesThatDoNotCompute) {
   Compare(Random(3000, 0.0f, 0.16f, 3), 64, "random, reuse", /*reuse=*/true);
+}
+
+/// A lattice with `perCell` particles in every cell of a box of cells, jittered inside its cell.
+std::vector<Vec3> PerCell(int cellsX, int cellsY, int cellsZ, int perCell, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.02f, 0.98f);
+  std::vector<Vec3> p;
+  for (int z = 0; z < cellsZ; ++z)
+    for (int y = 0; y < cellsY; ++y)
+      for (int x = 0; x < cellsX; ++x)
+        for (int k = 0; k < perCell; ++k) {
+          p.push_back(Vec3{(x + u(rng)) * kSupport, (y + u(rng)) * kSupport, (z + u(rng)) * kSupport});
+        }
+  return p;
+}
+
+// Spray (far fewer particles than cells): the blocks span boxes of up to 4 x 4 x 4 cells.
+TEST(CpuStages, DensitySprayInBoxBlocksMatches) {
+  Compare(Random(400, 0.0f, 0.16f, 11), 64, "spray");
+  Compare(Random(400, 0.0f, 0.16f, 12), 64, "spray, reuse", /*reuse=*/true);
+  const WallScene scene;
+  std::vector<Vec3> low = Random(300, 0.0f, 0.16f, 13, 0.18f);  // spray low over the floor
+  for (Vec3& v : low) v.y *= 0.3f;
+  Compare(low, 64, "spray over walls", /*reuse=*/false, scene.walls);
+}
+
+// Cells of 9 and 12 (pairs of 18 and 24): their blocks are cut per cell, not per pair.
+TEST(CpuStages, DensityCrowdedPairsCutPerCellMatch) {
+  Compare(PerCell(8, 8, 8, 9, 14), 64, "9 per cell");
+  Compare(PerCell(7, 8, 8, 12, 15), 64, "12 per cell, odd row", /*reuse=*/true);
+}
+
+// The blocks tile the particles: each particle in exactly one block of at most kLanes, every block's
+// particles inside its box; spray takes boxes of several cells, and crowded pairs are cut per cell.
+TEST(CpuStages, DensityBlocksTileTheParticles) {
+  struct Case {
+    std::string what;
+    std::vector<Vec3> points;
+    int minLevel, maxLevel;  // levels that some block must reach
+  };
+  const std::vector<Case> cases = {
+      {"spray", Random(400, 0.0f, 0.16f, 11), 4, kMaxBlockLevel},
+      {"random", Random(3000, 0.0f, 0.16f, 1), 1, 2},
+      {"9 per cell", PerCell(8, 8, 8, 9, 14), 1, 1},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    struct Setup s(c.points, 64);
+    const GridView g = s.Grid();
+    const int n = static_cast<int>(s.position.size());
+    const std::vector<uint32_t> keys = s.Keys();
+    const std::vector<uint32_t> starts = s.BlockStarts(keys, false), pairStarts = s.BlockStarts(keys, true);
+    std::vector<int> blockOf(n, -1);
+    int deepest = 0, shallowest = kMaxBlockLevel, singleCells = 0;
+    for (size_t b = 0; b < starts.size(); ++b) {
+      const BlockBox box = BlockBoxOf(g, keys.data(), n, static_cast<int>(starts[b]), false);
+      deepest = std::max(deepest, box.level);
+      shallowest = std::min(shallowest, box.level);
+      if (box.level == 1 && box.x0 == box.x1) ++singleCells;
+      const uint32_t end = std::min<uint32_t>(box.end, starts[b] + kLanes);
+      ASSERT_GT(end, starts[b]);
+      for (uint32_t i = starts[b]; i < end; ++i) {
+        ASSERT_EQ(blockOf[i], -1) << "particle " << i << " in two blocks";
+        blockOf[i] = static_cast<int>(b);
+        int cx, cy, cz;
+        g.CellOf(Xyz(s.position[i]), &cx, &cy, &cz);
+        EXPECT_TRUE(cx >= box.x0 && cx <= box.x1 && cy >= box.y0 && cy <= box.y1 && cz >= box.z0 && cz <= box.z1)
+            << "particle " << i << " outside its block's box";
+      }
+    }
+    for (int i = 0; i < n; ++i) ASSERT_NE(blockOf[i], -1) << "particle " << i << " in no block";
+    EXPECT_GE(deepest, c.minLevel);
+    EXPECT_LE(shallowest, c.maxLevel);
+    if (c.what == "spray") {
+      EXPECT_LT(starts.size() * 2, pairStarts.size()) << "spray in boxes: far fewer blocks than pairs";
+    }
+    if (c.what == "9 per cell") {  // every pair of 18 is cut into its two cells: one block each
+      EXPECT_EQ(singleCells, static_cast<int>(starts.size()));
+      EXPECT_EQ(starts.size(), pairStarts.size());
+    }
+  }
 }
 
 
