@@ -3,8 +3,9 @@
 // stages.h's DensityStage and ForceStage, a thread per particle). The physics is stages.h's: these
 // only arrange the same sums for vector units (kLanes wide: 8 with AVX, else 16; see kLanes).
 //
-// Density (DensityBlockStage): one work item per block of up to kLanes particles of a pair of grid cells
-// along x (particles are sorted by Morton code, so a pair is a contiguous run). Each candidate j of the cells around
+// Density (DensityBlockStage): one work item per block of up to kLanes particles of one box of grid cells
+// (particles are sorted by Morton code, so a Morton-aligned box is a contiguous run: a pair of cells along
+// x where the water is dense, up to 4 x 4 x 4 cells in spray; BlockBoxOf). Each candidate j of the cells around
 // the block is loaded once and evaluated for all the block's particles at once: the distance, the hit
 // mask, sqrt and the kernel (both pieces, selected per lane); the neighbour-list appends are scalar
 // (kVectorAppends: on AVX and AVX-512 without a branch per hit). The per-particle DensityStage does the same one
@@ -260,7 +261,7 @@ inline Lanes KernelWLanes(const CubicSpline& k, Lanes q, LaneInts valid) {
 /// contiguous run (`first`, `end`). With 16 lanes a block from the pair fills the vector better than one
 /// cell's ~8, and the pair's 4 x 3 x 3 cells around it are 36 instead of twice 27. A pair of more than
 /// kLanes is cut into runs of kLanes, from the pair's first particle or, where that makes fewer
-/// candidate loads, from each cell's (`single`): a block's candidates scale with the cells around it,
+/// candidate loads, from each cell's (CutRunOf): a block's candidates scale with the cells around it,
 /// so the cut costs 36 per pair block and 27 per cell block (17 particles, 8 + 9: two pair blocks, 72,
 /// or two cell blocks, 54; 40, 20 + 20: three pair blocks, 108, or four cell blocks, 108).
 struct CellPair {
@@ -280,7 +281,7 @@ SPHXR_INLINE CellPair PairOf(const GridView& g, int cx, int cy, int cz) {
 
 /// The run that the blocks of cell (cx, cy, cz)'s particles are cut from when their 2 x 2 x 1 box holds
 /// more than kLanes (BlockBoxOf): the pair's, or the cell's own (x0 == x1 == cx) where that is cheaper.
-/// `pairsOnly`: always the pair's (the layout before the boxes; for benchmarks).
+/// `pairsOnly`: always the pair's (the layout before the boxes, which the tests hold the boxes to).
 SPHXR_INLINE CellPair CutRunOf(const GridView& g, int cx, int cy, int cz, bool pairsOnly) {
   const CellPair pair = PairOf(g, cx, cy, cz);
   const uint32_t n = pair.end - pair.first;
@@ -299,8 +300,10 @@ SPHXR_INLINE CellPair CutRunOf(const GridView& g, int cx, int cy, int cz, bool p
 /// (m = 1: 2 x 1 x 1 cells, the pair; 2: 2 x 2 x 1; 3: 2 x 2 x 2; 4: 4 x 2 x 2; 5: 4 x 4 x 2; 6: 4 x 4 x 4)
 /// and their particles one contiguous run of the sorted keys. A block is the largest such box, up to
 /// level kMaxBlockLevel, whose run fits in kLanes; where not even the 2 x 2 x 1 box fits, the pair's
-/// or the cell's run cut into kLanes (CutRunOf). Every particle of a box finds the same box (the boxes of one level tile the grid,
-/// and a box that fits holds only boxes that fit), so the blocks tile the particles.
+/// or the cell's run cut into kLanes (CutRunOf). Every particle of a box finds the same box (the boxes
+/// of one level tile the grid, and a box that fits holds only boxes that fit), so the blocks tile the
+/// particles. The start predicate and the stage each find a block's box (from its first particle);
+/// the stage's second look costs a scan of at most 2 kLanes keys per block.
 inline constexpr int kMaxBlockLevel = 6;
 
 struct BlockBox {
@@ -310,8 +313,8 @@ struct BlockBox {
 };
 
 /// The block box of particle i (keys: the sorted Morton keys of the n particles). `pairsOnly`: every
-/// block from a pair, cut from the pair's first (the layout before the boxes; for benchmarks, results
-/// bit for bit the same).
+/// block from a pair, cut from the pair's first (the layout before the boxes; the results are the same
+/// bit for bit, and tests/sim/cpu_stages_test.cpp checks that they are).
 SPHXR_INLINE BlockBox BlockBoxOf(const GridView& g, const uint32_t* keys, int n, int i, bool pairsOnly) {
   const uint32_t key = keys[i];
   int lo = i, hi = i + 1, level = 1;
@@ -476,7 +479,7 @@ inline Lanes GradFactorLanes(const CubicSpline& k, Lanes q, Lanes r, LaneInts pa
 }
 
 /// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to the
-/// end of its box's run, or kLanes particles of its pair's: BlockBoxOf). With reuse (`idle` set), only the lanes that compute this
+/// end of its box's run, or kLanes of a cut run: BlockBoxOf). With reuse (`idle` set), only the lanes that compute this
 /// step (ComputesThisStep) are written; a block without one costs nothing. The walls' sums
 /// (DensityStage::WallSum) are taken the same way, for the lanes whose cell has wall particles around.
 struct DensityBlockStage {
