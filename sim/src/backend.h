@@ -59,7 +59,8 @@ class Backend {
   virtual SurfaceExtractor* Surface() = 0;
 };
 
-std::unique_ptr<Backend> MakeCpuBackend(int threads);
+/// `pairBlocks`: SolverConfig::pairDensityBlocks.
+std::unique_ptr<Backend> MakeCpuBackend(int threads, bool pairBlocks = false);
 /// Null when the CUDA backend is not compiled in; `*why` says so.
 std::unique_ptr<Backend> MakeCudaBackend(std::string* why);
 int CudaDevices();

@@ -41,10 +41,10 @@ struct OmpTraits {
 
 }  // namespace
 
-std::unique_ptr<Backend> MakeCpuBackend(int threads) {
+std::unique_ptr<Backend> MakeCpuBackend(int threads, bool pairBlocks) {
   // 0 = all cores, also after an earlier solver in this process asked for fewer.
   omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
-  return std::make_unique<BackendImpl<OmpTraits>>();
+  return std::make_unique<BackendImpl<OmpTraits>>(pairBlocks);
 }
 
 }  // namespace sphxr::sim

@@ -30,6 +30,10 @@ class BackendImpl final : public Backend {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  /// `pairBlocks`: the CPU's density blocks from pairs of cells only (the layout before the fitted boxes,
+  /// cpu_stages.h BlockBoxOf); the same results bit for bit, for benchmarks. CUDA ignores it.
+  explicit BackendImpl(bool pairBlocks = false) : m_pairBlocks(pairBlocks) {}
+
   const char* Name() const override { return Traits::kName; }
 
   Status Init(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
@@ -191,11 +195,12 @@ class BackendImpl final : public Backend {
     if constexpr (Traits::kSimdStages) {
       m_blockStart.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_blockStart.begin(),
-                                 typename Traits::DensityBlockStart{View(), Raw(m_keys), n});
+                                 typename Traits::DensityBlockStart{View(), Raw(m_keys), n, m_pairBlocks});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
       loop(blocks, 8,
            typename Traits::DensityBlockStage{density, Raw(m_keys), Raw(m_blockStart),
-                                              physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr, physics.reuseIdle});
+                                              physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr, physics.reuseIdle,
+                                              m_pairBlocks});
     } else {
       overComputing(32, density);
     }
@@ -488,6 +493,7 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell; scratch of the 27-cell sums
   Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each cell
   Vector<uint32_t> m_blockStart;   // CPU density blocks: first particle of each (cpu_stages.h)
+  bool m_pairBlocks = false;       // CPU density blocks from pairs of cells only (the constructor's)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
   Vector<float> m_boundaryPressureTerm;  // per boundary particle, walls with their own density only

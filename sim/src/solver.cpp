@@ -386,7 +386,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
     }
     solver->m_backend = MakeCudaBackend(&why);
   } else {
-    solver->m_backend = MakeCpuBackend(config.threads);
+    solver->m_backend = MakeCpuBackend(config.threads, config.pairDensityBlocks);
   }
   solver->m_device = device;
 

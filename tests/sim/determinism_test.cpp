@@ -2,7 +2,7 @@
 // order, a stable sort and max reductions for the time step. Its SIMD stages hand out guided chunks, so
 // which thread takes which particles may change from run to run (backend_cpu.cpp). The same scene on 1,
 // 2 (twice) and 3 threads must give bit-identical positions and velocities, with reuse off; on 1 and 2
-// with reuse on (its compacted list). omp_set_num_threads is process-global, so each solver is created and run to
+// with reuse on (its compacted list); and the CPU density blocks' two layouts alike. omp_set_num_threads is process-global, so each solver is created and run to
 // the end before the next one is created.
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -25,9 +25,10 @@ struct RunResult {
   double meanComputed = 0;  // the mean fraction of particles that computed per step
 };
 
-RunResult RunScene(const SceneSetup& scene, int threads, int steps) {
+RunResult RunScene(const SceneSetup& scene, int threads, int steps, bool pairDensityBlocks = false) {
   SolverConfig config = test::TestConfig();
   config.threads = threads;
+  config.pairDensityBlocks = pairDensityBlocks;
   RunResult run;
   auto solver = test::CreateOrFail(scene, config);
   if (!solver) return run;
@@ -134,6 +135,24 @@ TEST(DeterminismTest, OneAndTwoThreadsGiveIdenticalResultsWithReuse) {
   const RunResult one = RunScene(scene, 1, 200);
   EXPECT_LT(one.meanComputed, 0.99) << "some particles should reuse, or the list is the identity";
   ExpectIdentical(one, RunScene(scene, 2, 200));
+}
+
+// The CPU's density blocks fitted to the particles (boxes of up to 4 x 4 x 4 cells in the spreading front,
+// crowded pairs cut per cell) change no bit against the pairs-only layout (SolverConfig::pairDensityBlocks,
+// which sphxr_bench_blocks times against them), with reuse off and on. tests/sim/cpu_stages_test.cpp
+// checks the same for one density pass per layout on made-up particles; this runs the whole solver.
+TEST(DeterminismTest, DensityBlocksFittedToTheParticlesGiveThePairsBits) {
+  if (RerunWithPassiveWaiting()) return;
+  SceneSetup scene = test::SmallDamBreak(0.01f);
+  {
+    SCOPED_TRACE("reuse off");
+    ExpectIdentical(RunScene(scene, 2, 200), RunScene(scene, 2, 200, true));
+  }
+  ASSERT_TRUE(ApplyReusePreset("balanced", &scene.reuse));
+  {
+    SCOPED_TRACE("reuse balanced");
+    ExpectIdentical(RunScene(scene, 2, 200), RunScene(scene, 2, 200, true));
+  }
 }
 
 }  // namespace
