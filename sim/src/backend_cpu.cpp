@@ -18,6 +18,7 @@ struct OmpTraits {
   static constexpr bool kOnDevice = false;  // where the surface mesh lives
   static constexpr int kTraversalRun = 256;  // a descent per run of vertices: few threads, each stepping along the mesh
   static constexpr bool kSimdStages = true;  // density and forces in SIMD (cpu_stages.h)
+  using BlockSet = sim::BlockSet;
   using DensityBlockStart = sim::DensityBlockStart;
   using DensityBlockStage = sim::DensityBlockStage;
   using ForceListStage = sim::ForceListStage;

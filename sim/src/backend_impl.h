@@ -5,11 +5,14 @@
 // kind is hand-written. Include this from exactly one translation unit per system.
 #include <thrust/copy.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/sequence.h>
+#include <thrust/functional.h>
+#include <thrust/scan.h>
 #include <thrust/sort.h>
 #include <thrust/transform_reduce.h>
 
@@ -193,14 +196,28 @@ class BackendImpl final : public Backend {
     // lanes that reuse; CUDA a thread per particle (over the compacted list with reuse).
     const DensityStage density{View(), fv, Neighbours(physics), physics};
     if constexpr (Traits::kSimdStages) {
-      m_blockStart.resize(n);
-      auto end = thrust::copy_if(policy, first, first + n, m_blockStart.begin(),
-                                 typename Traits::DensityBlockStart{View(), Raw(m_keys), n, m_pairBlocks});
+      // The blocks are drawn from every particle, or with reuse from the compacted list, so that the
+      // particles that reuse take no lane (cpu_stages.h BlockSet). The pairs-only layout (benchmarks)
+      // keeps the layout before both: every particle, the lanes that reuse masked.
+      typename Traits::BlockSet set{Raw(m_keys), n};
+      const bool compacted = computing < n && !m_pairBlocks;
+      if (compacted) {
+        m_computeKeys.resize(computing);
+        thrust::gather(policy, m_computeList.begin(), m_computeList.begin() + computing, m_keys.begin(),
+                       m_computeKeys.begin());
+        m_computeRank.resize(n + 1);
+        const auto flags = thrust::make_transform_iterator(first, ComputeFlag{Raw(m_fluid.idle), physics.reuseIdle, n});
+        thrust::exclusive_scan(policy, flags, flags + (n + 1), m_computeRank.begin(), 0u, thrust::plus<uint32_t>());
+        set = typename Traits::BlockSet{Raw(m_computeKeys), computing, Raw(m_computeList), Raw(m_computeRank)};
+      }
+      m_blockStart.resize(set.count);
+      auto end = thrust::copy_if(policy, first, first + set.count, m_blockStart.begin(),
+                                 typename Traits::DensityBlockStart{View(), set, m_pairBlocks});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
+      const bool masked = physics.reuseEnabled && computing < n && !compacted;
       loop(blocks, 8,
-           typename Traits::DensityBlockStage{density, Raw(m_keys), Raw(m_blockStart),
-                                              physics.reuseEnabled ? Raw(m_fluid.idle) : nullptr, physics.reuseIdle,
-                                              m_pairBlocks});
+           typename Traits::DensityBlockStage{density, set, Raw(m_blockStart), masked ? Raw(m_fluid.idle) : nullptr,
+                                              physics.reuseIdle, m_pairBlocks});
     } else {
       overComputing(32, density);
     }
@@ -492,7 +509,9 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
   Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell; scratch of the 27-cell sums
   Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each cell
-  Vector<uint32_t> m_blockStart;   // CPU density blocks: first particle of each (cpu_stages.h)
+  Vector<uint32_t> m_blockStart;   // CPU density blocks: first entry of each (cpu_stages.h)
+  Vector<uint32_t> m_computeKeys;  // CPU density blocks with reuse: the compacted list's Morton keys
+  Vector<uint32_t> m_computeRank;  // and the computing particles before each particle (n + 1)
   bool m_pairBlocks = false;       // CPU density blocks from pairs of cells only (the constructor's)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;

@@ -269,30 +269,55 @@ struct CellPair {
   uint32_t first, end;
 };
 
-SPHXR_INLINE CellPair PairOf(const GridView& g, int cx, int cy, int cz) {
+/// The particles the density blocks are drawn from, as entries in Morton order: every particle (`list`
+/// null: entry e is particle e), or with reuse the compacted list of those that compute this step
+/// (entry e is particle list[e]), so that a block's lanes are all particles that compute and the
+/// particles that reuse take no lane. `rank[i]`: the entries before particle i (n + 1 values, an
+/// exclusive scan of the computing flags), so that cell c's entries run from rank[fluidStart[c]] to
+/// rank[fluidEnd[c]].
+struct BlockSet {
+  const uint32_t* keys;            // the entries' sorted Morton keys
+  int count;                       // entries
+  const uint32_t* list = nullptr;  // entry -> particle; null: the identity
+  const uint32_t* rank = nullptr;  // particle -> entries before it; null: the identity
+  SPHXR_INLINE uint32_t Particle(uint32_t e) const { return list != nullptr ? list[e] : e; }
+  SPHXR_INLINE uint32_t Rank(uint32_t i) const { return rank != nullptr ? rank[i] : i; }
+  /// Cell c's entries [*first, *end); false when the cell has no particle at all.
+  SPHXR_INLINE bool CellRun(const GridView& g, uint32_t c, uint32_t* first, uint32_t* end) const {
+    if (g.fluidStart[c] == kEmptyCell) return false;
+    *first = Rank(g.fluidStart[c]);
+    *end = Rank(g.fluidEnd[c]);
+    return true;
+  }
+};
+
+SPHXR_INLINE CellPair PairOf(const GridView& g, const BlockSet& set, int cx, int cy, int cz) {
   CellPair p;
   p.x0 = cx & ~1;
   p.x1 = p.x0 + 1 < g.nx ? p.x0 + 1 : p.x0;
-  const uint32_t c0 = g.Linear(p.x0, cy, cz), c1 = g.Linear(p.x1, cy, cz);
-  p.first = g.fluidStart[c0] != kEmptyCell ? g.fluidStart[c0] : g.fluidStart[c1];
-  p.end = g.fluidStart[c1] != kEmptyCell ? g.fluidEnd[c1] : g.fluidEnd[c0];
+  uint32_t f0 = 0, e0 = 0, f1 = 0, e1 = 0;
+  const bool has0 = set.CellRun(g, g.Linear(p.x0, cy, cz), &f0, &e0);
+  const bool has1 = set.CellRun(g, g.Linear(p.x1, cy, cz), &f1, &e1);
+  p.first = has0 ? f0 : f1;
+  p.end = has1 ? e1 : e0;
   return p;
 }
 
 /// The run that the blocks of cell (cx, cy, cz)'s particles are cut from when their 2 x 2 x 1 box holds
 /// more than kLanes (BlockBoxOf): the pair's, or the cell's own (x0 == x1 == cx) where that is cheaper.
 /// `pairsOnly`: always the pair's (the layout before the boxes, which the tests hold the boxes to).
-SPHXR_INLINE CellPair CutRunOf(const GridView& g, int cx, int cy, int cz, bool pairsOnly) {
-  const CellPair pair = PairOf(g, cx, cy, cz);
+SPHXR_INLINE CellPair CutRunOf(const GridView& g, const BlockSet& set, int cx, int cy, int cz, bool pairsOnly) {
+  const CellPair pair = PairOf(g, set, cx, cy, cz);
   const uint32_t n = pair.end - pair.first;
   if (pairsOnly || n <= static_cast<uint32_t>(kLanes) || pair.x1 == pair.x0) return pair;
-  const uint32_t c0 = g.Linear(pair.x0, cy, cz), c1 = g.Linear(pair.x1, cy, cz);
-  if (g.fluidStart[c0] == kEmptyCell || g.fluidStart[c1] == kEmptyCell) return pair;
+  uint32_t f0 = 0, e0 = 0, f1 = 0, e1 = 0;
+  set.CellRun(g, g.Linear(pair.x0, cy, cz), &f0, &e0);
+  set.CellRun(g, g.Linear(pair.x1, cy, cz), &f1, &e1);
+  const uint32_t n0 = e0 - f0, n1 = e1 - f1;
+  if (n0 == 0 || n1 == 0) return pair;  // one cell holds the run already
   auto blocks = [](uint32_t m) { return (m + static_cast<uint32_t>(kLanes) - 1) / static_cast<uint32_t>(kLanes); };
-  const uint32_t n0 = g.fluidEnd[c0] - g.fluidStart[c0], n1 = g.fluidEnd[c1] - g.fluidStart[c1];
   if (27 * (blocks(n0) + blocks(n1)) >= 36 * blocks(n)) return pair;
-  const uint32_t c = cx == pair.x0 ? c0 : c1;
-  return CellPair{cx, cx, g.fluidStart[c], g.fluidEnd[c]};
+  return cx == pair.x0 ? CellPair{cx, cx, f0, e0} : CellPair{cx, cx, f1, e1};
 }
 
 /// Where particles are few (spray, a thin sheet, the surface), a pair holds two or three and its block
@@ -315,7 +340,9 @@ struct BlockBox {
 /// The block box of particle i (keys: the sorted Morton keys of the n particles). `pairsOnly`: every
 /// block from a pair, cut from the pair's first (the layout before the boxes; the results are the same
 /// bit for bit, and tests/sim/cpu_stages_test.cpp checks that they are).
-SPHXR_INLINE BlockBox BlockBoxOf(const GridView& g, const uint32_t* keys, int n, int i, bool pairsOnly) {
+SPHXR_INLINE BlockBox BlockBoxOf(const GridView& g, const BlockSet& set, int i, bool pairsOnly) {
+  const uint32_t* keys = set.keys;
+  const int n = set.count;
   const uint32_t key = keys[i];
   int lo = i, hi = i + 1, level = 1;
   for (int m = 2; m <= (pairsOnly ? 1 : kMaxBlockLevel); ++m) {  // widen the run level by level while it fits
@@ -340,7 +367,7 @@ SPHXR_INLINE BlockBox BlockBoxOf(const GridView& g, const uint32_t* keys, int n,
   box.y1 = box.y0 + sy - 1 < g.ny ? box.y0 + sy - 1 : g.ny - 1;
   box.z1 = box.z0 + sz - 1 < g.nz ? box.z0 + sz - 1 : g.nz - 1;
   if (level == 1) {
-    const CellPair run = CutRunOf(g, static_cast<int>(MortonCompact(key)), box.y0, box.z0, pairsOnly);
+    const CellPair run = CutRunOf(g, set, static_cast<int>(MortonCompact(key)), box.y0, box.z0, pairsOnly);
     box.x0 = run.x0;
     box.x1 = run.x1;
     box.first = run.first;
@@ -352,24 +379,24 @@ SPHXR_INLINE BlockBox BlockBoxOf(const GridView& g, const uint32_t* keys, int n,
   return box;
 }
 
-/// Whether particle i starts a density block: the first of its box, or (a pair's cut runs) kLanes,
-/// 2 kLanes, ... after the pair's first. Its cell comes from the step's sorted Morton keys
-/// (CellCodeStage), not from its position again. A particle that is not its cell's first can start a
+/// Whether entry i of the set starts a density block: the first of its box, or (a pair's cut runs)
+/// kLanes, 2 kLanes, ... after the run's first. Its cell comes from the step's sorted Morton keys
+/// (CellCodeStage), not from its position again. An entry that is not its cell's first can start a
 /// block only as a cut (its box's first is some cell's first), so only cells' firsts look for a box.
 struct DensityBlockStart {
   GridView grid;
-  const uint32_t* keys;  // sorted
-  int count;             // particles
+  BlockSet set;
   bool pairsOnly = false;  // BlockBoxOf's
   bool operator()(int i) const {
-    const uint32_t key = keys[i];
-    if (i > 0 && keys[i - 1] == key) {
+    const uint32_t key = set.keys[i];
+    if (i > 0 && set.keys[i - 1] == key) {
       uint32_t cx, cy, cz;
       MortonDecode(key, &cx, &cy, &cz);
-      const CellPair run = CutRunOf(grid, static_cast<int>(cx), static_cast<int>(cy), static_cast<int>(cz), pairsOnly);
+      const CellPair run =
+          CutRunOf(grid, set, static_cast<int>(cx), static_cast<int>(cy), static_cast<int>(cz), pairsOnly);
       return (static_cast<uint32_t>(i) - run.first) % kLanes == 0;
     }
-    const BlockBox box = BlockBoxOf(grid, keys, count, i, pairsOnly);
+    const BlockBox box = BlockBoxOf(grid, set, i, pairsOnly);
     return (static_cast<uint32_t>(i) - box.first) % kLanes == 0;
   }
 };
@@ -478,15 +505,18 @@ inline Lanes GradFactorLanes(const CubicSpline& k, Lanes q, Lanes r, LaneInts pa
                   Select(LessEq(q, Splat(0.5f)), k.gradA * (3.0f * q - 2.0f), -k.gradB * t * t / r), Splat(0.0f));
 }
 
-/// Density and pressure for the particles of block b (`blockStart`: its first particle; it runs to the
-/// end of its box's run, or kLanes of a cut run: BlockBoxOf). With reuse (`idle` set), only the lanes that compute this
-/// step (ComputesThisStep) are written; a block without one costs nothing. The walls' sums
-/// (DensityStage::WallSum) are taken the same way, for the lanes whose cell has wall particles around.
+/// Density and pressure for the particles of block b (`blockStart`: its first entry of the set; it runs
+/// to the end of its box's run, or kLanes of a cut run: BlockBoxOf). The backend's set is, with reuse,
+/// the particles that compute this step, so every lane computes. Masked lanes instead (`idle` set, the
+/// set every particle; the layout before the compacted blocks, which sphxr_bench_blocks times and the
+/// tests compare with): only the lanes that compute this step (ComputesThisStep) are written, and a
+/// block without one costs nothing. The walls' sums (DensityStage::WallSum) are taken the same way, for
+/// the lanes whose cell has wall particles around.
 struct DensityBlockStage {
   DensityStage stage;
-  const uint32_t* keys;        // the sorted Morton keys (DensityBlockStart's)
+  BlockSet set;                // DensityBlockStart's
   const uint32_t* blockStart;
-  const int32_t* idle = nullptr;  // reuse: the idle counts; nullptr: every particle computes
+  const int32_t* idle = nullptr;  // masked lanes: the idle counts; nullptr: every entry computes
   int32_t idleSteps = 0;
   bool pairsOnly = false;  // DensityBlockStart's
 
@@ -494,12 +524,14 @@ struct DensityBlockStage {
     const GridView& g = stage.grid;
     const Vec4* position = stage.fluid.position;
     const uint32_t first = blockStart[b];
-    const BlockBox box = BlockBoxOf(g, keys, stage.fluid.count, static_cast<int>(first), pairsOnly);
+    const BlockBox box = BlockBoxOf(g, set, static_cast<int>(first), pairsOnly);
     const int lanes = static_cast<int>(box.end - first < static_cast<uint32_t>(kLanes) ? box.end - first : kLanes);
     uint32_t computing = 0;
+    uint32_t particle[kLanes];  // each lane's particle
     const ComputesThisStep computes{idle, idleSteps};
     for (int l = 0; l < lanes; ++l) {
-      if (idle == nullptr || computes(static_cast<int>(first) + l)) computing |= 1u << l;
+      particle[l] = set.Particle(first + static_cast<uint32_t>(l));
+      if (idle == nullptr || computes(static_cast<int>(particle[l]))) computing |= 1u << l;
     }
     if (computing == 0) return;
 
@@ -507,7 +539,7 @@ struct DensityBlockStage {
     BlockCells cells(g, box);
     for (int l = 0; l < kLanes; ++l) {
       if (computing & (1u << l)) {
-        const Vec4 p = position[first + l];
+        const Vec4 p = position[particle[l]];
         px[l] = p.x;
         py[l] = p.y;
         pz[l] = p.z;
@@ -531,7 +563,7 @@ struct DensityBlockStage {
       LaneInts laneList, self, count = LaneInts{};
       for (int l = 0; l < kLanes; ++l) {
         laneList[l] = static_cast<int32_t>(static_cast<uint32_t>(l) * stride);
-        self[l] = static_cast<int32_t>(first + static_cast<uint32_t>(l));
+        self[l] = (computing & (1u << l)) ? static_cast<int32_t>(particle[l]) : -1;
       }
       const LaneInts full = LaneInts{} + static_cast<int32_t>(capacity);
       sum = KernelSumLanes(k, cells, g.fluidStart, g.fluidEnd, position, false, px, py, pz, [&](uint32_t j, LaneInts within) {
@@ -543,7 +575,8 @@ struct DensityBlockStage {
         found[l] = static_cast<uint32_t>(count[l]);
         if (computing & (1u << l)) {
           const uint32_t n = found[l] < capacity ? found[l] : capacity;
-          std::memcpy(stage.Slots(static_cast<int>(first) + l), lists + static_cast<size_t>(l) * stride, n * sizeof(uint32_t));
+          std::memcpy(stage.Slots(static_cast<int>(particle[l])), lists + static_cast<size_t>(l) * stride,
+                      n * sizeof(uint32_t));
         }
       }
     } else {
@@ -552,7 +585,7 @@ struct DensityBlockStage {
         while (hits != 0) {  // the neighbour lists: every hit but the particle itself
           const int l = __builtin_ctz(hits);
           hits &= hits - 1u;
-          const uint32_t i = first + static_cast<uint32_t>(l);
+          const uint32_t i = particle[l];
           if (j == i) continue;
           if (found[l] < capacity) stage.Slots(static_cast<int>(i))[found[l]] = j;
           ++found[l];
@@ -584,7 +617,7 @@ struct DensityBlockStage {
     }
     for (int l = 0; l < lanes; ++l) {
       if (computing & (1u << l)) {
-        stage.Complete(static_cast<int>(first) + l, Vec3{px[l], py[l], pz[l]}, sum[l], wall[l], found[l]);
+        stage.Complete(static_cast<int>(particle[l]), Vec3{px[l], py[l], pz[l]}, sum[l], wall[l], found[l]);
       }
     }
   }

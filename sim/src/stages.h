@@ -423,6 +423,15 @@ struct ComputesThisStep {
   SPHXR_HD bool operator()(int i) const { return idle[i] < 0 || idle[i] == idleSteps; }
 };
 
+/// 1 for a particle i < n that computes this step, else 0 (also for i = n: the CPU density blocks' rank
+/// scan runs over n + 1 items, cpu_stages.h BlockSet).
+struct ComputeFlag {
+  const int32_t* idle;
+  int32_t idleSteps;
+  int n;
+  SPHXR_HD uint32_t operator()(int i) const { return i < n && ComputesThisStep{idle, idleSteps}(i) ? 1u : 0u; }
+};
+
 /// Runs a per-particle stage over a compacted list of particle indices.
 template <class Stage>
 struct OverList {

@@ -179,7 +179,7 @@ struct Setup {
   /// The first particle of each density block (DensityBlockStart).
   std::vector<uint32_t> BlockStarts(const std::vector<uint32_t>& keys, bool pairsOnly) {
     const int n = static_cast<int>(position.size());
-    const DensityBlockStart isStart{Grid(), keys.data(), n, pairsOnly};
+    const DensityBlockStart isStart{Grid(), BlockSet{keys.data(), n}, pairsOnly};
     std::vector<uint32_t> blocks;
     for (int i = 0; i < n; ++i) {
       if (isStart(i)) blocks.push_back(static_cast<uint32_t>(i));
@@ -187,11 +187,50 @@ struct Setup {
     return blocks;
   }
 
+  /// The backend's set with reuse (cpu_stages.h BlockSet): the particles that compute this step, their
+  /// keys, and each particle's rank among them (n + 1 values), held in `compactList`, `compactKeys` and
+  /// `compactRank`.
+  BlockSet ComputingSet(const std::vector<uint32_t>& keys, int idleSteps) {
+    const int n = static_cast<int>(position.size());
+    const ComputesThisStep computes{idle.data(), idleSteps};
+    compactList.clear();
+    compactKeys.clear();
+    compactRank.assign(1, 0u);
+    for (int i = 0; i < n; ++i) {
+      if (computes(i)) {
+        compactList.push_back(static_cast<uint32_t>(i));
+        compactKeys.push_back(keys[i]);
+      }
+      compactRank.push_back(static_cast<uint32_t>(compactList.size()));
+    }
+    return BlockSet{compactKeys.data(), static_cast<int>(compactKeys.size()), compactList.data(), compactRank.data()};
+  }
+  std::vector<uint32_t> compactList, compactKeys, compactRank;
+
+  /// The first entry of each density block of `set`.
+  std::vector<uint32_t> BlockStarts(const BlockSet& set, bool pairsOnly) {
+    const DensityBlockStart isStart{Grid(), set, pairsOnly};
+    std::vector<uint32_t> blocks;
+    for (int e = 0; e < set.count; ++e) {
+      if (isStart(e)) blocks.push_back(static_cast<uint32_t>(e));
+    }
+    return blocks;
+  }
+
+  /// The density blocks drawn from the particles that compute only, as the backend runs them with reuse.
+  void RunCompacted(int idleSteps) {
+    const std::vector<uint32_t> keys = Keys();
+    const BlockSet set = ComputingSet(keys, idleSteps);
+    const std::vector<uint32_t> blocks = BlockStarts(set, false);
+    const DensityBlockStage s{Stage(), set, blocks.data(), nullptr, idleSteps, false};
+    for (int b = 0; b < static_cast<int>(blocks.size()); ++b) s(b);
+  }
+
   void RunBlocked(bool reuse, int idleSteps, bool pairsOnly = false) {
     const std::vector<uint32_t> keys = Keys();
     const std::vector<uint32_t> blocks = BlockStarts(keys, pairsOnly);
-    const DensityBlockStage s{Stage(), keys.data(), blocks.data(), reuse ? idle.data() : nullptr, idleSteps,
-                              pairsOnly};
+    const DensityBlockStage s{Stage(), BlockSet{keys.data(), static_cast<int>(keys.size())}, blocks.data(),
+                              reuse ? idle.data() : nullptr, idleSteps, pairsOnly};
     for (int b = 0; b < static_cast<int>(blocks.size()); ++b) s(b);
   }
 };
@@ -201,28 +240,37 @@ void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::stri
              const std::vector<Vec3>& walls = {}) {
   SCOPED_TRACE(what);
   Setup perParticle(points, maxNeighbours, walls), blocked(points, maxNeighbours, walls),
-      pairs(points, maxNeighbours, walls);
+      pairs(points, maxNeighbours, walls), compacted(points, maxNeighbours, walls);
   const size_t n = perParticle.position.size();
   constexpr int kIdle = 3;
   if (reuse) {  // every third particle reuses this step (IC = 1), every fifth computes at IC = IDLE
     for (size_t i = 0; i < n; ++i) {
       const int32_t ic = i % 3 == 0 ? 1 : (i % 5 == 0 ? kIdle : -1);
-      perParticle.idle[i] = blocked.idle[i] = pairs.idle[i] = ic;
+      perParticle.idle[i] = blocked.idle[i] = pairs.idle[i] = compacted.idle[i] = ic;
     }
   }
   perParticle.RunPerParticle(reuse, kIdle);
   blocked.RunBlocked(reuse, kIdle);
   pairs.RunBlocked(reuse, kIdle, /*pairsOnly=*/true);
-  // The boxes and the pairs-only layout give every lane the same candidates in the same order: the
-  // same bits, not just close.
-  for (size_t i = 0; i < n; ++i) {
-    ASSERT_EQ(blocked.count[i], pairs.count[i]) << "particle " << i;
-    ASSERT_EQ(std::memcmp(&blocked.density[i], &pairs.density[i], sizeof(float)), 0)
-        << "particle " << i << ": " << blocked.density[i] << " against " << pairs.density[i] << " (pairs only)";
-    ASSERT_EQ(std::memcmp(&blocked.pressure[i], &pairs.pressure[i], sizeof(float)), 0) << "particle " << i;
-    ASSERT_EQ(std::memcmp(&blocked.position[i].w, &pairs.position[i].w, sizeof(float)), 0) << "particle " << i;
+  if (reuse) {
+    compacted.RunCompacted(kIdle);
+  } else {
+    compacted.RunBlocked(false, kIdle);
   }
-  ASSERT_EQ(blocked.index, pairs.index);
+  // The boxes, the pairs-only layout and (with reuse) the boxes of the computing particles alone give
+  // every lane the same candidates in the same order: the same bits, not just close.
+  for (const Setup* other : {&pairs, &compacted}) {
+    const char* which = other == &pairs ? "pairs only, lanes masked" : "boxes of the computing particles";
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(blocked.count[i], other->count[i]) << "particle " << i << ", " << which;
+      ASSERT_EQ(std::memcmp(&blocked.density[i], &other->density[i], sizeof(float)), 0)
+          << "particle " << i << ": " << blocked.density[i] << " against " << other->density[i] << " (" << which << ")";
+      ASSERT_EQ(std::memcmp(&blocked.pressure[i], &other->pressure[i], sizeof(float)), 0) << "particle " << i << ", " << which;
+      ASSERT_EQ(std::memcmp(&blocked.position[i].w, &other->position[i].w, sizeof(float)), 0)
+          << "particle " << i << ", " << which;
+    }
+    ASSERT_EQ(blocked.index, other->index) << which;
+  }
   const CubicSpline k = perParticle.ph.kernel;
   size_t overflowed = 0, checked = 0, nearWall = 0;
   for (size_t i = 0; i < n; ++i) {
@@ -572,7 +620,7 @@ TEST(CpuStages, DensityBlocksTileTheParticles) {
     std::vector<int> blockOf(n, -1);
     int deepest = 0, shallowest = kMaxBlockLevel, singleCells = 0;
     for (size_t b = 0; b < starts.size(); ++b) {
-      const BlockBox box = BlockBoxOf(g, keys.data(), n, static_cast<int>(starts[b]), false);
+      const BlockBox box = BlockBoxOf(g, BlockSet{keys.data(), n}, static_cast<int>(starts[b]), false);
       deepest = std::max(deepest, box.level);
       shallowest = std::min(shallowest, box.level);
       if (box.level == 1 && box.x0 == box.x1) ++singleCells;
@@ -597,6 +645,48 @@ TEST(CpuStages, DensityBlocksTileTheParticles) {
       EXPECT_EQ(singleCells, static_cast<int>(starts.size()));
       EXPECT_EQ(starts.size(), pairStarts.size());
     }
+  }
+}
+
+// With reuse the blocks are drawn from the particles that compute only: each of them in exactly one
+// block, inside its box, no particle that reuses in any; with half of crowded water reusing, the blocks
+// take fewer lanes idle, so there are fewer of them than of the masked layout's.
+TEST(CpuStages, DensityBlocksOfTheComputingParticlesTileThem) {
+  constexpr int kIdle = 3;
+  for (const int perCell : {9, 16}) {
+    SCOPED_TRACE(std::to_string(perCell) + " per cell");
+    struct Setup s(PerCell(8, 8, 8, perCell, 21), 64);
+    const int n = static_cast<int>(s.position.size());
+    for (int i = 0; i < n; ++i) s.idle[i] = i % 2 == 0 ? 2 : -1;  // every other particle reuses
+    const GridView g = s.Grid();
+    const std::vector<uint32_t> keys = s.Keys();
+    const BlockSet set = s.ComputingSet(keys, kIdle);
+    ASSERT_GT(set.count, n / 3);
+    ASSERT_LT(set.count, 2 * n / 3);
+    const std::vector<uint32_t> starts = s.BlockStarts(set, false), masked = s.BlockStarts(keys, false);
+    std::vector<int> blockOf(n, -1);
+    for (size_t b = 0; b < starts.size(); ++b) {
+      const BlockBox box = BlockBoxOf(g, set, static_cast<int>(starts[b]), false);
+      const uint32_t end = std::min<uint32_t>(box.end, starts[b] + kLanes);
+      ASSERT_GT(end, starts[b]);
+      for (uint32_t e = starts[b]; e < end; ++e) {
+        const uint32_t i = set.Particle(e);
+        ASSERT_EQ(blockOf[i], -1) << "particle " << i << " in two blocks";
+        blockOf[i] = static_cast<int>(b);
+        int cx, cy, cz;
+        g.CellOf(Xyz(s.position[i]), &cx, &cy, &cz);
+        EXPECT_TRUE(cx >= box.x0 && cx <= box.x1 && cy >= box.y0 && cy <= box.y1 && cz >= box.z0 && cz <= box.z1)
+            << "particle " << i << " outside its block's box";
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      if (s.idle[i] > 0) {
+        EXPECT_EQ(blockOf[i], -1) << "particle " << i << " reuses, yet takes a lane";
+      } else {
+        ASSERT_NE(blockOf[i], -1) << "particle " << i << " computes, yet is in no block";
+      }
+    }
+    EXPECT_LT(starts.size() * 3, masked.size() * 2) << "half the particles reuse: far fewer blocks than masked lanes";
   }
 }
 
