@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <string>
@@ -742,6 +743,44 @@ TEST(Activity, CrowdCountsTheParticlesOfThe27CellsAroundAndClassifiesByIt) {
   // Both outcomes occur: the pool is crowded, the sparse water and the strays are not.
   EXPECT_GT(inactive, 500u);
   EXPECT_GT(active, 100u);
+}
+
+}  // namespace
+}  // namespace sphxr::sim
+
+namespace sphxr::sim {
+namespace {
+
+// The step's maxima combine inline (MaxDroppingNaN), not through libm's fmaxf: the same value as
+// fmaxf for every pair of the values below, NaN dropped from either side (a NaN particle must not hide
+// the others' maxima; StepReductionOp counts it on its own), and NaN only when both are.
+TEST(StepReduction, MaximaAreFmaxfsAndDropNaN) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> values = {0.0f, 1e-30f, 0.5f, 1.0f, 2.0f, 3.4e38f, inf, -1.0f, -inf, nan};
+  for (float a : values) {
+    for (float b : values) {
+      const float got = MaxDroppingNaN(a, b), want = std::fmax(a, b);
+      if (std::isnan(want)) {
+        EXPECT_TRUE(std::isnan(got)) << a << ", " << b;
+      } else {
+        EXPECT_EQ(got, want) << a << ", " << b;
+      }
+    }
+  }
+  StepReduction x, y;
+  x.maxSpeed2 = nan;
+  x.maxAccel2 = 4.0f;
+  x.maxDensityError = 0.25f;
+  y.maxSpeed2 = 9.0f;
+  y.maxAccel2 = nan;
+  y.maxDensityError = 0.5f;
+  const StepReduction r = StepReductionCombine{}(x, y), s = StepReductionCombine{}(y, x);
+  EXPECT_EQ(r.maxSpeed2, 9.0f);
+  EXPECT_EQ(r.maxAccel2, 4.0f);
+  EXPECT_EQ(r.maxDensityError, 0.5f);
+  EXPECT_EQ(s.maxSpeed2, 9.0f);
+  EXPECT_EQ(s.maxAccel2, 4.0f);
+  EXPECT_EQ(s.maxDensityError, 0.5f);
 }
 
 }  // namespace
