@@ -598,6 +598,31 @@ TEST(CpuStages, DensityCrowdedPairsCutPerCellMatch) {
   Compare(PerCell(7, 8, 8, 12, 15), 64, "12 per cell, odd row", /*reuse=*/true);
 }
 
+/// Puts each entry of `set` from its block's start up to kLanes or its box's end into `blockOf` (by
+/// particle; -1: in no block), failing where a particle lands in two blocks or outside its box. Returns
+/// each block's box.
+std::vector<BlockBox> TileBlocks(const GridView& g, const BlockSet& set, const std::vector<uint32_t>& starts,
+                                 const std::vector<Vec4>& position, std::vector<int>* blockOf) {
+  blockOf->assign(position.size(), -1);
+  std::vector<BlockBox> boxes;
+  for (size_t b = 0; b < starts.size(); ++b) {
+    const BlockBox box = BlockBoxOf(g, set, static_cast<int>(starts[b]), false);
+    boxes.push_back(box);
+    const uint32_t end = std::min<uint32_t>(box.end, starts[b] + kLanes);
+    EXPECT_GT(end, starts[b]) << "block " << b << " is empty";
+    for (uint32_t e = starts[b]; e < end; ++e) {
+      const uint32_t i = set.Particle(e);
+      EXPECT_EQ((*blockOf)[i], -1) << "particle " << i << " in two blocks";
+      (*blockOf)[i] = static_cast<int>(b);
+      int cx, cy, cz;
+      g.CellOf(Xyz(position[i]), &cx, &cy, &cz);
+      EXPECT_TRUE(cx >= box.x0 && cx <= box.x1 && cy >= box.y0 && cy <= box.y1 && cz >= box.z0 && cz <= box.z1)
+          << "particle " << i << " outside its block's box";
+    }
+  }
+  return boxes;
+}
+
 // The blocks tile the particles: each particle in exactly one block of at most kLanes, every block's
 // particles inside its box; spray takes boxes of several cells, and crowded pairs are cut per cell.
 TEST(CpuStages, DensityBlocksTileTheParticles) {
@@ -618,23 +643,12 @@ TEST(CpuStages, DensityBlocksTileTheParticles) {
     const int n = static_cast<int>(s.position.size());
     const std::vector<uint32_t> keys = s.Keys();
     const std::vector<uint32_t> starts = s.BlockStarts(keys, false), pairStarts = s.BlockStarts(keys, true);
-    std::vector<int> blockOf(n, -1);
+    std::vector<int> blockOf;
     int deepest = 0, shallowest = kMaxBlockLevel, singleCells = 0;
-    for (size_t b = 0; b < starts.size(); ++b) {
-      const BlockBox box = BlockBoxOf(g, BlockSet{keys.data(), n}, static_cast<int>(starts[b]), false);
+    for (const BlockBox& box : TileBlocks(g, BlockSet{keys.data(), n}, starts, s.position, &blockOf)) {
       deepest = std::max(deepest, box.level);
       shallowest = std::min(shallowest, box.level);
       if (box.level == 1 && box.x0 == box.x1) ++singleCells;
-      const uint32_t end = std::min<uint32_t>(box.end, starts[b] + kLanes);
-      ASSERT_GT(end, starts[b]);
-      for (uint32_t i = starts[b]; i < end; ++i) {
-        ASSERT_EQ(blockOf[i], -1) << "particle " << i << " in two blocks";
-        blockOf[i] = static_cast<int>(b);
-        int cx, cy, cz;
-        g.CellOf(Xyz(s.position[i]), &cx, &cy, &cz);
-        EXPECT_TRUE(cx >= box.x0 && cx <= box.x1 && cy >= box.y0 && cy <= box.y1 && cz >= box.z0 && cz <= box.z1)
-            << "particle " << i << " outside its block's box";
-      }
     }
     for (int i = 0; i < n; ++i) ASSERT_NE(blockOf[i], -1) << "particle " << i << " in no block";
     EXPECT_GE(deepest, c.minLevel);
@@ -665,21 +679,8 @@ TEST(CpuStages, DensityBlocksOfTheComputingParticlesTileThem) {
     ASSERT_GT(set.count, n / 3);
     ASSERT_LT(set.count, 2 * n / 3);
     const std::vector<uint32_t> starts = s.BlockStarts(set, false), masked = s.BlockStarts(keys, false);
-    std::vector<int> blockOf(n, -1);
-    for (size_t b = 0; b < starts.size(); ++b) {
-      const BlockBox box = BlockBoxOf(g, set, static_cast<int>(starts[b]), false);
-      const uint32_t end = std::min<uint32_t>(box.end, starts[b] + kLanes);
-      ASSERT_GT(end, starts[b]);
-      for (uint32_t e = starts[b]; e < end; ++e) {
-        const uint32_t i = set.Particle(e);
-        ASSERT_EQ(blockOf[i], -1) << "particle " << i << " in two blocks";
-        blockOf[i] = static_cast<int>(b);
-        int cx, cy, cz;
-        g.CellOf(Xyz(s.position[i]), &cx, &cy, &cz);
-        EXPECT_TRUE(cx >= box.x0 && cx <= box.x1 && cy >= box.y0 && cy <= box.y1 && cz >= box.z0 && cz <= box.z1)
-            << "particle " << i << " outside its block's box";
-      }
-    }
+    std::vector<int> blockOf;
+    TileBlocks(g, set, starts, s.position, &blockOf);
     for (int i = 0; i < n; ++i) {
       if (s.idle[i] > 0) {
         EXPECT_EQ(blockOf[i], -1) << "particle " << i << " reuses, yet takes a lane";
