@@ -775,13 +775,11 @@ TEST(StepReduction, MaximaAreFmaxfsAndDropNaN) {
   y.maxSpeed2 = 9.0f;
   y.maxAccel2 = nan;
   y.maxDensityError = 0.5f;
-  const StepReduction r = StepReductionCombine{}(x, y), s = StepReductionCombine{}(y, x);
-  EXPECT_EQ(r.maxSpeed2, 9.0f);
-  EXPECT_EQ(r.maxAccel2, 4.0f);
-  EXPECT_EQ(r.maxDensityError, 0.5f);
-  EXPECT_EQ(s.maxSpeed2, 9.0f);
-  EXPECT_EQ(s.maxAccel2, 4.0f);
-  EXPECT_EQ(s.maxDensityError, 0.5f);
+  for (const StepReduction& r : {StepReductionCombine{}(x, y), StepReductionCombine{}(y, x)}) {
+    EXPECT_EQ(r.maxSpeed2, 9.0f);
+    EXPECT_EQ(r.maxAccel2, 4.0f);
+    EXPECT_EQ(r.maxDensityError, 0.5f);
+  }
 }
 
 }  // namespace
