@@ -192,8 +192,8 @@ class BackendImpl final : public Backend {
         loop(wallCells, 8, wallPressure);
       }
     }
-    // 4. density and pressure. The CPU runs it in cell blocks (cpu_stages.h), with reuse masking the
-    // lanes that reuse; CUDA a thread per particle (over the compacted list with reuse).
+    // 4. density and pressure. The CPU runs it in blocks of cells (cpu_stages.h), with reuse drawn from
+    // the compacted list; CUDA a thread per particle (over the compacted list with reuse).
     const DensityStage density{View(), fv, Neighbours(physics), physics};
     if constexpr (Traits::kSimdStages) {
       // The blocks are drawn from every particle, or with reuse from the compacted list, so that the

@@ -23,9 +23,9 @@
 // scan's order), and WallPressureBlockStage the wall particles of one cell kLanes at a time.
 //
 // All are deterministic for any thread count (a particle's sums never depend on the schedule), and
-// the CPU runs them for every density and force evaluation, with reuse too (DensityBlockStage masks
-// the lanes that reuse and skips blocks without one), so reuse off and reuse with IDLE = 0 stay
-// bit-identical. tests/sim/cpu_stages_test.cpp compares each with the per-particle stages and with
+// the CPU runs them for every density and force evaluation, with reuse too (DensityBlockStage's
+// blocks then drawn from the particles that compute, BlockSet; masked lanes only for the pairs-only
+// layout), so reuse off and reuse with IDLE = 0 stay bit-identical. tests/sim/cpu_stages_test.cpp compares each with the per-particle stages and with
 // brute force.
 #include <cmath>
 #include <cstddef>
@@ -337,7 +337,7 @@ struct BlockBox {
   int x0, x1, y0, y1, z0, z1;  // its cells, clamped to the grid
 };
 
-/// The block box of particle i (keys: the sorted Morton keys of the n particles). `pairsOnly`: every
+/// The block box of entry i of the set (its keys sorted; BlockSet). `pairsOnly`: every
 /// block from a pair, cut from the pair's first (the layout before the boxes; the results are the same
 /// bit for bit, and tests/sim/cpu_stages_test.cpp checks that they are).
 SPHXR_INLINE BlockBox BlockBoxOf(const GridView& g, const BlockSet& set, int i, bool pairsOnly) {

@@ -52,8 +52,8 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
   // sim/src/backend_impl.h's members. Fluid: the field list (68 B) + sort keys and order (8) + reorder
   // scratch of each element type (16 + 4 + 4 + 4) + the sort's temporary storage (about keys and values
   // again, 8) + the CPU density stage's block starts (4) + the host copy at creation (68). Neighbour
-  // lists: 4 B per slot and a count (sim/src/stages.h NeighbourList). Reuse: the compacted list (4) and, on
-  // the CPU, its keys and every particle's rank in it for the density blocks (8);
+  // lists: 4 B per slot and a count (sim/src/stages.h NeighbourList). Reuse: the compacted list (4) and the
+  // CPU density blocks' keys of it and every particle's rank in it (8; counted for CUDA too, erring high);
   // bodies: each fluid particle's pressure term for the reaction (4). Boundary: 16 B, plus its sort at
   // start-up (~40 B transient) and the host copy (16); with wall_density its pressure term (4). Grid:
   // 4 ranges of 4 B and the near-boundary flag per cell; with bodies their 2 ranges and near flag (9),

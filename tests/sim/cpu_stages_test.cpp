@@ -253,14 +253,12 @@ void Compare(const std::vector<Vec3>& points, int maxNeighbours, const std::stri
   perParticle.RunPerParticle(reuse, kIdle);
   blocked.RunBlocked(reuse, kIdle);
   pairs.RunBlocked(reuse, kIdle, /*pairsOnly=*/true);
-  if (reuse) {
-    compacted.RunCompacted(kIdle);
-  } else {
-    compacted.RunBlocked(false, kIdle);
-  }
+  if (reuse) compacted.RunCompacted(kIdle);
   // The boxes, the pairs-only layout and (with reuse) the boxes of the computing particles alone give
   // every lane the same candidates in the same order: the same bits, not just close.
-  for (const Setup* other : {&pairs, &compacted}) {
+  std::vector<const Setup*> others = {&pairs};
+  if (reuse) others.push_back(&compacted);
+  for (const Setup* other : others) {
     const char* which = other == &pairs ? "pairs only, lanes masked" : "boxes of the computing particles";
     for (size_t i = 0; i < n; ++i) {
       ASSERT_EQ(blocked.count[i], other->count[i]) << "particle " << i << ", " << which;

@@ -151,7 +151,9 @@ TEST(DeterminismTest, DensityBlocksFittedToTheParticlesGiveThePairsBits) {
   ASSERT_TRUE(ApplyReusePreset("balanced", &scene.reuse));
   {
     SCOPED_TRACE("reuse balanced");
-    ExpectIdentical(RunScene(scene, 2, 200), RunScene(scene, 2, 200, true));
+    const RunResult fitted = RunScene(scene, 2, 200);
+    EXPECT_LT(fitted.meanComputed, 0.99) << "some particles should reuse, or the blocks of the computing ones are all";
+    ExpectIdentical(fitted, RunScene(scene, 2, 200, true));
   }
 }
 

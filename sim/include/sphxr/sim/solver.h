@@ -29,9 +29,10 @@ struct SolverConfig {
   Device device = Device::kAuto;
   int threads = 0;        // CPU backend: 0 = all cores
   bool validate = false;  // check every stage for non-finite values (slow)
-  /// CPU backend: density blocks from pairs of cells only, not the boxes fitted to the particles
-  /// (docs/performance.md, "Density blocks fitted to the particles"). The results are the same bit for
-  /// bit; sphxr_bench_blocks steps both layouts in lock-step to time the difference.
+  /// CPU backend: density blocks from pairs of cells only, not the boxes fitted to the particles, and
+  /// with reuse drawn from every particle with the lanes that reuse masked, not from the compacted list
+  /// (docs/performance.md, "Density blocks fitted to the particles"): the layout before both. The
+  /// results are the same bit for bit; sphxr_bench_blocks steps both layouts in lock-step to time them.
   bool pairDensityBlocks = false;
 };
 
