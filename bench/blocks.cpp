@@ -197,7 +197,7 @@ int Main(int argc, char** argv) {
     const double t = solver[0]->Time();
     if (t >= segmentStart + args.segment - 1e-9 || t >= args.time - 1e-9) {
       char label[64];
-      std::snprintf(label, sizeof label, "%.2f-%.2f", segmentStart, t);
+      std::snprintf(label, sizeof label, "%.3f-%.3f", segmentStart, t);
       row(label, start);
       start[0] = Read(*solver[0]);
       start[1] = Read(*solver[1]);
