@@ -21,7 +21,11 @@
 //     in spacings, averaged over the sample times;
 //   - front_dev: the surge front (sim::SurgeFront from the tank's back wall) against the reference's,
 //     largest relative deviation over the sample times (dam break only);
-//   - max_speed, lost/clamped counts, NaN: the run's health.
+//   - max_speed, lost/clamped counts, NaN: the run's health;
+//   - wall_speedup (paired runs only): the reference's wall time in Solver::Step over the run's simulated
+//     time divided by the run's. Where steps get dearer during a run (the dam break's splash) and reuse
+//     skips most while they are cheap, the medians' ratio misses that; a run that takes more steps
+//     (a time step clamped to a faster flow's CFL limit) pays for them here.
 // --csv writes one row per run (docs/reuse.csv); bench/plot_reuse.py draws docs/reuse.png.
 #include <array>
 #include <chrono>
@@ -457,7 +461,7 @@ int main(int argc, char** argv) {
                "timestamp_utc,cpu_model,nproc,threads,scene,fluid,setting,enabled,delta1,delta2,threshold,idle,accel_tolerance,"
                "sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,paired_ref_step_ms,speedup,active_fraction,"
                "mean_density_error,peak_density_error,surface_rms_spacings,front_deviation,max_speed,clamped,"
-               "finite,load_avg_start,load_avg_end",
+               "finite,load_avg_start,load_avg_end,wall_speedup",
                false, &csv);
       !why.empty()) {
     std::fprintf(stderr, "%s\n", why.c_str());
@@ -512,7 +516,8 @@ int main(int argc, char** argv) {
             << speedup << ','
             << r.active << ',' << r.meanErr << ',' << r.peakErr << ',' << r.surfaceRms << ','
             << (sc.dam ? r.frontDev : std::nan("")) << ',' << r.maxSpeed << ',' << r.clamped << ','
-            << (r.finite ? 1 : 0) << ',' << r.loadStart << ',' << r.loadEnd << '\n';
+            << (r.finite ? 1 : 0) << ',' << r.loadStart << ',' << r.loadEnd << ','
+            << (paired ? r.pairedRefStepSeconds / r.stepSeconds : std::nan("")) << '\n';
       }
     }
     // Where the time goes: each stage's mean per step, the run against its lock-step reference.
