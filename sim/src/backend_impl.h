@@ -214,7 +214,7 @@ class BackendImpl final : public Backend {
       auto end = thrust::copy_if(policy, first, first + set.count, m_blockStart.begin(),
                                  typename Traits::DensityBlockStart{View(), set, m_pairBlocks});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
-      const bool masked = physics.reuseEnabled && computing < n && !compacted;
+      const bool masked = computing < n && m_pairBlocks;  // the pairs-only layout's masked lanes
       loop(blocks, 8,
            typename Traits::DensityBlockStage{density, set, Raw(m_blockStart), masked ? Raw(m_fluid.idle) : nullptr,
                                               physics.reuseIdle, m_pairBlocks});

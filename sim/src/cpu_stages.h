@@ -291,30 +291,22 @@ struct BlockSet {
   }
 };
 
-SPHXR_INLINE CellPair PairOf(const GridView& g, const BlockSet& set, int cx, int cy, int cz) {
-  CellPair p;
-  p.x0 = cx & ~1;
-  p.x1 = p.x0 + 1 < g.nx ? p.x0 + 1 : p.x0;
-  uint32_t f0 = 0, e0 = 0, f1 = 0, e1 = 0;
-  const bool has0 = set.CellRun(g, g.Linear(p.x0, cy, cz), &f0, &e0);
-  const bool has1 = set.CellRun(g, g.Linear(p.x1, cy, cz), &f1, &e1);
-  p.first = has0 ? f0 : f1;
-  p.end = has1 ? e1 : e0;
-  return p;
-}
-
 /// The run that the blocks of cell (cx, cy, cz)'s particles are cut from when their 2 x 2 x 1 box holds
 /// more than kLanes (BlockBoxOf): the pair's, or the cell's own (x0 == x1 == cx) where that is cheaper.
 /// `pairsOnly`: always the pair's (the layout before the boxes, which the tests hold the boxes to).
 SPHXR_INLINE CellPair CutRunOf(const GridView& g, const BlockSet& set, int cx, int cy, int cz, bool pairsOnly) {
-  const CellPair pair = PairOf(g, set, cx, cy, cz);
+  CellPair pair;
+  pair.x0 = cx & ~1;
+  pair.x1 = pair.x0 + 1 < g.nx ? pair.x0 + 1 : pair.x0;
+  uint32_t f0 = 0, e0 = 0, f1 = 0, e1 = 0;
+  const bool has0 = set.CellRun(g, g.Linear(pair.x0, cy, cz), &f0, &e0);
+  const bool has1 = set.CellRun(g, g.Linear(pair.x1, cy, cz), &f1, &e1);
+  pair.first = has0 ? f0 : f1;
+  pair.end = has1 ? e1 : e0;
   const uint32_t n = pair.end - pair.first;
   if (pairsOnly || n <= static_cast<uint32_t>(kLanes) || pair.x1 == pair.x0) return pair;
-  uint32_t f0 = 0, e0 = 0, f1 = 0, e1 = 0;
-  set.CellRun(g, g.Linear(pair.x0, cy, cz), &f0, &e0);
-  set.CellRun(g, g.Linear(pair.x1, cy, cz), &f1, &e1);
   const uint32_t n0 = e0 - f0, n1 = e1 - f1;
-  if (n0 == 0 || n1 == 0) return pair;  // one cell holds the run already
+  if (n0 == 0 || n1 == 0) return pair;  // one cell holds the run already (an empty cell: 0 to 0)
   auto blocks = [](uint32_t m) { return (m + static_cast<uint32_t>(kLanes) - 1) / static_cast<uint32_t>(kLanes); };
   if (27 * (blocks(n0) + blocks(n1)) >= 36 * blocks(n)) return pair;
   return cx == pair.x0 ? CellPair{cx, cx, f0, e0} : CellPair{cx, cx, f1, e1};

@@ -179,13 +179,7 @@ struct Setup {
 
   /// The first particle of each density block (DensityBlockStart).
   std::vector<uint32_t> BlockStarts(const std::vector<uint32_t>& keys, bool pairsOnly) {
-    const int n = static_cast<int>(position.size());
-    const DensityBlockStart isStart{Grid(), BlockSet{keys.data(), n}, pairsOnly};
-    std::vector<uint32_t> blocks;
-    for (int i = 0; i < n; ++i) {
-      if (isStart(i)) blocks.push_back(static_cast<uint32_t>(i));
-    }
-    return blocks;
+    return BlockStarts(BlockSet{keys.data(), static_cast<int>(keys.size())}, pairsOnly);
   }
 
   /// The backend's set with reuse (cpu_stages.h BlockSet): the particles that compute this step, their
