@@ -27,6 +27,7 @@
 //     skips most while they are cheap, the medians' ratio misses that; a run that takes more steps
 //     (a time step clamped to a faster flow's CFL limit) pays for them here.
 // --csv writes one row per run (docs/reuse.csv); bench/plot_reuse.py draws docs/reuse.png.
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -58,6 +59,7 @@ struct Setting {
   float delta1 = 1, delta2 = 1, threshold = 1.2f;
   int idle = 3;
   float tolerance = 0.1f;  // reuse.accel_tolerance, in |g| (0: the guard off)
+  int impulse = 2;         // reuse.impulse: 2 the impulse hold with live density, 1 without, 0 the held acceleration
 };
 
 struct Args {
@@ -74,7 +76,7 @@ struct Args {
 
 const char* kUsage =
     "usage: sphxr_bench_reuse [--quick] [--threads N] [--csv FILE] [--scene deep_tank|dam_break_1m] [--time T]\n"
-    "                          [--presets] [--unpaired] [--setting D1,D2,T,IDLE,TOL]...\n"
+    "                          [--presets] [--unpaired] [--setting D1,D2,T,IDLE,TOL[,HOLD]]...\n"
     "  --quick         off, the three presets and 2 more settings, to t = 0.1 s (a smoke run)\n"
     "  --threads N     CPU backend threads (default 0 = all cores)\n"
     "  --csv FILE      write one row per run to FILE (overwritten; only a file with this bench's header)\n"
@@ -83,23 +85,26 @@ const char* kUsage =
     "  --presets       off and the three presets only (no sweep)\n"
     "  --unpaired      no lock-step reference: half the time, but the speed-up is then against reference runs\n"
     "                  made minutes apart (noise on a shared machine)\n"
-    "  --setting D1,D2,T,IDLE,TOL  run this setting (delta1, delta2, threshold, idle steps, accel tolerance\n"
-    "                  in g; 0 = guard off) instead of the sweep and the presets (also with --presets or\n"
-    "                  --quick); repeatable. Each run is named \"custom\"; its parameters are in the row.\n"
+    "  --setting D1,D2,T,IDLE,TOL[,HOLD]  run this setting (delta1, delta2, threshold, idle steps, accel\n"
+    "                  tolerance in g, 0 = guard off; HOLD = reuse.impulse, 0, 1 or 2, default 2) instead of\n"
+    "                  the sweep and the presets (also with --presets or --quick); repeatable. Each run is\n"
+    "                  named \"custom\"; its parameters are in the row.\n"
     "The printout ends each scene with every stage's mean ms per step for each paired run and its\n"
     "reference, both runs' mean whole step, and the ratio of their wall times over the same simulated\n"
     "time (a scene whose steps get dearer, as the dam break's do, can give another ratio than the\n"
     "medians; a run that takes more steps pays for them) (not with --unpaired, which has no reference\n"
     "to set beside it).\n";
 
-/// "D1,D2,T,IDLE,TOL" (--setting) into a reuse-on setting named "custom"; false unless it is five
-/// decimal numbers from 0 to 1e9 (as the scene's reuse section allows) that stay what they say as floats
-/// (1e-50 would become 0, and a tolerance of 0 turns the guard off), IDLE a whole number to 1000.
+/// "D1,D2,T,IDLE,TOL[,HOLD]" (--setting) into a reuse-on setting named "custom"; false unless it is
+/// five or six decimal numbers from 0 to 1e9 (as the scene's reuse section allows) that stay what they
+/// say as floats (1e-50 would become 0, and a tolerance of 0 turns the guard off), IDLE a whole number
+/// to 1000, HOLD (reuse.impulse) 0, 1 or 2.
 bool ParseSetting(const std::string& text, Setting* out) {
-  float v[5];
+  float v[6] = {0, 0, 0, 0, 0, 2};
+  const int fields = std::count(text.begin(), text.end(), ',') == 5 ? 6 : 5;
   size_t at = 0;
-  for (int k = 0; k < 5; ++k) {
-    const size_t comma = k < 4 ? text.find(',', at) : text.size();
+  for (int k = 0; k < fields; ++k) {
+    const size_t comma = k < fields - 1 ? text.find(',', at) : text.size();
     if (comma == std::string::npos) return false;
     const std::string field = text.substr(at, comma - at);
     at = comma + 1;
@@ -114,6 +119,7 @@ bool ParseSetting(const std::string& text, Setting* out) {
     if (d > 0.0 && !(v[k] > 0.0f)) return false;  // a positive number too small for a float
   }
   if (v[3] != std::floor(v[3]) || v[3] > 1000.0f) return false;
+  if (v[5] != 0.0f && v[5] != 1.0f && v[5] != 2.0f) return false;
   out->name = "custom";
   out->enabled = true;
   out->delta1 = v[0];
@@ -121,6 +127,7 @@ bool ParseSetting(const std::string& text, Setting* out) {
   out->threshold = v[2];
   out->idle = static_cast<int>(v[3]);
   out->tolerance = v[4];
+  out->impulse = static_cast<int>(v[5]);
   return true;
 }
 
@@ -166,8 +173,8 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       Setting setting;
       if (!ParseSetting(v, &setting)) {
         std::fprintf(stderr,
-                     "sphxr_bench_reuse: --setting %s: must be D1,D2,T,IDLE,TOL (numbers from 0, IDLE a whole "
-                     "number of steps from 0 to 1000)\n",
+                     "sphxr_bench_reuse: --setting %s: must be D1,D2,T,IDLE,TOL[,HOLD] (numbers from 0, IDLE a "
+                     "whole number of steps from 0 to 1000, HOLD 0, 1 or 2)\n",
                      v.c_str());
         return false;
       }
@@ -182,8 +189,9 @@ bool ParseArgs(int argc, char** argv, Args* out) {
   return true;
 }
 
-Setting Sweep(float d1, float d2, float t, int idle, float tol) {
+Setting Sweep(float d1, float d2, float t, int idle, float tol, int impulse = 2) {
   Setting s;
+  s.impulse = impulse;
   s.tolerance = tol;
   s.name = "sweep";
   s.enabled = true;
@@ -197,7 +205,7 @@ Setting Sweep(float d1, float d2, float t, int idle, float tol) {
 Setting Preset(const char* name) {
   sim::ReuseParams r;
   sim::ApplyReusePreset(name, &r);
-  Setting s = Sweep(r.delta1, r.delta2, r.threshold, r.idle, r.accelTolerance);
+  Setting s = Sweep(r.delta1, r.delta2, r.threshold, r.idle, r.accelTolerance, r.impulse);
   s.name = name;
   return s;
 }
@@ -310,6 +318,7 @@ class Runner {
     m_scene.setup.reuse.threshold = setting.threshold;
     m_scene.setup.reuse.idle = setting.idle;
     m_scene.setup.reuse.accelTolerance = setting.tolerance;
+    m_scene.setup.reuse.impulse = setting.impulse;
     sim::SolverConfig config;
     config.device = sim::Device::kCpu;
     config.threads = threads;
@@ -459,7 +468,7 @@ int main(int argc, char** argv) {
   std::ofstream csv;
   if (const std::string why = args.csv.empty() ? std::string() : OpenCsv(args.csv,
                "timestamp_utc,cpu_model,nproc,threads,scene,fluid,setting,enabled,delta1,delta2,threshold,idle,accel_tolerance,"
-               "sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,paired_ref_step_ms,speedup,active_fraction,"
+               "impulse,sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,paired_ref_step_ms,speedup,active_fraction,"
                "mean_density_error,peak_density_error,surface_rms_spacings,front_deviation,max_speed,clamped,"
                "finite,load_avg_start,load_avg_end,wall_speedup",
                false, &csv);
@@ -479,8 +488,8 @@ int main(int argc, char** argv) {
     if (!Run(sc, off, args.threads, false, &ref)) return 1;
     std::vector<Result> results;
     for (const Setting& s : Settings(args.quick, args.presetsOnly, args.custom)) {
-      std::fprintf(stderr, "%s: %s delta1 %g delta2 %g T %g IDLE %d tolerance %g ...\n", sc.name.c_str(),
-                   s.name.c_str(), s.delta1, s.delta2, s.threshold, s.idle, s.tolerance);
+      std::fprintf(stderr, "%s: %s delta1 %g delta2 %g T %g IDLE %d tolerance %g hold %d ...\n", sc.name.c_str(),
+                   s.name.c_str(), s.delta1, s.delta2, s.threshold, s.idle, s.tolerance, s.impulse);
       Result r;
       if (!Run(sc, s, args.threads, !args.unpaired, &r)) return 1;
       results.push_back(std::move(r));
@@ -511,7 +520,7 @@ int main(int argc, char** argv) {
         csv << when << ',' << CsvField(cpu) << ',' << CpuCount() << ',' << threads << ',' << sc.name << ',' << r.fluid
             << ',' << r.setting.name << ',' << (r.setting.enabled ? 1 : 0) << ',' << r.setting.delta1 << ','
             << r.setting.delta2 << ',' << r.setting.threshold << ',' << r.setting.idle << ',' << r.setting.tolerance << ','
-            << sc.time << ','
+            << r.setting.impulse << ',' << sc.time << ','
             << r.steps << ',' << r.stepMs << ',' << ref.stepMs << ',' << refLast.stepMs << ',' << r.pairedRefMs << ','
             << speedup << ','
             << r.active << ',' << r.meanErr << ',' << r.peakErr << ',' << r.surfaceRms << ','

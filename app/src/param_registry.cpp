@@ -49,18 +49,28 @@ std::vector<ParamDesc> Build() {
              "a particle whose acceleration changed by more than this many |g| since its last computation stays "
              "active for IDLE + 1 steps (0 = off; docs/reuse.md)",
              &sim::ReuseParams::accelTolerance);
-  ParamDesc idle;
-  idle.name = "idle";
-  idle.key = "reuse.idle";
-  idle.group = "reuse";
-  idle.unit = "steps";
-  idle.help = "IDLE: consecutive steps an inactive particle reuses its density, pressure and acceleration";
-  idle.min = 0;
-  idle.max = 1000;
-  idle.defaultValue = reuseDefaults.idle;
-  idle.integer = true;
-  idle.reuseInt = &sim::ReuseParams::idle;
-  out.push_back(idle);
+  const auto reuseInt = [&](const char* name, const char* unit, const char* help, int lo, int hi,
+                            int sim::ReuseParams::*m) {
+    ParamDesc p;
+    p.name = name;
+    p.key = std::string("reuse.") + name;
+    p.group = "reuse";
+    p.unit = unit;
+    p.help = help;
+    p.min = lo;
+    p.max = hi;
+    p.defaultValue = reuseDefaults.*m;
+    p.integer = true;
+    p.reuseInt = m;
+    out.push_back(p);
+  };
+  reuseInt("idle", "steps", "IDLE: consecutive steps an inactive particle reuses its density, pressure and acceleration",
+           0, 1000, &sim::ReuseParams::idle);
+  reuseInt("impulse", "",
+           "2: the impulse hold with live density (stable to IDLE 3); 1: the impulse hold (synchronised schedule, "
+           "kick (IDLE + 1) dt a, drift while reusing; stable to IDLE 1); 0: the paper's held acceleration "
+           "(docs/reuse.md)",
+           0, 2, &sim::ReuseParams::impulse);
   return out;
 }
 

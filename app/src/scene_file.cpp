@@ -166,7 +166,7 @@ class Reader {
       if (!reuse.is_object()) return Error("reuse", "must be an object");
       CheckKeys(reuse, "reuse",
                 {"enabled", "preset", "delta1", "delta2", "threshold", "idle", "pressure_scale", "cell_count",
-                 "accel_tolerance"});
+                 "accel_tolerance", "impulse"});
       sim::ReuseParams& r = s.reuse;
       r.enabled = true;
       // A preset first, then any parameter the section names overrides it.

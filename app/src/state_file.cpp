@@ -233,6 +233,8 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
       return Status::Error(Format("%s: step count %lld: the file is damaged", path.c_str(), static_cast<long long>(out->step)));
     }
   }
+  // The impulse hold's schedule continues in step with the saved run (unknown: from 0, a one-off shift).
+  out->clock.steps = out->step < 0 ? 0 : out->step;
   if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return truncated();
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
   const sim::ParamInfo* spacing = sim::FindSolverParam("spacing");

@@ -140,6 +140,11 @@ class BackendImpl final : public Backend {
     // 3b. activity (reuse): classify, then compact the particles that compute this step
     const FluidView fv = Fluid();
     int computing = n;
+    // The particles whose density is computed: those that compute, and with the impulse hold the
+    // reusing ones next to them (DensityThisStep; its own list then, else the compute list).
+    int densityCount = n;
+    const uint32_t* densityList = Raw(m_computeList);
+    DensityThisStep densityOf{View(), fv.position, Raw(m_fluid.idle), physics.reuseIdle, nullptr};
     if (physics.reuseEnabled) {
       const int cells = static_cast<int>(m_fluidStart.size());
       m_cellCount.resize(cells);
@@ -158,6 +163,20 @@ class BackendImpl final : public Backend {
       auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),
                                  ComputesThisStep{Raw(m_fluid.idle), physics.reuseIdle});
       computing = static_cast<int>(end - m_computeList.begin());
+      densityCount = computing;
+      if (physics.reuseLiveDensity && computing < n) {
+        // Live density: the reusing particles with a computing one in their 27 cells (count, then the
+        // same three box-sum passes as the crowding, whose counts are no longer needed).
+        thrust::for_each_n(policy, first, cells, CellComputingStage{grid, Raw(m_fluid.idle), physics.reuseIdle, count});
+        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
+        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, crowd, count, 1});
+        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 2});
+        densityOf.computingNear = crowd;
+        m_densityList.resize(n);
+        auto last = thrust::copy_if(policy, first, first + n, m_densityList.begin(), densityOf);
+        densityCount = static_cast<int>(last - m_densityList.begin());
+        densityList = Raw(m_densityList);
+      }
       if (Status s = lap(Stage::kActivity); !s) return s;
     }
 
@@ -200,26 +219,27 @@ class BackendImpl final : public Backend {
       // particles that reuse take no lane (cpu_stages.h BlockSet). The pairs-only layout (benchmarks)
       // keeps the layout before both: every particle, the lanes that reuse masked.
       typename Traits::BlockSet set{Raw(m_keys), n};
-      const bool compacted = computing < n && !m_pairBlocks;
+      const bool compacted = densityCount < n && !m_pairBlocks;
       if (compacted) {
-        m_computeKeys.resize(computing);
-        thrust::gather(policy, m_computeList.begin(), m_computeList.begin() + computing, m_keys.begin(),
-                       m_computeKeys.begin());
+        m_computeKeys.resize(densityCount);
+        thrust::gather(policy, densityList, densityList + densityCount, m_keys.begin(), m_computeKeys.begin());
         m_computeRank.resize(n + 1);
-        const auto flags = thrust::make_transform_iterator(first, ComputeFlag{Raw(m_fluid.idle), physics.reuseIdle, n});
+        const auto flags = thrust::make_transform_iterator(first, ComputeFlag{densityOf, n});
         thrust::exclusive_scan(policy, flags, flags + (n + 1), m_computeRank.begin(), 0u, thrust::plus<uint32_t>());
-        set = typename Traits::BlockSet{Raw(m_computeKeys), computing, Raw(m_computeList), Raw(m_computeRank)};
+        set = typename Traits::BlockSet{Raw(m_computeKeys), densityCount, densityList, Raw(m_computeRank)};
       }
       m_blockStart.resize(set.count);
       auto end = thrust::copy_if(policy, first, first + set.count, m_blockStart.begin(),
                                  typename Traits::DensityBlockStart{View(), set, m_pairBlocks});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
-      const bool masked = computing < n && m_pairBlocks;  // the pairs-only layout's masked lanes
+      const bool masked = densityCount < n && m_pairBlocks;  // the pairs-only layout's masked lanes
       loop(blocks, 8,
            typename Traits::DensityBlockStage{density, set, Raw(m_blockStart), masked ? Raw(m_fluid.idle) : nullptr,
-                                              physics.reuseIdle, m_pairBlocks});
+                                              physics.reuseIdle, m_pairBlocks, densityOf.computingNear});
+    } else if (densityCount < n) {
+      loop(densityCount, 32, OverList<DensityStage>{densityList, density});
     } else {
-      overComputing(32, density);
+      loop(n, 32, density);
     }
     if (Status s = lap(Stage::kDensity); !s) return s;
 
@@ -507,6 +527,7 @@ class BackendImpl final : public Backend {
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
+  Vector<uint32_t> m_densityList;  // the impulse hold: those whose density is computed (DensityThisStep)
   Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell; scratch of the 27-cell sums
   Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each cell
   Vector<uint32_t> m_blockStart;   // CPU density blocks: first entry of each (cpu_stages.h)

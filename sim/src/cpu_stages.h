@@ -511,6 +511,7 @@ struct DensityBlockStage {
   const int32_t* idle = nullptr;  // masked lanes: the idle counts; nullptr: every entry computes
   int32_t idleSteps = 0;
   bool pairsOnly = false;  // DensityBlockStart's
+  const uint32_t* computingNear = nullptr;  // masked lanes with the impulse hold: live density (DensityThisStep)
 
   void operator()(int b) const {
     const GridView& g = stage.grid;
@@ -520,7 +521,7 @@ struct DensityBlockStage {
     const int lanes = static_cast<int>(box.end - first < static_cast<uint32_t>(kLanes) ? box.end - first : kLanes);
     uint32_t computing = 0;
     uint32_t particle[kLanes];  // each lane's particle
-    const ComputesThisStep computes{idle, idleSteps};
+    const DensityThisStep computes{g, position, idle, idleSteps, computingNear};
     for (int l = 0; l < lanes; ++l) {
       particle[l] = set.Particle(first + static_cast<uint32_t>(l));
       if (idle == nullptr || computes(static_cast<int>(particle[l]))) computing |= 1u << l;

@@ -81,6 +81,11 @@ Status ValidateReuse(const ReuseParams& r) {
   if (r.idle < 0 || r.idle > 1000) {
     return Status::Error(Format("reuse.idle = %d is invalid: must be 0 to 1000 steps", r.idle));
   }
+  if (r.impulse < 0 || r.impulse > 2) {
+    return Status::Error(Format("reuse.impulse = %d is invalid: must be 2 (the impulse hold with live density), 1 (the "
+                                "impulse hold) or 0 (the held acceleration)",
+                                r.impulse));
+  }
   return Status::Ok();
 }
 
@@ -227,6 +232,18 @@ Status ValidateScene(const SceneSetup& scene) {
   return Status::Ok();
 }
 
+// Reuse settings measured unstable are named when they are set (at start-up and by SetReuse).
+void WarnAboutReuse(const ReuseParams& reuse) {
+  const int stableIdle = reuse.impulse == 2 ? 3 : 1;
+  if (reuse.enabled && reuse.impulse != 0 && reuse.idle > stableIdle) {
+    // Measured (docs/reuse.md, "The impulse hold"): the deep tank at the CFL step blew up at IDLE 5 and 7.
+    SPHXR_LOG_WARN("reuse.idle = %d with reuse.impulse = %d: IDLE above %d was measured unstable at the CFL step "
+                   "(the held kick outruns the pressure waves); use IDLE <= %d%s or a smaller cfl",
+                   reuse.idle, reuse.impulse, stableIdle, stableIdle,
+                   reuse.impulse == 1 ? " (3 with reuse.impulse = 2)" : "");
+  }
+}
+
 // Settings that run but will not give usable water are named at start-up, once.
 void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed) {
   // Fluid is not seeded inside the moving bodies at their start poses: say how much that leaves out (a
@@ -253,6 +270,7 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
                    "errors above 1%% (WCSPH wants 10x); solver.stiffness >= %.3g Pa would give that",
                    soundSpeed, soundSpeed / vRef, vRef, needB);
   }
+  WarnAboutReuse(scene.reuse);
   for (size_t i = 0; i < scene.fluid.size(); ++i) {
     const Aabb& b = scene.fluid[i].box;
     const float thin = std::min({b.max.x - b.min.x, b.max.y - b.min.y, b.max.z - b.min.z});
@@ -295,6 +313,9 @@ Physics MakePhysics(const SceneSetup& scene) {
     ph.reuseAccelTolerance2 = r.accelTolerance > 0.0f ? tol * tol : 3.0e38f;
     ph.reuseCooldown = r.idle + 1;
   }
+  ph.reuseImpulse = r.impulse >= 1;
+  ph.reuseLiveDensity = r.impulse == 2;
+  ph.reuseSyncStep = true;  // Solver::Step sets it from the step's number
   ph.stiffness = p.stiffness;
   ph.exponent = p.exponent;
   ph.soundSpeed = std::sqrt(p.exponent * p.stiffness / p.restDensity);
@@ -469,7 +490,7 @@ Status Solver::Step() {
                                 "simulation has become unstable",
                                 dt, m_last.time, m_maxAccel));
   }
-  const int64_t stepNumber = m_totals.steps + 1;
+  const int64_t stepNumber = m_stepBase + m_totals.steps + 1;
   StageHook hook;
   HostFluid host;
   if (m_config.validate) {
@@ -501,7 +522,8 @@ Status Solver::Step() {
   }
 
   StepReduction red;
-  const Physics physics = MakePhysics(m_scene);
+  Physics physics = MakePhysics(m_scene);
+  physics.reuseSyncStep = stepNumber % (physics.reuseIdle + 1) == 0;
   std::vector<BodyState> states;
   if (!m_bodies.empty()) {
     // Each body moves from its pose now to its interpolated pose at the end of the step; its particles
@@ -593,6 +615,7 @@ SolverClock Solver::Clock() const {
   c.time = m_last.time;
   c.lastMaxSpeed = m_last.maxSpeed;
   c.lastMaxAccel = m_maxAccel;
+  c.steps = m_stepBase + m_totals.steps;
   return c;
 }
 
@@ -601,10 +624,10 @@ Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
   // A clock past 1e9 s (32 years) is damage, not a run: there a step of ~1e-4 s no longer moves a double
   // clock, and frame numbers computed from it overflow (a flipped exponent bit hung the headless runner).
   if (!std::isfinite(clock.time) || clock.time < 0.0 || clock.time > 1e9 || !std::isfinite(clock.lastMaxSpeed) ||
-      clock.lastMaxSpeed < 0.0f || !std::isfinite(clock.lastMaxAccel) || clock.lastMaxAccel < 0.0f) {
-    return Status::Error(Format("restore: the clock (t = %g s, last max speed %g m/s, last max |a| %g m/s^2) must be "
-                                "finite, not negative, and t at most 1e9 s",
-                                clock.time, clock.lastMaxSpeed, clock.lastMaxAccel));
+      clock.lastMaxSpeed < 0.0f || !std::isfinite(clock.lastMaxAccel) || clock.lastMaxAccel < 0.0f || clock.steps < 0) {
+    return Status::Error(Format("restore: the clock (t = %g s, last max speed %g m/s, last max |a| %g m/s^2, %lld "
+                                "steps) must be finite, not negative, and t at most 1e9 s",
+                                clock.time, clock.lastMaxSpeed, clock.lastMaxAccel, static_cast<long long>(clock.steps)));
   }
   if (Status s = CheckFluidSizes(fluid, "restore"); !s) return s;
   for (size_t i = 0; i < fluid.size(); ++i) {
@@ -636,6 +659,7 @@ Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
   m_last.maxSpeed = clock.lastMaxSpeed;
   m_maxAccel = clock.lastMaxAccel;
   m_totals = Totals{};
+  m_stepBase = clock.steps;
   for (BodyMotion& b : m_bodies) HoldBody(&b, b.pose, clock.time);  // where it is, at rest, on the restored clock
   return Status::Ok();
 }
@@ -706,6 +730,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
 Status Solver::SetReuse(const ReuseParams& reuse) {
   if (Status s = ValidateReuse(reuse); !s) return s;
   m_scene.reuse = reuse;
+  WarnAboutReuse(reuse);
   HostFluid fluid;
   m_backend->Download(&fluid);
   std::fill(fluid.idle.begin(), fluid.idle.end(), -1);

@@ -171,6 +171,9 @@ struct Physics {
   float reuseCellCount;         // N_CPN
   float reuseAccelTolerance2;   // (tolerance)^2, m^2/s^4: a larger change of acceleration keeps i active
   int reuseCooldown;            // steps a particle so flagged stays active before it is classified again
+  bool reuseImpulse;            // the impulse hold (ReuseParams::impulse >= 1): synchronised and kicked
+  bool reuseLiveDensity;        // ReuseParams::impulse == 2: reusing neighbours of computing ones recompute density
+  bool reuseSyncStep;           // with the impulse hold: this step's number is a multiple of IDLE + 1
   bool wallDensity;             // walls with their own density (WallPressureStage), else mirrored pressure
   float bodyGradScale;          // as boundaryGradScale, for the one-sheet shells of moving bodies
   float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle
@@ -417,7 +420,10 @@ struct ActivityStage {
     const float meanCount = static_cast<float>(crowd[grid.Linear(cx, cy, cz)]) / 27.0f;
     const float act = ph.reuseDelta1 * fluid.pressure[i] * ph.reuseInvPressureScale +
                       ph.reuseDelta2 * ph.reuseCellCount / AtLeast(meanCount, 1e-6f);
-    fluid.idle[i] = (act < ph.reuseThreshold && ph.reuseIdle > 0) ? ph.reuseIdle : -1;
+    // The impulse hold's synchronised schedule: particles go inactive together, on every (IDLE + 1)-th
+    // step, so a calm region reuses over the same steps and computes on the same step (docs/reuse.md).
+    const bool mayStart = !ph.reuseImpulse || ph.reuseSyncStep;
+    fluid.idle[i] = (mayStart && act < ph.reuseThreshold && ph.reuseIdle > 0) ? ph.reuseIdle : -1;
   }
 };
 
@@ -427,13 +433,48 @@ struct ComputesThisStep {
   SPHXR_HD bool operator()(int i) const { return idle[i] < 0 || idle[i] == idleSteps; }
 };
 
-/// 1 for a particle i < n that computes this step, else 0 (also for i = n: the CPU density blocks' rank
-/// scan runs over n + 1 items, cpu_stages.h BlockSet).
-struct ComputeFlag {
+/// The impulse hold's live density: each cell's fluid particles that compute this step (every cell,
+/// empty ones 0), summed over the 27 cells around each cell by CellBoxSumStage's three passes.
+struct CellComputingStage {
+  GridView grid;
   const int32_t* idle;
   int32_t idleSteps;
+  uint32_t* count;
+  SPHXR_HD void operator()(int c) const {
+    uint32_t computing = 0;
+    if (grid.fluidStart[c] != kEmptyCell) {
+      const ComputesThisStep computes{idle, idleSteps};
+      for (uint32_t j = grid.fluidStart[c]; j < grid.fluidEnd[c]; ++j) computing += computes(static_cast<int>(j)) ? 1u : 0u;
+    }
+    count[c] = computing;
+  }
+};
+
+/// The particles whose density and pressure are computed this step: those that compute, and with the
+/// impulse hold also those that reuse with a computing particle in their 27 cells (live density), so
+/// that a computing particle never feels a neighbour's stale pressure. `computingNear`: the computing
+/// particles of the 27 cells around each cell (CellComputingStage, summed); nullptr: the held hold.
+struct DensityThisStep {
+  GridView grid;
+  const Vec4* position;
+  const int32_t* idle;
+  int32_t idleSteps;
+  const uint32_t* computingNear;
+  SPHXR_HD bool operator()(int i) const {
+    if (ComputesThisStep{idle, idleSteps}(i)) return true;
+    if (computingNear == nullptr) return false;
+    int cx, cy, cz;
+    grid.CellOf(Xyz(position[i]), &cx, &cy, &cz);
+    return computingNear[grid.Linear(cx, cy, cz)] > 0;
+  }
+};
+
+/// 1 for a particle i < n whose density is computed this step, else 0 (also for i = n: the CPU density
+/// blocks' rank scan runs over n + 1 items, cpu_stages.h BlockSet).
+struct ComputeFlag {
+  DensityThisStep density;
   int n;
-  SPHXR_HD uint32_t operator()(int i) const { return i < n && ComputesThisStep{idle, idleSteps}(i) ? 1u : 0u; }
+  SPHXR_HD uint32_t operator()(int i) const { return i < n && density(i) ? 1u : 0u; }
 };
 
 /// Runs a per-particle stage over a compacted list of particle indices.
@@ -690,9 +731,23 @@ struct IntegrateStage {
     Vec4 a = fluid.acceleration[i];
     Vec4 v = fluid.velocity[i];
     Vec4 x = fluid.position[i];
-    v.x += dt * a.x;
-    v.y += dt * a.y;
-    v.z += dt * a.z;
+    // The impulse hold (docs/reuse.md): a particle that computed this step and reuses the next IDLE
+    // steps takes all their kicks now, (IDLE + 1) dt a, and drifts while it reuses. For a calm region
+    // on the synchronised schedule that is symplectic Euler at step (IDLE + 1) dt for its forces:
+    // stable where that step meets the pressure waves' limit, and conserving phase-space area, where
+    // applying the held a on every step pumps energy into every sound mode.
+    float kick = dt;
+    if (ph.reuseEnabled && ph.reuseImpulse && ph.reuseIdle > 0) {
+      const int32_t ic = fluid.idle[i];
+      if (ic == ph.reuseIdle) {
+        kick = dt * static_cast<float>(ph.reuseIdle + 1);
+      } else if (ic >= 0) {
+        kick = 0.0f;
+      }
+    }
+    v.x += kick * a.x;
+    v.y += kick * a.y;
+    v.z += kick * a.z;
     x.x += dt * v.x;
     x.y += dt * v.y;
     x.z += dt * v.z;

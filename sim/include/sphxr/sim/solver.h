@@ -76,6 +76,7 @@ struct SolverClock {
   double time = 0.0;        // s, simulated
   float lastMaxSpeed = 0.0f;  // m/s, of the last step
   float lastMaxAccel = 0.0f;  // m/s^2, of the last step
+  int64_t steps = 0;          // steps taken since the run began: the impulse hold's schedule is in step with it
 };
 
 /// A moving body's motion, for a restart: where it is, the target segment it is on, and the velocities
@@ -193,6 +194,7 @@ class Solver {
   std::unique_ptr<Backend> m_backend;
   StepInfo m_last;
   Totals m_totals;
+  int64_t m_stepBase = 0;  // steps of the run before a restore (SolverClock::steps)
   float m_maxAccel = 0.0f;
   // The motion (pose now, the target segment, the last step's velocities: BodyMotionState, which is what
   // a restart saves) and the fixed shape.
