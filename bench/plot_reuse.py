@@ -11,15 +11,18 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-# The presets as sim/src/params.cpp has them now (delta1, delta2, threshold, idle, accel_tolerance). A
+# The presets as sim/src/params.cpp has them now (delta1, delta2, threshold, idle, accel_tolerance,
+# impulse; rows from before the impulse column were the held acceleration, impulse 0). A
 # preset row of the CSV whose parameters differ was measured under an older value of that preset and is
 # drawn hollow; a sweep row with a preset's current parameters is drawn as that preset.
-PRESETS = {"accurate": (0.25, 1.0, 1.2, 1, 0.3), "balanced": (0.25, 1.0, 1.3, 3, 0.3), "fast": (0.25, 1.0, 1.5, 5, 2.0)}
+PRESETS = {"accurate": (0.1, 1.0, 1.6, 1, 0.0, 1), "balanced": (0.0, 1.0, 1.6, 3, 0.0, 2),
+           "fast": (0.0, 1.0, 1.8, 3, 0.0, 2)}
 COLOURS = {"accurate": "tab:green", "balanced": "tab:blue", "fast": "tab:red"}
 
 
 def params(r):
-    return (float(r["delta1"]), float(r["delta2"]), float(r["threshold"]), int(r["idle"]), float(r["accel_tolerance"]))
+    return (float(r["delta1"]), float(r["delta2"]), float(r["threshold"]), int(r["idle"]), float(r["accel_tolerance"]),
+            int(r.get("impulse") or 0))
 
 
 def current_preset(r):
@@ -42,24 +45,28 @@ def main():
             continue
         for r in rs:
             x = float(r[key]) * (100.0 if key == "front_deviation" else 1.0)
-            y = float(r["speedup"])
+            # The wall-time ratio: with the impulse hold one step in IDLE + 1 is dear and the rest cheap, so
+            # the median step's ratio overstates the speed-up (rows without it: the median's).
+            wall = r.get("wall_speedup") or "nan"
+            y = float(wall) if wall not in ("", "nan") else float(r["speedup"])
             # The work bound: the density and force stages run for the active fraction only.
             ax.plot(x, 1.0 / float(r["active_fraction"]), "_", ms=10, color="tab:purple",
                     label="1 / active fraction (work bound)" if r is rs[0] else None)
-            guard_off = float(r["accel_tolerance"]) == 0.0
+            hold = int(r.get("impulse") or 0)
             now = current_preset(r)
             if r["setting"] in PRESETS and now != r["setting"]:  # a preset's older parameters
-                ax.plot(x, y, "o", ms=9, mfc="none", color=COLOURS[r["setting"]],
-                        label="%s before (tolerance %g g)" % (r["setting"], float(r["accel_tolerance"])))
+                ax.plot(x, y, "o", ms=9, mfc="none", color=COLOURS[r["setting"]], label="%s before" % r["setting"])
             elif now is not None:
                 ax.plot(x, y, "o", ms=9, color=COLOURS[now], label=now)
-            elif guard_off:
-                ax.plot(x, y, "x", ms=9, color="k", label="guard off (T %g, IDLE %d)" % (float(r["threshold"]), int(r["idle"])))
+            elif hold == 0:
+                ax.plot(x, y, "x", ms=9, color="k", label="held acceleration (the paper's)")
+            elif hold == 1:
+                ax.plot(x, y, "^", ms=7, color="0.4", label="impulse hold")
             else:
-                ax.plot(x, y, ".", ms=7, color="0.5")
+                ax.plot(x, y, ".", ms=8, color="0.4", label="impulse hold, live density")
         ax.axhline(1.0, color="0.7", lw=0.8)
         ax.set_xlabel(label + (" (%)" if key == "front_deviation" else ""))
-        ax.set_ylabel("speed-up of the whole step (reuse off = 1)")
+        ax.set_ylabel("speed-up of the whole step, wall time (reuse off = 1)")
         ax.set_title("%s, %s particles" % (scene, rs[0]["fluid"]))
         handles, labels = ax.get_legend_handles_labels()
         seen = {}

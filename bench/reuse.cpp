@@ -210,20 +210,23 @@ Setting Preset(const char* name) {
   return s;
 }
 
-/// The sweep: one factor at a time around (delta1 0.25, delta2 1, T 1.3, IDLE 3, tolerance 1 g), the
-/// guard off once (to show why it exists), then the presets.
+/// The sweep: the holds side by side, then one factor at a time around `balanced` (delta1 0, delta2 1,
+/// T 1.5, IDLE 3, guard off, the impulse hold with live density), then the presets.
 std::vector<Setting> Settings(bool quick, bool presetsOnly, const std::vector<Setting>& custom) {
   if (!custom.empty()) return custom;
   std::vector<Setting> s;
   if (quick && !presetsOnly) {
-    s = {Sweep(1, 1, 1.2f, 1, 0.0f), Sweep(0.25f, 1, 1.3f, 3, 1.0f)};
+    s = {Sweep(0.25f, 1, 1.3f, 3, 0.3f, 0), Sweep(0, 1, 1.5f, 1, 0.0f, 1)};
   } else if (!presetsOnly) {
-    s.push_back(Sweep(1, 1, 1.2f, 1, 0.0f));
-    for (float tol : {0.1f, 0.3f, 1.0f, 2.0f, 5.0f}) s.push_back(Sweep(0.25f, 1, 1.3f, 3, tol));
-    for (int idle : {1, 2, 5, 8}) s.push_back(Sweep(0.25f, 1, 1.3f, idle, 1.0f));
-    for (float t : {1.1f, 1.2f, 1.5f, 2.0f}) s.push_back(Sweep(0.25f, 1, t, 3, 1.0f));
-    for (float d1 : {0.0f, 0.5f, 1.0f}) s.push_back(Sweep(d1, 1, 1.3f, 3, 1.0f));
-    for (float d2 : {0.8f, 1.2f}) s.push_back(Sweep(0.25f, d2, 1.3f, 3, 1.0f));
+    s.push_back(Sweep(0.25f, 1, 1.3f, 3, 0.3f, 0));  // the held acceleration, guarded: `balanced` until 2026-12-02
+    s.push_back(Sweep(0.25f, 1, 1.3f, 1, 0.0f, 0));  // the held acceleration, guard off
+    s.push_back(Sweep(0, 1, 1.5f, 1, 0.0f, 1));      // the impulse hold without live density
+    s.push_back(Sweep(0, 1, 1.5f, 3, 0.0f, 1));
+    for (int idle : {1, 2, 5}) s.push_back(Sweep(0, 1, 1.5f, idle, 0.0f, 2));
+    for (float t : {1.3f, 1.4f, 1.6f, 2.0f}) s.push_back(Sweep(0, 1, t, 3, 0.0f, 2));
+    for (float d1 : {0.1f, 0.25f, 0.5f}) s.push_back(Sweep(d1, 1, 1.5f, 3, 0.0f, 2));
+    for (float d2 : {0.8f, 1.2f}) s.push_back(Sweep(0, d2, 1.5f, 3, 0.0f, 2));
+    for (float tol : {0.3f, 1.0f}) s.push_back(Sweep(0, 1, 1.5f, 3, tol, 2));
   }
   for (const char* p : {"accurate", "balanced", "fast"}) s.push_back(Preset(p));
   return s;
@@ -504,16 +507,16 @@ int main(int argc, char** argv) {
                 sc.name.c_str(), ref.fluid, sc.time, ref.stepMs, refLast.stepMs);
     std::printf("%s\n", args.unpaired ? "speed-up against the mean of the two reference runs"
                                        : "speed-up against a reference stepped in lock-step with each run (ref_ms)");
-    std::printf("%-9s %6s %6s %6s %5s %5s %8s %8s %7s %7s %9s %9s %8s %8s %6s\n", "setting", "delta1", "delta2", "T", "IDLE", "tol",
+    std::printf("%-9s %6s %6s %6s %5s %5s %4s %8s %8s %7s %7s %9s %9s %8s %8s %6s\n", "setting", "delta1", "delta2", "T", "IDLE", "tol", "hold",
                 "step_ms", "ref_ms", "speedup", "active", "mean_err%", "peak_err%", "surf_rms", "front%", "vmax");
     results.insert(results.begin(), ref);
     for (Result& r : results) {
       Compare(ref, &r, dx);
       const bool paired = std::isfinite(r.pairedRefMs);
       const double speedup = r.stepMs > 0 ? (paired ? r.pairedRefMs : refMs) / r.stepMs : 0.0;
-      std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %8.2f %8.2f %7.2f %7.3f %9.3f %9.3f %8.3f %8.2f %6.2f%s\n",
+      std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %4d %8.2f %8.2f %7.2f %7.3f %9.3f %9.3f %8.3f %8.2f %6.2f%s\n",
                   r.setting.name.c_str(), r.setting.delta1, r.setting.delta2, r.setting.threshold, r.setting.idle,
-                  r.setting.tolerance,
+                  r.setting.tolerance, r.setting.impulse,
                   r.stepMs, paired ? r.pairedRefMs : refMs, speedup, r.active, 100 * r.meanErr, 100 * r.peakErr, r.surfaceRms, 100 * r.frontDev,
                   r.maxSpeed, r.finite ? "" : "  NaN!");
       if (csv) {
@@ -531,14 +534,14 @@ int main(int argc, char** argv) {
     }
     // Where the time goes: each stage's mean per step, the run against its lock-step reference.
     if (!args.unpaired) {
-      std::printf("stages, mean ms per step: the run (reference in lock-step)\n%-9s %6s %6s %6s %5s %5s", "setting",
-                  "delta1", "delta2", "T", "IDLE", "tol");
+      std::printf("stages, mean ms per step: the run (reference in lock-step)\n%-9s %6s %6s %6s %5s %5s %4s", "setting",
+                  "delta1", "delta2", "T", "IDLE", "tol", "hold");
       for (int k = 0; k < kStages; ++k) std::printf(" %15s", sim::StageName(static_cast<sim::Stage>(k)));
       std::printf(" %17s %12s\n", "mean step", "wall speedup");
       for (const Result& r : results) {
         if (!std::isfinite(r.pairedRefMs)) continue;
-        std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f", r.setting.name.c_str(), r.setting.delta1, r.setting.delta2,
-                    r.setting.threshold, r.setting.idle, r.setting.tolerance);
+        std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %4d", r.setting.name.c_str(), r.setting.delta1, r.setting.delta2,
+                    r.setting.threshold, r.setting.idle, r.setting.tolerance, r.setting.impulse);
         for (int k = 0; k < kStages; ++k) std::printf(" %6.3f (%6.3f)", r.stageMs[k], r.pairedRefStageMs[k]);
         std::printf(" %7.3f (%7.3f) %12.3f\n", r.meanMs, r.pairedRefMeanMs, r.pairedRefStepSeconds / r.stepSeconds);
       }

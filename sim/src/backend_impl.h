@@ -153,11 +153,13 @@ class BackendImpl final : public Backend {
       const int rows = grid.ny * grid.nz;
       uint32_t* count = Raw(m_cellCount);
       uint32_t* crowd = Raw(m_cellCrowd);
-      thrust::for_each_n(policy, first, cells, CellCountStage{grid, count});
-      // The 27-cell sums in three passes (x, y, z), the two buffers in turn; the crowding ends in m_cellCrowd.
-      thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
-      thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, crowd, count, 1});
-      thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 2});
+      if (!physics.reuseImpulse || physics.reuseSyncStep) {  // the impulse hold classifies on its schedule only
+        thrust::for_each_n(policy, first, cells, CellCountStage{grid, count});
+        // The 27-cell sums in three passes (x, y, z), the two buffers in turn; the crowding ends in m_cellCrowd.
+        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
+        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, crowd, count, 1});
+        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 2});
+      }
       thrust::for_each_n(policy, first, n, ActivityStage{grid, fv, physics, crowd});
       m_computeList.resize(n);
       auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),

@@ -414,16 +414,20 @@ struct ActivityStage {
       fluid.idle[i] = ic + 1;
       return;
     }
+    // The impulse hold's synchronised schedule: particles go inactive together, on every (IDLE + 1)-th
+    // step, so a calm region reuses over the same steps and computes on the same step (docs/reuse.md).
+    // On the other steps the crowding is not computed (BackendImpl::Step) and not read.
+    if (ph.reuseImpulse && !ph.reuseSyncStep) {
+      fluid.idle[i] = -1;
+      return;
+    }
     int cx, cy, cz;
     grid.CellOf(Xyz(fluid.position[i]), &cx, &cy, &cz);
     // The mean over all 27 cells, those outside the grid as empty: a particle there is at an edge.
     const float meanCount = static_cast<float>(crowd[grid.Linear(cx, cy, cz)]) / 27.0f;
     const float act = ph.reuseDelta1 * fluid.pressure[i] * ph.reuseInvPressureScale +
                       ph.reuseDelta2 * ph.reuseCellCount / AtLeast(meanCount, 1e-6f);
-    // The impulse hold's synchronised schedule: particles go inactive together, on every (IDLE + 1)-th
-    // step, so a calm region reuses over the same steps and computes on the same step (docs/reuse.md).
-    const bool mayStart = !ph.reuseImpulse || ph.reuseSyncStep;
-    fluid.idle[i] = (mayStart && act < ph.reuseThreshold && ph.reuseIdle > 0) ? ph.reuseIdle : -1;
+    fluid.idle[i] = (act < ph.reuseThreshold && ph.reuseIdle > 0) ? ph.reuseIdle : -1;
   }
 };
 

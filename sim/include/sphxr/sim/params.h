@@ -78,7 +78,7 @@ struct ReuseParams {
 };
 
 /// The presets chosen from the measured trade (docs/reuse.md): "accurate", "balanced", "fast".
-/// Each sets delta1, delta2, threshold, idle and the acceleration tolerance and turns reuse on; the derived constants
+/// Each sets delta1, delta2, threshold, idle, the acceleration tolerance and the hold (impulse) and turns reuse on; the derived constants
 /// (pressure_scale, cell_count) are left as they are. False for an unknown name.
 bool ApplyReusePreset(const std::string& name, ReuseParams* reuse);
 /// The preset names, for help texts and errors: "accurate, balanced, fast".
