@@ -15,8 +15,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 # impulse; rows from before the impulse column were the held acceleration, impulse 0). A
 # preset row of the CSV whose parameters differ was measured under an older value of that preset and is
 # drawn hollow; a sweep row with a preset's current parameters is drawn as that preset.
-PRESETS = {"accurate": (0.1, 1.0, 1.6, 1, 0.0, 1), "balanced": (0.0, 1.0, 1.6, 3, 0.0, 2),
-           "fast": (0.0, 1.0, 1.8, 3, 0.0, 2)}
+PRESETS = {"accurate": (0.1, 1.0, 1.6, 1, 0.0, 1), "balanced": (0.0, 1.0, 1.5, 3, 0.0, 1),
+           "fast": (0.0, 1.0, 1.8, 3, 0.0, 1)}
 COLOURS = {"accurate": "tab:green", "balanced": "tab:blue", "fast": "tab:red"}
 
 

@@ -67,9 +67,9 @@ std::vector<ParamDesc> Build() {
   reuseInt("idle", "steps", "IDLE: consecutive steps an inactive particle reuses its density, pressure and acceleration",
            0, 1000, &sim::ReuseParams::idle);
   reuseInt("impulse", "",
-           "2: the impulse hold with live density (stable to IDLE 3); 1: the impulse hold (synchronised schedule, "
-           "kick (IDLE + 1) dt a, drift while reusing; stable to IDLE 1); 0: the paper's held acceleration "
-           "(docs/reuse.md)",
+           "1: the impulse hold (synchronised schedule, kick (IDLE + 1) dt a, drift while reusing; stable to "
+           "IDLE 3); 2: the same with live density (reusing neighbours of computing particles recompute their "
+           "density); 0: the paper's held acceleration, stable only with accel_tolerance (docs/reuse.md)",
            0, 2, &sim::ReuseParams::impulse);
   return out;
 }

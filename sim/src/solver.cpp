@@ -234,13 +234,13 @@ Status ValidateScene(const SceneSetup& scene) {
 
 // Reuse settings measured unstable are named when they are set (at start-up and by SetReuse).
 void WarnAboutReuse(const ReuseParams& reuse) {
-  const int stableIdle = reuse.impulse == 2 ? 3 : 1;
-  if (reuse.enabled && reuse.impulse != 0 && reuse.idle > stableIdle) {
-    // Measured (docs/reuse.md, "The impulse hold"): the deep tank at the CFL step blew up at IDLE 5 and 7.
+  constexpr int kStableIdle = 3;
+  if (reuse.enabled && reuse.impulse != 0 && reuse.idle > kStableIdle) {
+    // Measured (docs/reuse.md, "Why the impulse hold is stable"): at the CFL step the deep tank and
+    // dam_break_1m blew up at IDLE 5 with either impulse hold (and the deep tank at IDLE 7 before).
     SPHXR_LOG_WARN("reuse.idle = %d with reuse.impulse = %d: IDLE above %d was measured unstable at the CFL step "
-                   "(the held kick outruns the pressure waves); use IDLE <= %d%s or a smaller cfl",
-                   reuse.idle, reuse.impulse, stableIdle, stableIdle,
-                   reuse.impulse == 1 ? " (3 with reuse.impulse = 2)" : "");
+                   "(the held kick outruns the pressure waves); use IDLE <= %d or a smaller cfl",
+                   reuse.idle, reuse.impulse, kStableIdle, kStableIdle);
   }
 }
 

@@ -77,7 +77,7 @@ TEST(Restore, CarriesReuseIdleCounts) {
 
 TEST(Restore, IdleCountsBeyondThisRunsIdleStartActive) {
   SceneSetup scene = test::SmallDamBreak(0.01f);
-  ASSERT_TRUE(ApplyReusePreset("fast", &scene.reuse));  // IDLE 5
+  ASSERT_TRUE(ApplyReusePreset("fast", &scene.reuse));  // IDLE 3
   scene.reuse.enabled = true;
   auto saved = test::CreateOrFail(scene);
   ASSERT_TRUE(saved);

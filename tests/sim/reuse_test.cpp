@@ -54,6 +54,32 @@ TEST(Reuse, IdleZeroIsBitIdenticalToReuseOff) {
   EXPECT_EQ(0, std::memcmp(ha.velocity.data(), hb.velocity.data(), ha.size() * sizeof(Vec4)));
 }
 
+// A scene whose reuse section says "enabled": false runs the core solver's step, whatever else the
+// section holds: bit for bit what the scene without the section gives.
+TEST(Reuse, DisabledIsBitIdenticalToTheCoreSolver) {
+  SceneSetup core = SmallDamBreak();
+  SceneSetup disabled = core;
+  ASSERT_TRUE(ApplyReusePreset("fast", &disabled.reuse));
+  disabled.reuse.enabled = false;
+  disabled.reuse.threshold = 1e9f;  // were it read, every particle would reuse
+  auto a = Make(core);
+  auto b = Make(disabled);
+  ASSERT_TRUE(a && b);
+  for (int i = 0; i < 200; ++i) {
+    ASSERT_TRUE(a->Step().ok());
+    ASSERT_TRUE(b->Step().ok());
+    ASSERT_EQ(a->LastStep().dt, b->LastStep().dt) << "step " << i;
+    ASSERT_EQ(b->LastStep().activeFraction, 1.0f);
+  }
+  HostFluid ha, hb;
+  a->Download(&ha);
+  b->Download(&hb);
+  ASSERT_EQ(ha.size(), hb.size());
+  EXPECT_EQ(0, std::memcmp(ha.position.data(), hb.position.data(), ha.size() * sizeof(Vec4)));
+  EXPECT_EQ(0, std::memcmp(ha.velocity.data(), hb.velocity.data(), ha.size() * sizeof(Vec4)));
+  EXPECT_EQ(0, std::memcmp(ha.density.data(), hb.density.data(), ha.size() * sizeof(float)));
+}
+
 // Both holds during a splash: no particle reuses more than IDLE consecutive steps, and with the
 // impulse hold particles go inactive only on the synchronised steps (numbers a multiple of IDLE + 1).
 void ExpectIdleBoundAndSchedule(int impulse, int idle) {
@@ -100,8 +126,8 @@ void ExpectIdleBoundAndSchedule(int impulse, int idle) {
 
 TEST(Reuse, NoParticleReusesMoreThanIdleConsecutiveSteps) {
   ExpectIdleBoundAndSchedule(0, 4);  // the paper's held acceleration
-  ExpectIdleBoundAndSchedule(2, 3);  // the impulse hold with live density
-  ExpectIdleBoundAndSchedule(1, 1);  // and without
+  ExpectIdleBoundAndSchedule(1, 3);  // the impulse hold
+  ExpectIdleBoundAndSchedule(2, 3);  // with live density
 }
 
 // Live density (reuse.impulse = 2): a reusing particle within one support radius of a computing one
@@ -158,9 +184,10 @@ TEST(Reuse, LiveDensityRecomputesTheReusingNeighboursOfComputingParticles) {
 }
 
 // A deep pool (16 x 32 x 16 spacings) starting hydrostatic, settled with reuse off, then classified
-// once: ACT_i = delta1 P_i/P_pc + delta2 N_CPN/N_i. With delta1 = 0.25 the pressure term stays below
-// 0.3 at the floor, so the crowded interior is inactive; the free surface, where the 27 cells are half
-// empty (N_i ~ N_CPN * 2/3, so the crowding term is ~1.5), stays active.
+// once with `balanced`: ACT_i = delta1 P_i/P_pc + delta2 N_CPN/N_i with delta1 0, the crowding alone,
+// so the crowded interior is inactive; the free surface, where the 27 cells are a third empty (N_i ~
+// N_CPN * 2/3, so the crowding term is ~1.5), stays active. (`balanced` at T 1.6 failed this: the
+// surface's term is about 1.5, so T is 1.5.)
 TEST(Reuse, DeepTankAtRestIsMostlyInactiveButItsSurfaceIsActive) {
   SceneSetup scene;
   scene.params.spacing = 0.02f;
@@ -253,22 +280,23 @@ TEST(Reuse, GuardKeepsADeepTankAsCalmAsReuseOff) {
                                        << "unnecessary and docs/reuse.md wrong";
 }
 
-// The impulse hold needs no guard: IDLE 3 with live density, guard off, stays as calm as reuse off in
-// the tank where the held acceleration blows up, while most particles reuse.
+// The impulse hold needs no guard: `balanced` (IDLE 3, guard off), with and without live density,
+// stays as calm as reuse off in the tank where the held acceleration blows up, while most particles
+// reuse.
 TEST(Reuse, ImpulseHoldKeepsADeepTankCalmWithoutTheGuard) {
   double active = 1.0;
   const float off = DeepTankMaxSpeed(nullptr, &active);
-  ReuseParams impulse;
-  impulse.enabled = true;
-  impulse.delta1 = 0.1f;
-  impulse.threshold = 1.6f;
-  impulse.idle = 3;
-  impulse.impulse = 2;
-  impulse.accelTolerance = 0.0f;
-  const float on = DeepTankMaxSpeed(&impulse, &active);
-  ASSERT_TRUE(std::isfinite(on));
-  EXPECT_LT(on, 2.0f * off) << "reuse off " << off << " m/s, the impulse hold " << on << " m/s";
-  EXPECT_LT(active, 0.6) << "most particles should reuse in a tank at rest";
+  for (int hold : {1, 2}) {
+    ReuseParams impulse;
+    ASSERT_TRUE(ApplyReusePreset("balanced", &impulse));
+    ASSERT_EQ(impulse.accelTolerance, 0.0f) << "balanced runs without the guard";
+    ASSERT_EQ(impulse.idle, 3);
+    impulse.impulse = hold;
+    const float on = DeepTankMaxSpeed(&impulse, &active);
+    ASSERT_TRUE(std::isfinite(on));
+    EXPECT_LT(on, 2.0f * off) << "reuse off " << off << " m/s, the impulse hold (" << hold << ") " << on << " m/s";
+    EXPECT_LT(active, 0.6) << "most particles should reuse in a tank at rest (hold " << hold << ")";
+  }
 }
 
 // The fast preset through 10 simulated seconds of a violent scene: a 1 m dam break at 8 cm spacing

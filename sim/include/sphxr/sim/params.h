@@ -66,15 +66,15 @@ struct ReuseParams {
   /// Our rule beyond the paper: a particle whose acceleration changed by more than this many |g| since
   /// its last computation stays active for IDLE + 1 steps before it is classified again (0 = off).
   float accelTolerance = 0.1f;
-  /// How a particle that reuses moves (docs/reuse.md, "The impulse hold"). 1 and 2, the impulse hold:
-  /// a particle goes inactive only on steps whose number is a multiple of IDLE + 1 (the synchronised
-  /// schedule), takes the kick of all its IDLE + 1 steps, (IDLE + 1) dt a, on the step it computes, and
-  /// drifts at that velocity while it reuses. 2, the default, adds live density: a reusing particle with
-  /// a computing one in its 27 cells recomputes its density and pressure (not its force), so computing
-  /// particles never feel stale neighbour pressure; measured stable to IDLE 3 at the CFL step (1 alone:
-  /// to IDLE 1). 0: the paper's held acceleration (applied on every step it is reused), which only the
-  /// acceleration tolerance keeps stable.
-  int impulse = 2;
+  /// How a particle that reuses moves (docs/reuse.md, "The algorithm as built"). 1 (the default) and 2,
+  /// the impulse hold: a particle goes inactive only on steps whose number is a multiple of IDLE + 1
+  /// (the synchronised schedule), takes the kick of all its IDLE + 1 steps, (IDLE + 1) dt a, on the step
+  /// it computes, and drifts at that velocity while it reuses; measured stable to IDLE 3 at the CFL
+  /// step (IDLE 5 blew up). 2 adds live density: a reusing particle with a computing one in its 27
+  /// cells recomputes its density and pressure (not its force); measured slower and no more accurate.
+  /// 0: the paper's held acceleration (applied on every step it is reused), which only the acceleration
+  /// tolerance keeps stable.
+  int impulse = 1;
 };
 
 /// The presets chosen from the measured trade (docs/reuse.md): "accurate", "balanced", "fast".
