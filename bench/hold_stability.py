@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Why holding a particle's acceleration (activity-based reuse) is unstable: docs/reuse.md.
+"""Why holding a particle's acceleration (activity-based reuse) is unstable: docs/reuse_history.md (the impulse hold that replaced it: docs/reuse.md).
 
 One sound mode x'' = -w^2 x, integrated by the solver's symplectic Euler (v += a dt; x += v dt), with
 the acceleration computed once and held for k = IDLE + 1 steps. Prints, per w dt and k, the k-step
@@ -96,7 +96,7 @@ def main():
 
 
     print()
-    print("Holds that do not hold the acceleration (docs/reuse.md, eleventh session): largest |eigenvalue| per")
+    print("Holds that do not hold the acceleration (docs/reuse_history.md, eleventh session): largest |eigenvalue| per")
     print("cycle, and the mode's frequency as a fraction of the true one (nan: unstable)")
     print()
     print("| w dt | k = IDLE + 1 | coast: max abs eigenvalue | coast: frequency / w | freeze: max abs eigenvalue | freeze: frequency / w |")

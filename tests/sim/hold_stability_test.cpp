@@ -1,6 +1,6 @@
 // The solver's integrator (IntegrateStage, sim/src/stages.h) with an acceleration computed once and
 // held for k steps, as activity-based reuse holds it, against the analytic k-step map of one sound
-// mode x'' = -w^2 x (docs/reuse.md, "Why holding the acceleration cannot be stable at the CFL step";
+// mode x'' = -w^2 x (docs/reuse_history.md, "Why holding the acceleration cannot be stable at the CFL step";
 // bench/hold_stability.py prints the same table):
 //   x_k = (1 - (w dt)^2 k(k+1)/2) x_0 + k u_0,   u_k = -k (w dt)^2 x_0 + u_0,   u = v dt,
 // whose determinant 1 + (w dt)^2 k(k-1)/2 exceeds 1 for every k >= 2. If the integrator changes (to
@@ -121,7 +121,7 @@ TEST(HoldStability, HoldingForFourStepsGrowsAModeThatReuseOffKeepsBounded) {
   EXPECT_LT(held, 20.0 * std::pow(7.0, 5));
 }
 
-// The impulse hold (docs/reuse.md, "The impulse hold"): kick k dt a on the computing step, then drift.
+// The impulse hold (docs/reuse.md, "Why the impulse hold is stable"): kick k dt a on the computing step, then drift.
 // Its k-step map is symplectic Euler at the step k dt, x_k = (1 - k^2 (w dt)^2) x_0 + k u_0,
 // u_k = -k (w dt)^2 x_0 + u_0, with determinant exactly 1 (no phase-space growth) for every k.
 TEST(HoldStability, ImpulseHoldIsSymplecticEulerAtTheHeldStep) {

@@ -260,7 +260,7 @@ float DeepTankMaxSpeed(const ReuseParams* reuse, double* active) {
 
 // Reusing accelerations at a CFL-limited step acts like a multiple of that step on the pressure
 // waves: with the paper's held acceleration and no guard (accel_tolerance 0) a deep tank at rest
-// blows up within 0.15 s (measured: 8 m/s, 2 % mean density error in docs/reuse.md); the guard keeps
+// blows up within 0.15 s (measured: 8 m/s, 2 % mean density error in docs/reuse_history.md); the guard keeps
 // it as calm as reuse off.
 TEST(Reuse, GuardKeepsADeepTankAsCalmAsReuseOff) {
   double active = 1.0;
@@ -277,7 +277,7 @@ TEST(Reuse, GuardKeepsADeepTankAsCalmAsReuseOff) {
   held.accelTolerance = 0.0f;
   const float unguarded = DeepTankMaxSpeed(&held, &active);
   EXPECT_FALSE(unguarded < 2.0f * off) << "held without the guard: " << unguarded << " m/s; the guard would be "
-                                       << "unnecessary and docs/reuse.md wrong";
+                                       << "unnecessary and docs/reuse_history.md wrong";
 }
 
 // The impulse hold needs no guard: `balanced` (IDLE 3, guard off), with and without live density,
