@@ -1,7 +1,7 @@
 // sphxr_bench_reuse: the trade of activity-based reuse (Huang et al. 2013, section 3.3), measured.
 //
 // Two scenes: scenes/deep_tank.json (a 36-spacing-deep pool, 51,840 particles, starting hydrostatic,
-// with a block dropped into one corner) and scenes/dam_break_1m.json (50,653 particles). Each is run
+// with a 1,000-particle block dropped into one corner: 52,840) and scenes/dam_break_1m.json (50,653 particles). Each is run
 // with reuse off (the reference) and with every setting of the sweep (delta1, delta2, threshold T,
 // IDLE, the acceleration tolerance, the hold), all from the same initial state, on the CPU backend, to the same simulated time with the
 // scenes' fixed time step, so the steps of all runs fall at the same simulated times. Per run:
