@@ -143,7 +143,7 @@ class BackendImpl final : public Backend {
     // The particles whose density is computed: those that compute, and with the impulse hold the
     // reusing ones next to them (DensityThisStep; its own list then, else the compute list).
     int densityCount = n;
-    const uint32_t* densityList = Raw(m_computeList);
+    const uint32_t* densityList = nullptr;  // set once the lists are sized: a resize moves their storage
     DensityThisStep densityOf{View(), fv.position, Raw(m_fluid.idle), physics.reuseIdle, nullptr};
     if (physics.reuseEnabled) {
       const int cells = static_cast<int>(m_fluidStart.size());
@@ -166,6 +166,7 @@ class BackendImpl final : public Backend {
                                  ComputesThisStep{Raw(m_fluid.idle), physics.reuseIdle});
       computing = static_cast<int>(end - m_computeList.begin());
       densityCount = computing;
+      densityList = Raw(m_computeList);
       if (physics.reuseLiveDensity && computing < n) {
         // Live density: the reusing particles with a computing one in their 27 cells (count, then the
         // same three box-sum passes as the crowding, whose counts are no longer needed).
