@@ -640,9 +640,11 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   }
 
   const bool probeEveryStep = scene.damBreak.has_value() && stats.is_open();
+  const bool dfsph = solver->Method() == sim::SolverMethod::kDfsph;
   if (stats.is_open()) {
     std::string header = "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction";
     if (probeEveryStep) header += ",front_Z,height_H";
+    if (dfsph) header += ",density_iterations,divergence_iterations,solver_density_error,solver_divergence_error";
     if (paddles) {
       header += ",pushed_out";
       for (int k = 0; k < paddles->Count(); ++k) header += Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
@@ -819,6 +821,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
         solver->Download(&host);
         const DamBreakMeasure m = MeasureDamBreak(*scene.damBreak, host, spacing);
         stats << ',' << m.front << ',' << m.height;
+      }
+      if (dfsph) {
+        stats << ',' << info.densityIterations << ',' << info.divergenceIterations << ',' << info.solverDensityError << ','
+              << info.solverDivergenceError;
       }
       if (paddles) {
         stats << ',' << info.pushedOut;

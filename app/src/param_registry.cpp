@@ -22,6 +22,7 @@ std::vector<ParamDesc> Build() {
     p.max = info.max;
     p.defaultValue = solverDefaults.*(info.member);
     p.solverMember = info.member;
+    p.integer = info.integer;
     out.push_back(p);
   }
   const sim::ReuseParams reuseDefaults;

@@ -81,6 +81,11 @@ class Reader {
       const json& solver = root["solver"];
       if (!solver.is_object()) return Error("solver", "must be an object");
       for (auto it = solver.begin(); it != solver.end(); ++it) {
+        if (it.key() == "method") {  // the pressure solver, by name (docs/user/scenes.md)
+          const std::string v = it.value().is_string() ? it.value().get<std::string>() : "";
+          if (!sim::ParseSolverMethod(v, &s.method)) return Error("solver.method", "must be \"wcsph\" or \"dfsph\"");
+          continue;
+        }
         const sim::ParamInfo* info = sim::FindSolverParam(it.key());
         if (!info) {
           m_out->warnings.push_back("unknown key 'solver." + it.key() + "' ignored");
@@ -93,6 +98,7 @@ class Reader {
           return Error("solver." + it.key(), Format("%g is out of range: must be from %g to %g%s%s (%s)", v, info->min,
                                                     info->max, info->unit[0] ? " " : "", info->unit, info->help));
         }
+        if (info->integer && v != std::floor(v)) return Error("solver." + it.key(), "must be a whole number");
         s.params.*(info->member) = static_cast<float>(v);
       }
     }
@@ -429,6 +435,12 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
   if (eq == std::string::npos) return Status::Error("--set " + assignment + ": expected key=value");
   const std::string key = assignment.substr(0, eq);
   const std::string value = assignment.substr(eq + 1);
+  if (key == "method" || key == "solver.method") {
+    if (!sim::ParseSolverMethod(value, &setup->method)) {
+      return Status::Error("--set " + key + "=" + value + ": must be wcsph or dfsph");
+    }
+    return Status::Ok();
+  }
   const ParamDesc* desc = FindParam(key);
   if (desc && desc->group == "reuse") {  // reuse.* keys of the registry
     char* end = nullptr;
@@ -451,6 +463,7 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
     return Status::Error(Format("--set %s=%s: out of range, must be from %g to %g%s%s", key.c_str(), value.c_str(),
                                 info->min, info->max, *info->unit ? " " : "", info->unit));
   }
+  if (info->integer && v != std::floor(v)) return Status::Error("--set " + key + "=" + value + ": must be a whole number");
   setup->params.*(info->member) = static_cast<float>(v);
   return Status::Ok();
 }

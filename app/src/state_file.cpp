@@ -21,7 +21,7 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'H', 'X', 'R', 'S', 'T', '1'};
 constexpr uint32_t kByteOrder = 0x01020304u;
-constexpr uint32_t kVersion = 2;  // 2: the step count after the clock
+constexpr uint32_t kVersion = 3;  // 2: the step count after the clock; 3: the solver method after the scene name
 constexpr uint32_t kOldestVersion = 1;
 static_assert(sizeof(sim::Vec3) == 12 && sizeof(sim::Quat) == 16 && sizeof(sim::RigidPose) == 28 &&
                   sizeof(interaction::Pose) == 28,
@@ -57,6 +57,10 @@ bool Sound(const interaction::PaddleRestart& p) {
          p.state.haptic >= 0.0f && p.state.haptic <= 1.0f && p.state.teleports >= 0 && std::isfinite(p.lostSince) &&
          std::isfinite(p.lastFrame);
 }
+
+// Fields a file may lack: DFSPH's stiffnesses only warm-start its next solve, so a file saved before
+// they existed (or by a WCSPH run, where they stay 0) starts that solve cold.
+bool OptionalField(const char* name) { return std::strcmp(name, "kappa") == 0 || std::strcmp(name, "kappaV") == 0; }
 
 class Reader {
  public:
@@ -126,6 +130,7 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     w.Put(static_cast<int32_t>(solver.FluidCount()));
     w.Put(static_cast<int32_t>(solver.BoundaryCount()));
     w.String(sceneName);
+    w.String(sim::SolverMethodName(solver.Method()));
     w.Put(static_cast<uint32_t>(solver.BodyCount()));
     for (int k = 0; k < solver.BodyCount(); ++k) {
       const sim::BodyMotionState m = solver.BodyMotionOf(k);
@@ -237,6 +242,14 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   out->clock.steps = out->step < 0 ? 0 : out->step;
   if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return truncated();
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
+  out->method = sim::SolverMethod::kWcsph;  // versions 1 and 2: the only method there was
+  if (version >= 3) {
+    std::string method;
+    if (!r.String(&method, 64)) return truncated();
+    if (!sim::ParseSolverMethod(method, &out->method)) {
+      return Status::Error(path + ": solver method '" + method.substr(0, 16) + "' is not one this build knows");
+    }
+  }
   const sim::ParamInfo* spacing = sim::FindSolverParam("spacing");
   if (!std::isfinite(out->spacing) || out->spacing < spacing->min || out->spacing > spacing->max) {
     return Status::Error(Format("%s: spacing %g m is outside %g to %g m: the file is damaged", path.c_str(), out->spacing,
@@ -287,7 +300,7 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   // The fields' bytes must be there before anything is allocated (a damaged count must not ask for
   // gigabytes).
   uint64_t perParticle = 0;
-#define SPHXR_FIELD_BYTES(type, name) perParticle += sizeof(type);
+#define SPHXR_FIELD_BYTES(type, name) perParticle += OptionalField(#name) ? 0 : sizeof(type);
   SPHXR_FLUID_FIELDS(SPHXR_FIELD_BYTES)
 #undef SPHXR_FIELD_BYTES
   if (static_cast<uint64_t>(fluid) * perParticle > r.Left()) return truncated();
@@ -316,7 +329,7 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
     if (!known) return Status::Error(path + ": field '" + name + "' is not one this build knows (saved by another version)");
   }
 #define SPHXR_CHECK_SEEN(type, name)                                                                        \
-  if (std::find(seen.begin(), seen.end(), #name) == seen.end()) {                                           \
+  if (!OptionalField(#name) && std::find(seen.begin(), seen.end(), #name) == seen.end()) {                 \
     return Status::Error(path + ": field '" #name "' of this build is not in the file (saved by another version)"); \
   }
   SPHXR_FLUID_FIELDS(SPHXR_CHECK_SEEN)
@@ -355,6 +368,11 @@ Status ReadStartState(const std::string& path, float spacingOption, const std::s
                    path.c_str(), state->scene.c_str(), sceneName.c_str());
   }
   setup->params.spacing = state->spacing;
+  if (state->method != setup->method) {
+    SPHXR_LOG_WARN("--load-state %s was saved under solver.method %s; this run uses %s (the scene or --set): the water "
+                   "continues under the other solver",
+                   path.c_str(), sim::SolverMethodName(state->method), sim::SolverMethodName(setup->method));
+  }
   *out = std::move(state);
   return Status::Ok();
 }

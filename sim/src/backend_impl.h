@@ -20,6 +20,7 @@
 #include <type_traits>
 
 #include "backend.h"
+#include "dfsph_solver.h"
 #include "surface_impl.h"
 
 namespace sphxr::sim {
@@ -107,6 +108,7 @@ class BackendImpl final : public Backend {
               const StageHook& hook) override {
     const int n = FluidCount();
     auto policy = Traits::Policy();
+    *out = StepReduction{};
     auto clock = std::chrono::steady_clock::now();
     auto lap = [&](Stage stage) -> Status {
       Traits::Sync();
@@ -246,6 +248,18 @@ class BackendImpl final : public Backend {
     }
     if (Status s = lap(Stage::kDensity); !s) return s;
 
+    // DFSPH (dfsph_solver.h): the factor and kernel-gradient cache, the divergence-free solve, then the
+    // force stage below with every pressure zero (viscosity and gravity only).
+    if (physics.dfsph) {
+      m_dfsph.Prepare(View(), fv, Neighbours(physics), physics);
+      if (Status s = lap(Stage::kDensity); !s) return s;
+      const auto divergence = m_dfsph.Divergence(View(), fv, Neighbours(physics), physics, dt);
+      out->divergenceIterations = divergence.iterations;
+      out->divergenceError = divergence.error;
+      m_dfsph.ZeroPressure(fv);
+      if (Status s = lap(Stage::kDivergence); !s) return s;
+    }
+
     // 5. forces
     if (bodies && m_bodyPressureTerm.size() != static_cast<size_t>(n)) m_bodyPressureTerm.resize(n);
     const ForceStage forces{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr};
@@ -256,15 +270,30 @@ class BackendImpl final : public Backend {
     }
     if (Status s = lap(Stage::kForces); !s) return s;
 
-    // 5b. the fluid's force on each body particle (the reaction)
+    // DFSPH: v* = v + dt a, the density-invariance solve, then the step's pressure (p_i/rho_i^2 into the
+    // body reaction's term), acceleration and drift.
+    if (physics.dfsph) {
+      m_dfsph.Kick(fv, dt);
+      const auto density = m_dfsph.Density(View(), fv, Neighbours(physics), physics, dt);
+      out->densityIterations = density.iterations;
+      out->densityError = density.error;
+      if (Status s = lap(Stage::kPressure); !s) return s;
+      m_dfsph.Finish(fv, physics, dt, bodies ? Raw(m_bodyPressureTerm) : nullptr);
+    }
+
+    // 5b. the fluid's force on each body particle (the reaction). DFSPH's term is the solves' own
+    // p_i/rho_i^2, without WCSPH's flat-wall gradient correction (the solve is consistent with its own
+    // boundary gradients).
     if (bodies) {
+      Physics reaction = physics;
+      if (physics.dfsph) reaction.bodyGradScale = 1.0f;
       thrust::for_each_n(policy, first, static_cast<int>(m_bodyPos.size()),
-                         BodyReactionStage{View(), fv, physics, Raw(m_bodyPressureTerm), Raw(m_bodyForce)});
+                         BodyReactionStage{View(), fv, reaction, Raw(m_bodyPressureTerm), Raw(m_bodyForce)});
       if (Status s = lap(Stage::kBodies); !s) return s;
     }
 
-    // 6. integrate, then the statistics the next time step needs
-    thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
+    // 6. integrate (DFSPH drifted in its Finish), then the statistics the next time step needs
+    if (!physics.dfsph) thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
     // 6b. push fluid out of the bodies at their end-of-step pose
     if (bodies) {
       if (Status s = lap(Stage::kIntegrate); !s) return s;
@@ -273,9 +302,14 @@ class BackendImpl final : public Backend {
                                       physics.bodyClearance});
       if (Status s = lap(Stage::kBodies); !s) return s;
     }
+    const StepReduction solves = *out;
     *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics.invRestDensity},
                                     StepReduction{}, StepReductionCombine{});
     out->computed = computing;
+    out->densityIterations = solves.densityIterations;
+    out->divergenceIterations = solves.divergenceIterations;
+    out->densityError = solves.densityError;
+    out->divergenceError = solves.divergenceError;
     return lap(Stage::kIntegrate);
   }
 
@@ -553,7 +587,8 @@ class BackendImpl final : public Backend {
   Vector<Vec4> m_bodyPos, m_bodyVel, m_bodyForce;  // sorted
   Vector<uint32_t> m_bodyStart, m_bodyEnd;
   Vector<uint8_t> m_movingNear;
-  Vector<float> m_bodyPressureTerm;  // per fluid particle (ForceStage -> BodyReactionStage)
+  Vector<float> m_bodyPressureTerm;  // per fluid particle (ForceStage or DFSPH's Finish -> BodyReactionStage)
+  DfsphSolver<Traits> m_dfsph;       // DFSPH's arrays (sized at its first step)
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the
   // step's sort. Re-sorting here does not change the next step (its stable sort then keeps this order).
   SurfaceImpl<Traits> m_surface{[this] {

@@ -7,7 +7,7 @@
 namespace sphxr::sim {
 namespace {
 
-const std::array<ParamInfo, 10> kParams = {{
+const std::array<ParamInfo, 15> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
     {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
@@ -23,11 +23,31 @@ const std::array<ParamInfo, 10> kParams = {{
     {"max_dt", "s", "upper bound of the time step", 1e-7, 0.1, &SolverParams::maxDt},
     {"fixed_dt", "s", "fixed time step (0 = adaptive); clamped to the stability limit", 0.0, 0.1,
      &SolverParams::fixedDt},
+    {"density_tolerance", "%", "dfsph: the density solve stops at this mean compression", 1e-5, 10.0,
+     &SolverParams::densityTolerance},
+    {"divergence_tolerance", "%", "dfsph: the divergence solve stops at this mean compression per step", 1e-5, 100.0,
+     &SolverParams::divergenceTolerance},
+    {"min_iterations", "", "dfsph: density solve iterations at least", 0.0, 1000.0, &SolverParams::minIterations, true},
+    {"max_iterations", "", "dfsph: density solve iterations at most (reaching it is a warning)", 1.0, 10000.0,
+     &SolverParams::maxIterations, true},
+    {"max_divergence_iterations", "", "dfsph: divergence solve iterations at most (0 = no divergence solve)", 0.0,
+     10000.0, &SolverParams::maxDivergenceIterations, true},
 }};
 
 }  // namespace
 
 std::span<const ParamInfo> SolverParamInfos() { return kParams; }
+
+const char* SolverMethodName(SolverMethod method) {
+  return method == SolverMethod::kDfsph ? "dfsph" : "wcsph";
+}
+
+bool ParseSolverMethod(const std::string& text, SolverMethod* out) {
+  if (text == "wcsph") *out = SolverMethod::kWcsph;
+  else if (text == "dfsph") *out = SolverMethod::kDfsph;
+  else return false;
+  return true;
+}
 
 const ParamInfo* FindSolverParam(const std::string& key) {
   for (const ParamInfo& p : kParams) {
@@ -45,13 +65,14 @@ ParticleCounts CountParticles(const SceneSetup& scene) {
   for (const RigidBodySetup& b : scene.bodies) c.bodyParticles += static_cast<int64_t>(b.points.size());
   c.reuse = scene.reuse.enabled;
   c.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity;
+  c.dfsph = scene.method == SolverMethod::kDfsph;
   return c;
 }
 
 int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
-  // sim/src/backend_impl.h's members. Fluid: the field list (68 B) + sort keys and order (8) + reorder
+  // sim/src/backend_impl.h's members. Fluid: the field list (76 B) + sort keys and order (8) + reorder
   // scratch of each element type (16 + 4 + 4 + 4) + the sort's temporary storage (about keys and values
-  // again, 8) + the CPU density stage's block starts (4) + the host copy at creation (68). Neighbour
+  // again, 8) + the CPU density stage's block starts (4) + the host copy at creation (76). Neighbour
   // lists: 4 B per slot and a count (sim/src/stages.h NeighbourList). Reuse: the compacted list (4), the
   // CPU density blocks' keys of it and every particle's rank in it (8; counted for CUDA too, erring high)
   // and live density's list of the particles whose density is computed (4; counted for every hold);
@@ -60,9 +81,12 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
   // 4 ranges of 4 B and the near-boundary flag per cell; with bodies their 2 ranges and near flag (9),
   // with wall_density the wall-cell list's first size (4), with reuse the cells' counts and crowding (8). Bodies'
   // own particles: body frame, index and alpha (24), sorted world copies of position, velocity and
-  // force (48), keys, order and owner (12).
-  const int64_t perFluid = 68 + 8 + 28 + 8 + 4 + 68 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 16 : 0) +
-                           (counts.bodyParticles > 0 ? 4 : 0);
+  // force (48), keys, order and owner (12). DFSPH (sim/src/dfsph_solver.h): a kernel gradient per
+  // neighbour slot (12), the boundary terms (16), factor, increment and neighbour count (12), the
+  // step's start velocity (16) and the error terms (8).
+  const int64_t perFluid = 76 + 8 + 28 + 8 + 4 + 76 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 16 : 0) +
+                           (counts.bodyParticles > 0 ? 4 : 0) +
+                           (counts.dfsph ? 12 * counts.neighbourSlots + 16 + 12 + 16 + 8 : 0);
   const int64_t perBoundary = 16 + 40 + 16 + (counts.wallDensity ? 4 : 0);
   const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0) + (counts.reuse ? 8 : 0);
   return counts.fluid * perFluid + counts.boundary * perBoundary + counts.gridCells * perCell +

@@ -132,11 +132,16 @@ Status ValidateScene(const SceneSetup& scene) {
       return Status::Error(Format("solver.%s = %g is invalid: must be a number from %g to %g%s%s (%s)", p.key, v, p.min,
                                   p.max, p.unit[0] ? " " : "", p.unit, p.help));
     }
+    if (p.integer && v != std::floor(v)) return Status::Error(Format("solver.%s = %g is invalid: must be a whole number", p.key, v));
   }
   if (!std::isfinite(scene.floorViscosity) || scene.floorViscosity > 10.0f) {
     return Status::Error(Format("tank.floor_viscosity = %g is invalid: must be from 0 to 10", scene.floorViscosity));
   }
   if (Status s = ValidateReuse(scene.reuse); !s) return s;
+  if (scene.params.minIterations > scene.params.maxIterations) {
+    return Status::Error(Format("solver.min_iterations = %g is above solver.max_iterations = %g",
+                                scene.params.minIterations, scene.params.maxIterations));
+  }
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
   {
     const double gx = scene.gravity.x, gy = scene.gravity.y, gz = scene.gravity.z;
@@ -264,13 +269,18 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
   float height = 0.0f;
   for (const FluidBlock& b : scene.fluid) height = std::max(height, b.box.max.y - scene.tank.min.y);
   const float vRef = std::sqrt(2.0f * g * height);
-  if (vRef > 0.0f && soundSpeed < 5.0f * vRef) {
+  const bool wcsph = scene.method == SolverMethod::kWcsph;
+  if (wcsph && vRef > 0.0f && soundSpeed < 5.0f * vRef) {
     const float needB = scene.params.restDensity * 100.0f * vRef * vRef / scene.params.exponent;
     SPHXR_LOG_WARN("sound speed %.3g m/s is only %.1fx the expected flow speed sqrt(2gH) = %.3g m/s: expect density "
                    "errors above 1%% (WCSPH wants 10x); solver.stiffness >= %.3g Pa would give that",
                    soundSpeed, soundSpeed / vRef, vRef, needB);
   }
-  WarnAboutReuse(scene.reuse);
+  if (wcsph) {
+    WarnAboutReuse(scene.reuse);
+  } else if (scene.reuse.enabled) {
+    SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method dfsph (docs/reuse.md, \"Under DFSPH\")");
+  }
   for (size_t i = 0; i < scene.fluid.size(); ++i) {
     const Aabb& b = scene.fluid[i].box;
     const float thin = std::min({b.max.x - b.min.x, b.max.y - b.min.y, b.max.z - b.min.z});
@@ -291,13 +301,16 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.invRestDensity = 1.0f / p.restDensity;
   ph.boundaryGamma = WallDensityCorrection(ph.kernel, p.spacing, scene.boundaryLayers);
   ph.boundaryGradScale = WallGradientCorrection(ph.kernel, p.spacing, scene.boundaryLayers) / ph.boundaryGamma;
-  ph.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity;
+  // DFSPH's solve gives every wall its pressure (the boundary term of the Jacobi update): the walls' own
+  // density is a WCSPH model.
+  ph.dfsph = scene.method == SolverMethod::kDfsph;
+  ph.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity && !ph.dfsph;
   ph.maxNeighbours = NeighbourCapacity(p.supportFactor);
   // Moving bodies are one-sheet shells (interaction::SamplePaddle): their own flat-wall corrections.
   ph.bodyGradScale = WallGradientCorrection(ph.kernel, p.spacing, 1) / WallDensityCorrection(ph.kernel, p.spacing, 1);
   ph.bodyClearance = 0.25f * p.spacing;
   const ReuseParams& r = scene.reuse;
-  ph.reuseEnabled = r.enabled;
+  ph.reuseEnabled = r.enabled && !ph.dfsph;  // reuse is WCSPH's (docs/reuse.md, "Under DFSPH")
   ph.reuseDelta1 = r.delta1;
   ph.reuseDelta2 = r.delta2;
   ph.reuseThreshold = r.threshold;
@@ -326,6 +339,12 @@ Physics MakePhysics(const SceneSetup& scene) {
   const float inset = 0.25f * p.spacing;
   ph.domainMin = Vec3{scene.tank.min.x + inset, scene.tank.min.y + inset, scene.tank.min.z + inset};
   ph.domainMax = Vec3{scene.tank.max.x - inset, scene.tank.max.y - inset, scene.tank.max.z - inset};
+  ph.volume = ph.mass / p.restDensity;
+  ph.densityTolerance = 0.01f * p.densityTolerance;  // % to a fraction
+  ph.divergenceTolerance = 0.01f * p.divergenceTolerance;
+  ph.minIterations = static_cast<int>(p.minIterations);
+  ph.maxIterations = static_cast<int>(p.maxIterations);
+  ph.maxDivergenceIterations = static_cast<int>(p.maxDivergenceIterations);
   return ph;
 }
 
@@ -366,6 +385,8 @@ const char* StageName(Stage stage) {
     case Stage::kForces: return "forces";
     case Stage::kIntegrate: return "integrate";
     case Stage::kBodies: return "bodies";
+    case Stage::kDivergence: return "divergence";
+    case Stage::kPressure: return "pressure";
     default: return "?";
   }
 }
@@ -453,9 +474,19 @@ float Solver::StableDt() const {
   const float h = 0.5f * p.spacing * p.supportFactor;
   const float c = std::sqrt(p.exponent * p.stiffness / p.restDensity);
   float dt = p.maxDt;
+  const float speed = std::max(m_last.maxSpeed, MaxBodySpeed());
+  if (m_scene.method == SolverMethod::kDfsph) {
+    // DFSPH's step follows the flow (Bender & Koschier 2017, sec. 5): no particle, fluid or paddle, moves
+    // more than cfl * h per step. The pressure is implicit, so neither the sound speed nor the
+    // acceleration limits it; the explicit viscosity still does.
+    if (speed > 0.0f) dt = std::min(dt, p.cfl * h / speed);
+    const float alpha = std::max({p.viscosity, p.boundaryViscosity, m_scene.floorViscosity});
+    if (alpha > 0.0f) dt = std::min(dt, 0.5f * h / (alpha * c));
+    return dt;
+  }
   // Acoustic CFL condition (Monaghan 1992; Becker & Teschner 2007, sec. 5), with the fastest point of a
   // moving body: it then moves less than cfl * h per step, so it cannot jump over fluid particles.
-  dt = std::min(dt, p.cfl * h / (c + std::max(m_last.maxSpeed, MaxBodySpeed())));
+  dt = std::min(dt, p.cfl * h / (c + speed));
   // Force condition: a particle must not move more than ~h/16 per step under its acceleration.
   const float accel = std::max(m_maxAccel, Length(m_scene.gravity));
   if (accel > 0.0f) dt = std::min(dt, 0.25f * std::sqrt(h / accel));
@@ -579,6 +610,25 @@ Status Solver::Step() {
   m_totals.clampedEvents += red.clamped;
   m_last.pushedOut = red.pushed;
   m_totals.pushedOutEvents += red.pushed;
+  m_last.densityIterations = red.densityIterations;
+  m_last.divergenceIterations = red.divergenceIterations;
+  m_last.solverDensityError = red.densityError;
+  m_last.solverDivergenceError = red.divergenceError;
+  m_totals.densityIterations += red.densityIterations;
+  m_totals.divergenceIterations += red.divergenceIterations;
+  if (physics.dfsph && red.densityIterations >= physics.maxIterations && red.densityError > physics.densityTolerance) {
+    // The solve stopped short: the water is more compressed than asked this step. Named with the error
+    // reached, at most once per simulated second (a hard impact hits the cap for many steps in a row).
+    ++m_totals.iterationCapSteps;
+    if (m_iterationWarnTime < 0.0 || m_last.time >= m_iterationWarnTime + 1.0) {
+      m_iterationWarnTime = m_last.time;
+      SPHXR_LOG_WARN("dfsph: the density solve reached max_iterations = %d at t = %.4g s with a mean compression of "
+                     "%.3g %% (density_tolerance %g %%; %lld such steps so far): raise solver.max_iterations or lower "
+                     "solver.cfl",
+                     physics.maxIterations, m_last.time, 100.0 * red.densityError, 100.0 * physics.densityTolerance,
+                     static_cast<long long>(m_totals.iterationCapSteps));
+    }
+  }
   m_totals.stepSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return Status::Ok();
 }

@@ -185,7 +185,28 @@ struct Physics {
   Vec3 gravity;
   Vec3 domainMin;       // clamp box for fluid particles
   Vec3 domainMax;
+  // DFSPH (dfsph_solver.h); unused by WCSPH.
+  bool dfsph;                   // SolverMethod::kDfsph
+  float volume;                 // m / rho0, each fluid particle's rest volume
+  float densityTolerance;       // mean compression (fraction) at which the density solve stops
+  float divergenceTolerance;    // mean compression per step (fraction) at which the divergence solve stops
+  int minIterations;
+  int maxIterations;
+  int maxDivergenceIterations;  // 0: no divergence solve
 };
+
+/// Puts a particle that left the domain back on its edge with the outward velocity removed; true when
+/// it did (the step counts them: acceleration.w, StepReductionOp).
+SPHXR_HD SPHXR_INLINE bool ClampToDomain(const Physics& ph, Vec4* x, Vec4* v) {
+  bool clamped = false;
+  if (x->x < ph.domainMin.x) { x->x = ph.domainMin.x; if (v->x < 0.0f) v->x = 0.0f; clamped = true; }
+  if (x->x > ph.domainMax.x) { x->x = ph.domainMax.x; if (v->x > 0.0f) v->x = 0.0f; clamped = true; }
+  if (x->y < ph.domainMin.y) { x->y = ph.domainMin.y; if (v->y < 0.0f) v->y = 0.0f; clamped = true; }
+  if (x->y > ph.domainMax.y) { x->y = ph.domainMax.y; if (v->y > 0.0f) v->y = 0.0f; clamped = true; }
+  if (x->z < ph.domainMin.z) { x->z = ph.domainMin.z; if (v->z < 0.0f) v->z = 0.0f; clamped = true; }
+  if (x->z > ph.domainMax.z) { x->z = ph.domainMax.z; if (v->z > 0.0f) v->z = 0.0f; clamped = true; }
+  return clamped;
+}
 
 SPHXR_HD SPHXR_INLINE float TaitPressure(const Physics& ph, float density) {
   const float ratio = density * ph.invRestDensity;
@@ -757,14 +778,7 @@ struct IntegrateStage {
     x.z += dt * v.z;
     // A particle that leaves the domain is put back on its edge with the outward velocity removed,
     // and flagged in acceleration.w so that the step reports how many were clamped.
-    bool clamped = false;
-    if (x.x < ph.domainMin.x) { x.x = ph.domainMin.x; if (v.x < 0.0f) v.x = 0.0f; clamped = true; }
-    if (x.x > ph.domainMax.x) { x.x = ph.domainMax.x; if (v.x > 0.0f) v.x = 0.0f; clamped = true; }
-    if (x.y < ph.domainMin.y) { x.y = ph.domainMin.y; if (v.y < 0.0f) v.y = 0.0f; clamped = true; }
-    if (x.y > ph.domainMax.y) { x.y = ph.domainMax.y; if (v.y > 0.0f) v.y = 0.0f; clamped = true; }
-    if (x.z < ph.domainMin.z) { x.z = ph.domainMin.z; if (v.z < 0.0f) v.z = 0.0f; clamped = true; }
-    if (x.z > ph.domainMax.z) { x.z = ph.domainMax.z; if (v.z > 0.0f) v.z = 0.0f; clamped = true; }
-    a.w = clamped ? 1.0f : 0.0f;
+    a.w = ClampToDomain(ph, &x, &v) ? 1.0f : 0.0f;
     fluid.acceleration[i] = a;
     fluid.velocity[i] = v;
     fluid.position[i] = x;
@@ -827,6 +841,11 @@ struct StepReduction {
   int32_t computed = 0;  // particles that computed density and forces this step (set by the backend)
   int32_t pushed = 0;    // fluid particles pushed out of a moving body this step (body_stages.h)
   int32_t nonFinite = 0; // fluid particles with a NaN or infinite position, velocity, acceleration or density
+  // DFSPH (set by the backend): iterations of each solve and the mean errors they reached (fractions).
+  int32_t densityIterations = 0;
+  int32_t divergenceIterations = 0;
+  float densityError = 0.0f;
+  float divergenceError = 0.0f;
 };
 
 struct StepReductionOp {

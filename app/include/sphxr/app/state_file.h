@@ -2,12 +2,13 @@
 // State files: the fluid and the clock of a run, to restart from (`sphxr --save-state FILE`,
 // `--load-state FILE`; docs/scenes.md "State files"). Every field of the one field list
 // (sim/fields.h) is stored with its name and element size, so a file from a build with other fields
-// is refused by name instead of being misread. Binary, little-endian, version 2 (version 1, read
-// too, lacks the step count):
+// is refused by name instead of being misread (DFSPH's warm-start fields kappa and kappaV may be
+// missing: zero). Binary, little-endian, version 3 (read too: version 2 lacks the method, version 1
+// also the step count):
 //
 //   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
 //   f64 time  f32 last max speed  f32 last max |a|  i64 step  f32 spacing  i32 fluid  i32 boundary
-//   u32 n + n bytes: the scene's name
+//   u32 n + n bytes: the scene's name   u32 n + n bytes: the solver method ("wcsph" | "dfsph")
 //   u32 bodies; per body: pose, from, to (7 f32 each: position x y z, orientation w x y z),
 //     f64 fromTime, f64 toTime, 3 f32 velocity, 3 f32 angular velocity (sim::BodyMotionState)
 //   u32 paddles; per paddle: i32 mode, 7 f32 commanded pose, 3+3+3 f32 force, torque, raw force,
@@ -37,6 +38,7 @@ struct StateFile {
   int fluidCount = 0;
   int boundaryCount = 0;
   std::string scene;  // the name of the scene it was saved from (informational)
+  sim::SolverMethod method = sim::SolverMethod::kWcsph;  // the solver it ran under
   std::string path;   // the file it was read from (for messages)
   std::vector<sim::BodyMotionState> bodies;        // the moving bodies' (paddles') motion
   std::vector<interaction::PaddleRestart> paddles;  // the paddle system's own state (may be empty)

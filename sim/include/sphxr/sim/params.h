@@ -24,7 +24,22 @@ struct SolverParams {
   float cfl = 0.4f;                // CFL number for the adaptive time step
   float maxDt = 2e-3f;             // s, upper bound of the adaptive step
   float fixedDt = 0.0f;            // s, 0 = adaptive; a fixed step above the CFL limit is clamped
+  // DFSPH (Bender & Koschier 2017) stopping rules; SPlisHSPlasH's defaults. Unused by WCSPH.
+  float densityTolerance = 0.01f;    // %, mean compression at which the density solve stops
+  float divergenceTolerance = 0.1f;  // %, mean compression rate (per step) at which the divergence solve stops
+  float minIterations = 2.0f;        // density solve iterations at least
+  float maxIterations = 100.0f;      // density solve iterations at most (then a warning)
+  float maxDivergenceIterations = 100.0f;  // divergence solve iterations at most
 };
+
+/// The pressure solver (`solver.method` in a scene, a name, never a number).
+enum class SolverMethod {
+  kWcsph,  // weakly compressible SPH, Tait equation of state (Becker & Teschner 2007): the paper's
+  kDfsph,  // divergence-free SPH (Bender & Koschier 2015, 2017): a step set by the flow speed
+};
+const char* SolverMethodName(SolverMethod method);
+/// Parses "wcsph" | "dfsph".
+bool ParseSolverMethod(const std::string& text, SolverMethod* out);
 
 struct ParamInfo {
   const char* key;    // scene-file key and command-line name
@@ -32,6 +47,7 @@ struct ParamInfo {
   const char* help;
   double min, max;    // inclusive valid range
   float SolverParams::*member;
+  bool integer = false;  // a count (iterations): whole numbers only
 };
 
 /// The table of solver parameters (same order as SolverParams).
@@ -86,6 +102,7 @@ const char* ReusePresetNames();
 
 struct SceneSetup {
   SolverParams params;
+  SolverMethod method = SolverMethod::kWcsph;
   Vec3 gravity{0.0f, -9.81f, 0.0f};
   /// The tank: its interior is the simulation domain. Walls and floor are sampled as boundary
   /// particles on its faces (the top face only when `openTop` is false).
@@ -119,6 +136,7 @@ struct ParticleCounts {
   int64_t bodyParticles = 0;   // of the moving bodies (paddles)
   bool reuse = false;          // the compacted list of computing particles, the cells' crowding
   bool wallDensity = false;    // the walls' own pressure and the list of wall cells
+  bool dfsph = false;          // DFSPH's per-particle solve terms and kernel-gradient cache
 };
 ParticleCounts CountParticles(const SceneSetup& scene);
 

@@ -39,7 +39,10 @@ struct SolverConfig {
 /// Stages of one step, each timed.
 /// kBodies: the moving boundaries' own work (placing and sorting their particles, the reaction on them,
 /// the push-out); their terms inside the density and force loops count to those stages.
-enum class Stage : int { kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kCount };
+/// kDivergence, kPressure: DFSPH's two solves (its factor counts to kDensity); WCSPH leaves them 0.
+enum class Stage : int {
+  kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kDivergence, kPressure, kCount
+};
 const char* StageName(Stage stage);
 
 struct StepInfo {
@@ -51,6 +54,12 @@ struct StepInfo {
   int32_t clamped = 0;           // fluid particles pushed back into the domain this step
   float activeFraction = 1.0f;   // fraction of fluid particles that computed density and forces (reuse)
   int32_t pushedOut = 0;         // fluid particles pushed out of a moving body this step
+  // DFSPH: iterations of its solves and the mean errors they reached (fractions: the density solve's
+  // mean compression, the divergence solve's mean compression rate times dt). 0 under WCSPH.
+  int32_t densityIterations = 0;
+  int32_t divergenceIterations = 0;
+  float solverDensityError = 0.0f;
+  float solverDivergenceError = 0.0f;
 };
 
 struct Totals {
@@ -58,6 +67,9 @@ struct Totals {
   int64_t clampedEvents = 0;     // sum of StepInfo::clamped
   int64_t dtClampedSteps = 0;    // steps where a fixed dt was clamped to the CFL limit
   int64_t pushedOutEvents = 0;   // sum of StepInfo::pushedOut
+  int64_t densityIterations = 0;     // DFSPH: sums of StepInfo's iterations
+  int64_t divergenceIterations = 0;
+  int64_t iterationCapSteps = 0;     // DFSPH: steps whose density solve stopped at max_iterations
   std::array<double, static_cast<int>(Stage::kCount)> stageSeconds{};
   double stepSeconds = 0.0;      // wall time in Step()
 };
@@ -125,7 +137,9 @@ class Solver {
   float ParticleMass() const;
   float SupportRadius() const { return m_scene.params.spacing * m_scene.params.supportFactor; }
   float SoundSpeed() const;
-  /// Maximum stable step for the current state (CFL, force and viscosity conditions).
+  SolverMethod Method() const { return m_scene.method; }
+  /// Maximum stable step for the current state: WCSPH's acoustic CFL, force and viscosity conditions;
+  /// DFSPH's CFL on the flow (and paddle) speed and the viscosity condition.
   float StableDt() const;
 
   /// Copies all fluid fields to the host (current sorted order; use `id` for identity).
@@ -212,6 +226,7 @@ class Solver {
   float MaxBodySpeed() const;
   void InitBodies(const Physics& physics);
   bool m_dtClampLogged = false;
+  double m_iterationWarnTime = -1.0;  // simulated time of the last "iteration cap reached" warning
 };
 
 }  // namespace sphxr::sim
