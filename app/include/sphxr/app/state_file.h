@@ -1,6 +1,6 @@
 #pragma once
 // State files: the fluid and the clock of a run, to restart from (`sphxr --save-state FILE`,
-// `--load-state FILE`; docs/scenes.md "State files"). Every field of the one field list
+// `--load-state FILE`; docs/user/scenes.md "State files"). Every field of the one field list
 // (sim/fields.h) is stored with its name and element size, so a file from a build with other fields
 // is refused by name instead of being misread. Binary, little-endian, version 2 (version 1, read
 // too, lacks the step count):
