@@ -263,7 +263,8 @@ std::string UsageText() {
          "  --validate        check every stage for non-finite values; stop at the first, naming it\n"
          "  --reuse on|off|accurate|balanced|fast\n"
          "                    activity-based reuse: on/off keeps the scene's \"reuse\" parameters, a preset\n"
-         "                    replaces them (docs/design/impulse_hold.md); --set reuse.threshold=1.3 etc. override them\n"
+         "                    replaces them; --set reuse.threshold=1.3 etc. override them\n"
+         "                    (docs/design/impulse_hold.md)\n"
 
          "  --screenshot FILE.png  a picture of the last state (OpenGL through EGL, no display needed);\n"
          "                    with --desktop, the window (panel included) when it closes\n"
