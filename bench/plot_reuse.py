@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Draws docs/reuse.png from docs/reuse.csv (bench/reuse.cpp): speed-up of the whole step against the
-deviation from the reuse-off run, one panel per scene, presets marked.
-usage: plot_reuse.py docs/reuse.csv docs/reuse.png"""
+"""Draws docs/images/reuse.png from bench/results/reuse.csv (bench/reuse.cpp): speed-up of the whole step
+against the deviation from the reuse-off run, one panel per scene, presets marked.
+usage: plot_reuse.py bench/results/reuse.csv docs/images/reuse.png"""
 import csv
 import sys
 
@@ -12,7 +12,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 # The presets as sim/src/params.cpp has them now (delta1, delta2, threshold, idle, accel_tolerance,
-# impulse; rows from before the impulse column were the held acceleration, impulse 0). A
+# impulse). Rows with those last two columns come from before the retired holds were removed: impulse 0
+# the held acceleration, 2 live density (docs/design/impulse_hold.md); rows without them are the impulse
+# hold. A
 # preset row of the CSV whose parameters differ was measured under an older value of that preset and is
 # drawn hollow; a sweep row with a preset's current parameters is drawn as that preset.
 PRESETS = {"accurate": (0.1, 1.0, 1.6, 1, 0.0, 1), "balanced": (0.0, 1.0, 1.5, 3, 0.0, 1),
@@ -21,8 +23,8 @@ COLOURS = {"accurate": "tab:green", "balanced": "tab:blue", "fast": "tab:red"}
 
 
 def params(r):
-    return (float(r["delta1"]), float(r["delta2"]), float(r["threshold"]), int(r["idle"]), float(r["accel_tolerance"]),
-            int(r.get("impulse") or 0))
+    return (float(r["delta1"]), float(r["delta2"]), float(r["threshold"]), int(r["idle"]),
+            float(r.get("accel_tolerance") or 0), int(r["impulse"]) if r.get("impulse") else 1)
 
 
 def current_preset(r):
@@ -56,7 +58,7 @@ def main():
             # The work bound: the density and force stages run for the active fraction only.
             ax.plot(x, 1.0 / float(r["active_fraction"]), "_", ms=10, color="tab:purple",
                     label="1 / active fraction (work bound)" if r is rs[0] else None)
-            hold = int(r.get("impulse") or 0)
+            hold = params(r)[5]
             now = current_preset(r)
             if r["setting"] in PRESETS and now != r["setting"]:  # a preset's older parameters
                 ax.plot(x, y, "o", ms=9, mfc="none", color=COLOURS[r["setting"]], label="%s before" % r["setting"])

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots the cost/accuracy sweep of sphxr_bench_tradeoff.
 
-usage: /usr/bin/python3 bench/plot_tradeoff.py [docs/tradeoff.csv] [docs/tradeoff.png]
+usage: /usr/bin/python3 bench/plot_tradeoff.py [bench/results/tradeoff.csv] [docs/images/tradeoff.png]
 
 Left: wall seconds per simulated second (log x) against the RMS relative error of the surge front
 against Martin & Moyce (1952). Right: the same cost against the time-averaged mean density error.
@@ -29,8 +29,8 @@ def number(text):
 
 
 def main(argv):
-    src = argv[1] if len(argv) > 1 else os.path.join(ROOT, "docs", "tradeoff.csv")
-    dst = argv[2] if len(argv) > 2 else os.path.join(ROOT, "docs", "tradeoff.png")
+    src = argv[1] if len(argv) > 1 else os.path.join(ROOT, "bench", "results", "tradeoff.csv")
+    dst = argv[2] if len(argv) > 2 else os.path.join(ROOT, "docs", "images", "tradeoff.png")
     with open(src, newline="") as f:
         rows = list(csv.DictReader(f))
     if not rows:

@@ -1,4 +1,4 @@
-// sphxr_bench_rest: how still water at rest really is (docs/physics.md, "Hydrostatics").
+// sphxr_bench_rest: how still water at rest really is (docs/design/settle.md).
 //
 // Runs a scene (default scenes/tank_rest.json) in windows of fixed simulated length and prints, per
 // window, the particle drift (median, 90th percentile, maximum, in spacings) and the mean and maximum
@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
       }
       clamped += solver->LastStep().clamped;
       if (solver->Time() > dampFrom && solver->Time() <= dampUntil) {
-        // The quench experiment (docs/physics.md): every velocity times exp(-rate dt) after each step.
+        // The quench experiment (docs/design/settle.md): every velocity times exp(-rate dt) after each step.
         HostFluid& f = damped;  // reused: no allocation per step
         solver->Download(&f);
         const float k = std::exp(-static_cast<float>(dampRate) * solver->LastStep().dt);

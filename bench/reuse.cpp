@@ -3,7 +3,7 @@
 // Two scenes: scenes/deep_tank.json (a 36-spacing-deep pool, 51,840 particles, starting hydrostatic,
 // with a 1,000-particle block dropped into one corner: 52,840) and scenes/dam_break_1m.json (50,653 particles). Each is run
 // with reuse off (the reference) and with every setting of the sweep (delta1, delta2, threshold T,
-// IDLE, the acceleration tolerance, the hold), all from the same initial state, on the CPU backend, to the same simulated time with the
+// IDLE), all from the same initial state, on the CPU backend, to the same simulated time with the
 // scenes' fixed time step, so the steps of all runs fall at the same simulated times. Per run:
 //   - step_ms: median wall time of Solver::Step over the run (the whole step, every stage);
 //   - speedup: the reference's median step time divided by the run's. By default every run is paired
@@ -26,7 +26,7 @@
 //     time divided by the run's. Where steps get dearer during a run (the dam break's splash) and reuse
 //     skips most while they are cheap, the medians' ratio misses that; a run that takes more steps
 //     (a time step clamped to a faster flow's CFL limit) pays for them here.
-// --csv writes one row per run (docs/reuse.csv); bench/plot_reuse.py draws docs/reuse.png.
+// --csv writes one row per run (bench/results/reuse.csv); bench/plot_reuse.py draws docs/images/reuse.png.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -58,8 +58,6 @@ struct Setting {
   bool enabled = false;
   float delta1 = 1, delta2 = 1, threshold = 1.2f;
   int idle = 3;
-  float tolerance = 0.1f;  // reuse.accel_tolerance, in |g| (0: the guard off)
-  int impulse = 1;         // reuse.impulse: 1 the impulse hold, 2 with live density, 0 the held acceleration
 };
 
 struct Args {
@@ -76,7 +74,7 @@ struct Args {
 
 const char* kUsage =
     "usage: sphxr_bench_reuse [--quick] [--threads N] [--csv FILE] [--scene deep_tank|dam_break_1m] [--time T]\n"
-    "                          [--presets] [--unpaired] [--setting D1,D2,T,IDLE,TOL[,HOLD]]...\n"
+    "                          [--presets] [--unpaired] [--setting D1,D2,T,IDLE]...\n"
     "  --quick         off, the three presets and 2 more settings, to t = 0.1 s (a smoke run)\n"
     "  --threads N     CPU backend threads (default 0 = all cores)\n"
     "  --csv FILE      write one row per run to FILE (overwritten; only a file with this bench's header)\n"
@@ -85,8 +83,7 @@ const char* kUsage =
     "  --presets       off and the three presets only (no sweep)\n"
     "  --unpaired      no lock-step reference: half the time, but the speed-up is then against reference runs\n"
     "                  made minutes apart (noise on a shared machine)\n"
-    "  --setting D1,D2,T,IDLE,TOL[,HOLD]  run this setting (delta1, delta2, threshold, idle steps, accel\n"
-    "                  tolerance in g, 0 = guard off; HOLD = reuse.impulse, 0, 1 or 2, default 1) instead of\n"
+    "  --setting D1,D2,T,IDLE  run this setting (delta1, delta2, threshold, idle steps) instead of\n"
     "                  the sweep and the presets (also with --presets or --quick); repeatable. Each run is\n"
     "                  named \"custom\"; its parameters are in the row.\n"
     "The printout ends each scene with every stage's mean ms per step for each paired run and its\n"
@@ -95,13 +92,12 @@ const char* kUsage =
     "medians; a run that takes more steps pays for them) (not with --unpaired, which has no reference\n"
     "to set beside it).\n";
 
-/// "D1,D2,T,IDLE,TOL[,HOLD]" (--setting) into a reuse-on setting named "custom"; false unless it is
-/// five or six decimal numbers from 0 to 1e9 (as the scene's reuse section allows) that stay what they
-/// say as floats (1e-50 would become 0, and a tolerance of 0 turns the guard off), IDLE a whole number
-/// to 1000, HOLD (reuse.impulse) 0, 1 or 2.
+/// "D1,D2,T,IDLE" (--setting) into a reuse-on setting named "custom"; false unless it is four decimal
+/// numbers from 0 to 1e9 (as the scene's reuse section allows) that stay what they say as floats (1e-50
+/// would become 0), IDLE a whole number to 1000.
 bool ParseSetting(const std::string& text, Setting* out) {
-  float v[6] = {0, 0, 0, 0, 0, 1};
-  const int fields = std::count(text.begin(), text.end(), ',') == 5 ? 6 : 5;
+  float v[4] = {0, 0, 0, 0};
+  const int fields = 4;
   size_t at = 0;
   for (int k = 0; k < fields; ++k) {
     const size_t comma = k < fields - 1 ? text.find(',', at) : text.size();
@@ -119,15 +115,12 @@ bool ParseSetting(const std::string& text, Setting* out) {
     if (d > 0.0 && !(v[k] > 0.0f)) return false;  // a positive number too small for a float
   }
   if (v[3] != std::floor(v[3]) || v[3] > 1000.0f) return false;
-  if (v[5] != 0.0f && v[5] != 1.0f && v[5] != 2.0f) return false;
   out->name = "custom";
   out->enabled = true;
   out->delta1 = v[0];
   out->delta2 = v[1];
   out->threshold = v[2];
   out->idle = static_cast<int>(v[3]);
-  out->tolerance = v[4];
-  out->impulse = static_cast<int>(v[5]);
   return true;
 }
 
@@ -189,10 +182,8 @@ bool ParseArgs(int argc, char** argv, Args* out) {
   return true;
 }
 
-Setting Sweep(float d1, float d2, float t, int idle, float tol, int impulse = 1) {
+Setting Sweep(float d1, float d2, float t, int idle) {
   Setting s;
-  s.impulse = impulse;
-  s.tolerance = tol;
   s.name = "sweep";
   s.enabled = true;
   s.delta1 = d1;
@@ -205,28 +196,22 @@ Setting Sweep(float d1, float d2, float t, int idle, float tol, int impulse = 1)
 Setting Preset(const char* name) {
   sim::ReuseParams r;
   sim::ApplyReusePreset(name, &r);
-  Setting s = Sweep(r.delta1, r.delta2, r.threshold, r.idle, r.accelTolerance, r.impulse);
+  Setting s = Sweep(r.delta1, r.delta2, r.threshold, r.idle);
   s.name = name;
   return s;
 }
 
-/// The sweep: the holds side by side, then one factor at a time around `balanced` (delta1 0, delta2 1,
-/// T 1.5, IDLE 3, guard off, the impulse hold), then the presets.
+/// The sweep: one factor at a time around `balanced` (delta1 0, delta2 1, T 1.5, IDLE 3), then the presets.
 std::vector<Setting> Settings(bool quick, bool presetsOnly, const std::vector<Setting>& custom) {
   if (!custom.empty()) return custom;
   std::vector<Setting> s;
   if (quick && !presetsOnly) {
-    s = {Sweep(0.25f, 1, 1.3f, 3, 0.3f, 0), Sweep(0, 1, 1.5f, 3, 0.0f, 2)};
+    s = {Sweep(0, 1, 1.5f, 1), Sweep(0, 1, 1.3f, 3)};
   } else if (!presetsOnly) {
-    s.push_back(Sweep(0.25f, 1, 1.3f, 3, 0.3f, 0));  // the held acceleration, guarded: `balanced` until 2026-12-02
-    s.push_back(Sweep(0.25f, 1, 1.3f, 1, 0.0f, 0));  // the held acceleration, guard off
-    s.push_back(Sweep(0, 1, 1.5f, 1, 0.0f, 2));      // the impulse hold with live density
-    s.push_back(Sweep(0, 1, 1.5f, 3, 0.0f, 2));
-    for (int idle : {1, 2, 5}) s.push_back(Sweep(0, 1, 1.5f, idle, 0.0f, 1));
-    for (float t : {1.3f, 1.4f, 1.6f, 2.0f}) s.push_back(Sweep(0, 1, t, 3, 0.0f, 1));
-    for (float d1 : {0.1f, 0.25f, 0.5f}) s.push_back(Sweep(d1, 1, 1.5f, 3, 0.0f, 1));
-    for (float d2 : {0.8f, 1.2f}) s.push_back(Sweep(0, d2, 1.5f, 3, 0.0f, 1));
-    for (float tol : {0.3f, 1.0f}) s.push_back(Sweep(0, 1, 1.5f, 3, tol, 1));
+    for (int idle : {1, 2, 5}) s.push_back(Sweep(0, 1, 1.5f, idle));
+    for (float t : {1.3f, 1.4f, 1.6f, 2.0f}) s.push_back(Sweep(0, 1, t, 3));
+    for (float d1 : {0.1f, 0.25f, 0.5f}) s.push_back(Sweep(d1, 1, 1.5f, 3));
+    for (float d2 : {0.8f, 1.2f}) s.push_back(Sweep(0, d2, 1.5f, 3));
   }
   for (const char* p : {"accurate", "balanced", "fast"}) s.push_back(Preset(p));
   return s;
@@ -320,8 +305,6 @@ class Runner {
     m_scene.setup.reuse.delta2 = setting.delta2;
     m_scene.setup.reuse.threshold = setting.threshold;
     m_scene.setup.reuse.idle = setting.idle;
-    m_scene.setup.reuse.accelTolerance = setting.tolerance;
-    m_scene.setup.reuse.impulse = setting.impulse;
     sim::SolverConfig config;
     config.device = sim::Device::kCpu;
     config.threads = threads;
@@ -470,8 +453,8 @@ int main(int argc, char** argv) {
   }
   std::ofstream csv;
   if (const std::string why = args.csv.empty() ? std::string() : OpenCsv(args.csv,
-               "timestamp_utc,cpu_model,nproc,threads,scene,fluid,setting,enabled,delta1,delta2,threshold,idle,accel_tolerance,"
-               "impulse,sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,paired_ref_step_ms,speedup,active_fraction,"
+               "timestamp_utc,cpu_model,nproc,threads,scene,fluid,setting,enabled,delta1,delta2,threshold,idle,"
+               "sim_time,steps,step_ms,ref_step_ms_first,ref_step_ms_last,paired_ref_step_ms,speedup,active_fraction,"
                "mean_density_error,peak_density_error,surface_rms_spacings,front_deviation,max_speed,clamped,"
                "finite,load_avg_start,load_avg_end,wall_speedup",
                false, &csv);
@@ -491,8 +474,8 @@ int main(int argc, char** argv) {
     if (!Run(sc, off, args.threads, false, &ref)) return 1;
     std::vector<Result> results;
     for (const Setting& s : Settings(args.quick, args.presetsOnly, args.custom)) {
-      std::fprintf(stderr, "%s: %s delta1 %g delta2 %g T %g IDLE %d tolerance %g hold %d ...\n", sc.name.c_str(),
-                   s.name.c_str(), s.delta1, s.delta2, s.threshold, s.idle, s.tolerance, s.impulse);
+      std::fprintf(stderr, "%s: %s delta1 %g delta2 %g T %g IDLE %d ...\n", sc.name.c_str(), s.name.c_str(), s.delta1,
+                   s.delta2, s.threshold, s.idle);
       Result r;
       if (!Run(sc, s, args.threads, !args.unpaired, &r)) return 1;
       results.push_back(std::move(r));
@@ -507,23 +490,22 @@ int main(int argc, char** argv) {
                 sc.name.c_str(), ref.fluid, sc.time, ref.stepMs, refLast.stepMs);
     std::printf("%s\n", args.unpaired ? "speed-up against the mean of the two reference runs"
                                        : "speed-up against a reference stepped in lock-step with each run (ref_ms)");
-    std::printf("%-9s %6s %6s %6s %5s %5s %4s %8s %8s %7s %7s %9s %9s %8s %8s %6s\n", "setting", "delta1", "delta2", "T", "IDLE", "tol", "hold",
+    std::printf("%-9s %6s %6s %6s %5s %8s %8s %7s %7s %9s %9s %8s %8s %6s\n", "setting", "delta1", "delta2", "T", "IDLE",
                 "step_ms", "ref_ms", "speedup", "active", "mean_err%", "peak_err%", "surf_rms", "front%", "vmax");
     results.insert(results.begin(), ref);
     for (Result& r : results) {
       Compare(ref, &r, dx);
       const bool paired = std::isfinite(r.pairedRefMs);
       const double speedup = r.stepMs > 0 ? (paired ? r.pairedRefMs : refMs) / r.stepMs : 0.0;
-      std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %4d %8.2f %8.2f %7.2f %7.3f %9.3f %9.3f %8.3f %8.2f %6.2f%s\n",
+      std::printf("%-9s %6.2f %6.2f %6.2f %5d %8.2f %8.2f %7.2f %7.3f %9.3f %9.3f %8.3f %8.2f %6.2f%s\n",
                   r.setting.name.c_str(), r.setting.delta1, r.setting.delta2, r.setting.threshold, r.setting.idle,
-                  r.setting.tolerance, r.setting.impulse,
                   r.stepMs, paired ? r.pairedRefMs : refMs, speedup, r.active, 100 * r.meanErr, 100 * r.peakErr, r.surfaceRms, 100 * r.frontDev,
                   r.maxSpeed, r.finite ? "" : "  NaN!");
       if (csv) {
         csv << when << ',' << CsvField(cpu) << ',' << CpuCount() << ',' << threads << ',' << sc.name << ',' << r.fluid
             << ',' << r.setting.name << ',' << (r.setting.enabled ? 1 : 0) << ',' << r.setting.delta1 << ','
-            << r.setting.delta2 << ',' << r.setting.threshold << ',' << r.setting.idle << ',' << r.setting.tolerance << ','
-            << r.setting.impulse << ',' << sc.time << ','
+            << r.setting.delta2 << ',' << r.setting.threshold << ',' << r.setting.idle << ','
+            << sc.time << ','
             << r.steps << ',' << r.stepMs << ',' << ref.stepMs << ',' << refLast.stepMs << ',' << r.pairedRefMs << ','
             << speedup << ','
             << r.active << ',' << r.meanErr << ',' << r.peakErr << ',' << r.surfaceRms << ','
@@ -534,14 +516,14 @@ int main(int argc, char** argv) {
     }
     // Where the time goes: each stage's mean per step, the run against its lock-step reference.
     if (!args.unpaired) {
-      std::printf("stages, mean ms per step: the run (reference in lock-step)\n%-9s %6s %6s %6s %5s %5s %4s", "setting",
-                  "delta1", "delta2", "T", "IDLE", "tol", "hold");
+      std::printf("stages, mean ms per step: the run (reference in lock-step)\n%-9s %6s %6s %6s %5s", "setting",
+                  "delta1", "delta2", "T", "IDLE");
       for (int k = 0; k < kStages; ++k) std::printf(" %15s", sim::StageName(static_cast<sim::Stage>(k)));
       std::printf(" %17s %12s\n", "mean step", "wall speedup");
       for (const Result& r : results) {
         if (!std::isfinite(r.pairedRefMs)) continue;
-        std::printf("%-9s %6.2f %6.2f %6.2f %5d %5.2f %4d", r.setting.name.c_str(), r.setting.delta1, r.setting.delta2,
-                    r.setting.threshold, r.setting.idle, r.setting.tolerance, r.setting.impulse);
+        std::printf("%-9s %6.2f %6.2f %6.2f %5d", r.setting.name.c_str(), r.setting.delta1, r.setting.delta2,
+                    r.setting.threshold, r.setting.idle);
         for (int k = 0; k < kStages; ++k) std::printf(" %6.3f (%6.3f)", r.stageMs[k], r.pairedRefStageMs[k]);
         std::printf(" %7.3f (%7.3f) %12.3f\n", r.meanMs, r.pairedRefMeanMs, r.pairedRefStepSeconds / r.stepSeconds);
       }

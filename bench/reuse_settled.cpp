@@ -4,7 +4,7 @@
 // simulated seconds, at a raised viscosity (--settle-viscosity) so the lattice's rearrangement dies out
 // sooner. Its state is then copied, by particle id, into the scene (with the dropped block when --drop
 // is given, otherwise the pool alone) and run for --time seconds twice from that same state: reuse off,
-// then the preset (with --tolerance overriding its acceleration guard; 0 turns the guard off). Every
+// then the preset. Every
 // --report steps it prints the fraction that computed, the maximum speed and the mean compression; at
 // the end the mean step time of each run. --probe prints the acceleration of four interior particles for
 // 16 steps after settling (how smooth the forces of a calm pool are) and stops.
@@ -35,13 +35,12 @@ using sphxr::sim::Solver;
 
 const char* kUsage =
     "usage: sphxr_bench_reuse_settled [--scene FILE] [--settle S] [--settle-viscosity V] [--time T] [--preset P]\n"
-    "                                 [--tolerance G] [--fixed-dt DT] [--drop] [--threads N] [--report K] [--probe]\n"
+    "                                 [--fixed-dt DT] [--drop] [--threads N] [--report K] [--probe]\n"
     "  --scene FILE          default scenes/deep_tank.json; its first fluid block is the pool\n"
     "  --settle S            simulated seconds of settling the pool alone, reuse off (default 2)\n"
     "  --settle-viscosity V  viscosity and wall viscosity while settling (default 0.5; the scene's after)\n"
     "  --time T              simulated seconds of each measured run (default 0.3)\n"
     "  --preset P            accurate | balanced | fast (default balanced)\n"
-    "  --tolerance G         override the preset's accel_tolerance (|g|; 0 = guard off)\n"
     "  --fixed-dt DT         override the scene's fixed time step (settling and both runs)\n"
     "  --drop                keep the scene's other blocks (deep_tank: the dropped block)\n"
     "  --threads N           CPU threads (default 0 = all cores)\n"
@@ -58,7 +57,7 @@ bool Fail(const sphxr::Status& s) {
 
 int main(int argc, char** argv) {
   std::string scenePath = std::string(SPHXR_SCENES_DIR) + "/deep_tank.json";
-  double settle = 2.0, settleViscosity = 0.5, runTime = 0.3, tolerance = -1.0, fixedDt = 0.0;
+  double settle = 2.0, settleViscosity = 0.5, runTime = 0.3, fixedDt = 0.0;
   std::string preset = "balanced";
   bool drop = false, probe = false;
   double threads = 0, report = 100;
@@ -76,7 +75,6 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--settle")) value(&settle, false);
     else if (!std::strcmp(argv[a], "--settle-viscosity")) value(&settleViscosity, false);
     else if (!std::strcmp(argv[a], "--time")) value(&runTime, true);
-    else if (!std::strcmp(argv[a], "--tolerance")) value(&tolerance, false);
     else if (!std::strcmp(argv[a], "--fixed-dt")) value(&fixedDt, true);
     else if (!std::strcmp(argv[a], "--threads")) value(&threads, false);
     else if (!std::strcmp(argv[a], "--report")) value(&report, true);
@@ -98,7 +96,6 @@ int main(int argc, char** argv) {
   if (!sphxr::sim::ApplyReusePreset(preset, &reuse)) {
     return std::fprintf(stderr, "sphxr_bench_reuse_settled: unknown preset '%s'\n", preset.c_str()), 2;
   }
-  if (tolerance >= 0) reuse.accelTolerance = static_cast<float>(tolerance);
   sphxr::sim::SolverConfig config;
   config.threads = static_cast<int>(threads);
   const int every = static_cast<int>(report);

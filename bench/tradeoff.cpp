@@ -10,7 +10,7 @@
 //     minPerBin from app::DamBreakMinPerBin, as the headless runner) interpolated linearly in time at
 //     each measured T; RMS and maximum of |Z_sim / Z_measured - 1|,
 //   - the mean density error, time-averaged (weighted by dt) over the run.
-// --csv writes one row per run (docs/tradeoff.csv); bench/plot_tradeoff.py draws docs/tradeoff.png.
+// --csv writes one row per run (bench/results/tradeoff.csv); bench/plot_tradeoff.py draws docs/images/tradeoff.png.
 #include <chrono>
 #include <cmath>
 #include <cstdio>

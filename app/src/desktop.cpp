@@ -219,7 +219,7 @@ struct DesktopApp::Impl {
   void Panel(const SimSnapshot& snap);
 
   /// The s key and the panel's button: the running state into --save-state's file, else
-  /// "<scene name>.state" in the working directory (docs/scenes.md "State files").
+  /// "<scene name>.state" in the working directory (docs/user/scenes.md "State files").
   void SaveState() { saveMessage = worker->SaveStateLogged(options.saveState, scene.name); }
   std::string saveMessage;  // the last save, shown in the panel
 };

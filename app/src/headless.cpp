@@ -231,7 +231,7 @@ std::string UsageText() {
          "                    No runtime: one line, then the desktop window. --frame-limit N ends after N\n"
          "                    frames, --screenshot FILE.png the last mirror image (the left eye);\n"
          "                    XR_RUNTIME_JSON=build/xr/sim_runtime/sphxr_sim_runtime.json: the simulated\n"
-         "                    headset (docs/xr.md)\n"
+         "                    headset (docs/dev/xr.md)\n"
          "  --desktop         a window with the water, a panel and a mouse-driven hand (the default when a\n"
          "                    display is present); --window-size WxH, --frame-limit N, --no-vsync\n"
          "  --headless        run without a window (the default without a display); Ctrl-C stops it after\n"
@@ -263,7 +263,8 @@ std::string UsageText() {
          "  --validate        check every stage for non-finite values; stop at the first, naming it\n"
          "  --reuse on|off|accurate|balanced|fast\n"
          "                    activity-based reuse: on/off keeps the scene's \"reuse\" parameters, a preset\n"
-         "                    replaces them (docs/reuse.md); --set reuse.threshold=1.3 etc. override them\n"
+         "                    replaces them; --set reuse.threshold=1.3 etc. override them\n"
+         "                    (docs/design/impulse_hold.md)\n"
 
          "  --screenshot FILE.png  a picture of the last state (OpenGL through EGL, no display needed);\n"
          "                    with --desktop, the window (panel included) when it closes\n"

@@ -46,10 +46,6 @@ std::vector<ParamDesc> Build() {
              &sim::ReuseParams::threshold);
   reuseFloat("pressure_scale", "Pa", "P_pc; 0 = the Tait pressure at 1 % compression", &sim::ReuseParams::pressureScale);
   reuseFloat("cell_count", "", "N_CPN; 0 = the rest lattice's particles per cell", &sim::ReuseParams::cellCount);
-  reuseFloat("accel_tolerance", "g",
-             "a particle whose acceleration changed by more than this many |g| since its last computation stays "
-             "active for IDLE + 1 steps (0 = off; docs/reuse.md)",
-             &sim::ReuseParams::accelTolerance);
   const auto reuseInt = [&](const char* name, const char* unit, const char* help, int lo, int hi,
                             int sim::ReuseParams::*m) {
     ParamDesc p;
@@ -67,11 +63,6 @@ std::vector<ParamDesc> Build() {
   };
   reuseInt("idle", "steps", "IDLE: consecutive steps an inactive particle reuses its density, pressure and acceleration",
            0, 1000, &sim::ReuseParams::idle);
-  reuseInt("impulse", "",
-           "1: the impulse hold (synchronised schedule, kick (IDLE + 1) dt a, drift while reusing; stable to "
-           "IDLE 3); 2: the same with live density (reusing neighbours of computing particles recompute their "
-           "density); 0: the paper's held acceleration, stable only with accel_tolerance (docs/reuse.md)",
-           0, 2, &sim::ReuseParams::impulse);
   return out;
 }
 

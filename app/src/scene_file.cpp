@@ -172,7 +172,14 @@ class Reader {
       if (!reuse.is_object()) return Error("reuse", "must be an object");
       CheckKeys(reuse, "reuse",
                 {"enabled", "preset", "delta1", "delta2", "threshold", "idle", "pressure_scale", "cell_count",
-                 "accel_tolerance", "impulse"});
+                 "accel_tolerance", "impulse"});  // the last two retired: warned about below
+      for (const char* retired : {"impulse", "accel_tolerance"}) {
+        if (!reuse.contains(retired)) continue;
+        const std::string why = std::string("retired key 'reuse.") + retired +
+                                "' ignored: the impulse hold is the only hold (docs/design/impulse_hold.md)";
+        m_out->warnings.push_back(why);
+        SPHXR_LOG_WARN("%s: %s", m_out->path.c_str(), why.c_str());
+      }
       sim::ReuseParams& r = s.reuse;
       r.enabled = true;
       // A preset first, then any parameter the section names overrides it.
@@ -197,7 +204,7 @@ class Reader {
       if (Status st = Paddles(root["paddles"]); !st) return st;
     }
     if (root.contains("surface")) {
-      // The water surface (docs/surface.md): sim::SurfaceParams; absent keys keep their defaults.
+      // The water surface (docs/dev/surface.md): sim::SurfaceParams; absent keys keep their defaults.
       const json& surface = root["surface"];
       if (!surface.is_object()) return Error("surface", "must be an object");
       CheckKeys(surface, "surface", {"cell_size", "iso_level", "margin"});

@@ -437,7 +437,7 @@ Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, u
                                 static_cast<long long>(vertices), static_cast<long long>(kMaxVertices)));
   }
   if (!*mesh || (*mesh)->Capacity() < vertices) {
-    // Geometric growth, as the solver's own buffer (docs/surface.md): O(log) re-creations, each logged.
+    // Geometric growth, as the solver's own buffer (docs/dev/surface.md): O(log) re-creations, each logged.
     const int64_t old = *mesh ? (*mesh)->Capacity() : 0;
     const int64_t grown = std::min(kMaxVertices, std::max<int64_t>({vertices + vertices / 4, old + old / 2, 3 * 4096}));
     mesh->reset();  // unregisters the old buffers from CUDA before the new ones are made

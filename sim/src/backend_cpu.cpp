@@ -32,7 +32,7 @@ struct OmpTraits {
   /// then a quarter, ... down to `chunk` items) let the thread that finishes first take over the rest;
   /// they cannot help where the dearer work all lies in the first chunk, and measured 4-10 % faster
   /// than the equal slices (plain dynamic chunks: no gain). An item writes only its own results, so
-  /// the schedule changes no number (docs/performance.md, "Guided chunks").
+  /// the schedule changes no number (docs/design/simd_stages.md).
   template <class F>
   static void ForEachGuided(int n, int chunk, const F& f) {
 #pragma omp parallel for schedule(guided, chunk)

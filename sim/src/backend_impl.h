@@ -142,11 +142,10 @@ class BackendImpl final : public Backend {
     // 3b. activity (reuse): classify, then compact the particles that compute this step
     const FluidView fv = Fluid();
     int computing = n;
-    // The particles whose density is computed: those that compute, and with the impulse hold the
-    // reusing ones next to them (DensityThisStep; its own list then, else the compute list).
+    // The particles whose density is computed: those that compute (the compute list).
     int densityCount = n;
     const uint32_t* densityList = nullptr;  // set once the lists are sized: a resize moves their storage
-    DensityThisStep densityOf{View(), fv.position, Raw(m_fluid.idle), physics.reuseIdle, nullptr};
+    const ComputesThisStep densityOf{Raw(m_fluid.idle), physics.reuseIdle};
     if (physics.reuseEnabled) {
       const int cells = static_cast<int>(m_fluidStart.size());
       m_cellCount.resize(cells);
@@ -155,7 +154,7 @@ class BackendImpl final : public Backend {
       const int rows = grid.ny * grid.nz;
       uint32_t* count = Raw(m_cellCount);
       uint32_t* crowd = Raw(m_cellCrowd);
-      if (!physics.reuseImpulse || physics.reuseSyncStep) {  // the impulse hold classifies on its schedule only
+      if (physics.reuseSyncStep) {  // the impulse hold classifies on its schedule only
         thrust::for_each_n(policy, first, cells, CellCountStage{grid, count});
         // The 27-cell sums in three passes (x, y, z), the two buffers in turn; the crowding ends in m_cellCrowd.
         thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
@@ -169,19 +168,6 @@ class BackendImpl final : public Backend {
       computing = static_cast<int>(end - m_computeList.begin());
       densityCount = computing;
       densityList = Raw(m_computeList);
-      if (physics.reuseLiveDensity && computing < n) {
-        // Live density: the reusing particles with a computing one in their 27 cells (count, then the
-        // same three box-sum passes as the crowding, whose counts are no longer needed).
-        thrust::for_each_n(policy, first, cells, CellComputingStage{grid, Raw(m_fluid.idle), physics.reuseIdle, count});
-        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
-        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, crowd, count, 1});
-        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 2});
-        densityOf.computingNear = crowd;
-        m_densityList.resize(n);
-        auto last = thrust::copy_if(policy, first, first + n, m_densityList.begin(), densityOf);
-        densityCount = static_cast<int>(last - m_densityList.begin());
-        densityList = Raw(m_densityList);
-      }
       if (Status s = lap(Stage::kActivity); !s) return s;
     }
 
@@ -240,7 +226,7 @@ class BackendImpl final : public Backend {
       const bool masked = densityCount < n && m_pairBlocks;  // the pairs-only layout's masked lanes
       loop(blocks, 8,
            typename Traits::DensityBlockStage{density, set, Raw(m_blockStart), masked ? Raw(m_fluid.idle) : nullptr,
-                                              physics.reuseIdle, m_pairBlocks, densityOf.computingNear});
+                                              physics.reuseIdle, m_pairBlocks});
     } else if (densityCount < n) {
       loop(densityCount, 32, OverList<DensityStage>{densityList, density});
     } else {
@@ -564,7 +550,6 @@ class BackendImpl final : public Backend {
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
-  Vector<uint32_t> m_densityList;  // the impulse hold: those whose density is computed (DensityThisStep)
   Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell; scratch of the 27-cell sums
   Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each cell
   Vector<uint32_t> m_blockStart;   // CPU density blocks: first entry of each (cpu_stages.h)

@@ -56,7 +56,7 @@ namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {
 
 // Lanes per SIMD value: one register of the widest unit where there is one (AVX-512 with DQ: 16;
-// AVX or AVX2, and AVX-512 without DQ: 8), else 16 in four SSE2 registers or in scalars. Measured on an AVX2 AMD EPYC (docs/performance.md,
+// AVX or AVX2, and AVX-512 without DQ: 8), else 16 in four SSE2 registers or in scalars. Measured on an AVX2 machine (docs/design/simd_stages.md,
 // "AVX2 machines"): 16 lanes in two 256-bit halves left the values spilling (16 ymm registers hold
 // eight of them) and every comparison, select and gather split in two; eight lanes in one register
 // made the whole step 1.23-1.4x faster, although a density block then holds 8 particles instead of 16.
@@ -73,9 +73,9 @@ inline constexpr int kLanes = 16;
 
 /// The density blocks' neighbour-list appends: branch-free into scratch lists (a store per lane per
 /// candidate that hits, the counts in a vector) in the AVX and AVX-512 tiers, where it made the density
-/// stage 1.2-1.3x faster on the AVX2 EPYC (Zen 3) and 1.05-1.1x on the AVX-512 EPYC (Zen 5); one store
+/// stage 1.2-1.3x faster on an AVX2 machine and 1.05-1.1x on an AVX-512 machine; one store
 /// per hit in the SSE2 and scalar tiers. In the SSE2 tier's 16 lanes (four registers) the vector counts
-/// made the stage 1.15-1.35x slower (docs/performance.md, "Transposed loads", "The AVX-512 tier on Zen 5").
+/// made the stage 1.15-1.35x slower (docs/design/simd_stages.md).
 #if defined(__AVX__)
 inline constexpr bool kVectorAppends = true;
 #else
@@ -131,7 +131,7 @@ inline uint32_t Bits(LaneInts c) {
 /// is one register (AVX-512, AVX) the float operators are one instruction each (AVX without AVX2
 /// splits the integer ones, a cost in speed only). In the SSE2 tier's
 /// four registers GCC 12 lowers a comparison or a ?: lane by lane (a scalar compare, a store of each
-/// 32-bit result, then a 128-bit reload that the store buffer cannot forward; measured on an AVX2 EPYC
+/// 32-bit result, then a 128-bit reload that the store buffer cannot forward; measured on an AVX2 machine
 /// with 16 lanes in two halves, that made the density and force stages 2-3x slower), so that tier
 /// compares and selects per quarter with the intrinsics. Same NaN semantics as the operators: <, <= are
 /// ordered (false for NaN), != is unordered (true for NaN); the results are bit for bit the operators'.
@@ -171,15 +171,15 @@ inline Lanes Select(LaneInts m, Lanes a, Lanes b) { return m ? a : b; }
 /// Gathers base[index[l]] into lane l (scalar loads put together; no tier uses a gather instruction).
 inline Lanes Gather(const float* base, LaneInts index) {
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
-  // Sixteen loads put together in registers, not the gather instruction: on the AVX-512 EPYC (Zen 5)
-  // the force stage is 1.1x faster so (docs/performance.md, "The AVX-512 tier on Zen 5").
+  // Sixteen loads put together in registers, not the gather instruction: on an AVX-512 machine
+  // the force stage is 1.1x faster so (docs/design/simd_stages.md).
   return reinterpret_cast<Lanes>(_mm512_set_ps(base[index[15]], base[index[14]], base[index[13]], base[index[12]],
                                                base[index[11]], base[index[10]], base[index[9]], base[index[8]],
                                                base[index[7]], base[index[6]], base[index[5]], base[index[4]],
                                                base[index[3]], base[index[2]], base[index[1]], base[index[0]]));
 #elif defined(__AVX__)
-  // Eight loads put together in registers, not AVX2's gather instruction: on the AVX2 EPYC (Zen 3) the
-  // force stage is 1.1-1.15x faster so (docs/performance.md, "Transposed loads").
+  // Eight loads put together in registers, not AVX2's gather instruction: on an AVX2 machine the
+  // force stage is 1.1-1.15x faster so (docs/design/simd_stages.md).
   return reinterpret_cast<Lanes>(_mm256_set_ps(base[index[7]], base[index[6]], base[index[5]], base[index[4]],
                                                base[index[3]], base[index[2]], base[index[1]], base[index[0]]));
 #else
@@ -192,9 +192,9 @@ inline Lanes Gather(const float* base, LaneInts index) {
 /// x, y, z (and w, where asked for) of the Vec4s base[index[l]] (base: x y z w per point) into lane l:
 /// the same values as Gathers of base, base + 1, ... at index * 4. On AVX the eight points are loaded
 /// whole (16 bytes each, two to a register) and transposed in registers, 8 loads and 7-8 shuffles instead
-/// of three or four gather instructions, whose latency the force loop waited on (AVX2 EPYC: the force
-/// stage 1.6-2x faster, docs/performance.md "Transposed loads"). AVX-512 does the same with 16 points,
-/// four to a register (AVX-512 EPYC, Zen 5: the force stage 1.5x faster, "The AVX-512 tier on Zen 5").
+/// of three or four gather instructions, whose latency the force loop waited on (AVX2: the force
+/// stage 1.6-2x faster, docs/design/simd_stages.md). AVX-512 does the same with 16 points,
+/// four to a register (AVX-512: the force stage 1.5x faster).
 SPHXR_INLINE void GatherXyzw(const float* base, LaneInts index, Lanes* x, Lanes* y, Lanes* z, Lanes* w) {
 #if defined(__AVX__) && !defined(__AVX512DQ__)
   auto row = [&](int l) {  // points l and l + 4 in the low and high halves
@@ -511,7 +511,6 @@ struct DensityBlockStage {
   const int32_t* idle = nullptr;  // masked lanes: the idle counts; nullptr: every entry computes
   int32_t idleSteps = 0;
   bool pairsOnly = false;  // DensityBlockStart's
-  const uint32_t* computingNear = nullptr;  // masked lanes with the impulse hold: live density (DensityThisStep)
 
   void operator()(int b) const {
     const GridView& g = stage.grid;
@@ -521,7 +520,7 @@ struct DensityBlockStage {
     const int lanes = static_cast<int>(box.end - first < static_cast<uint32_t>(kLanes) ? box.end - first : kLanes);
     uint32_t computing = 0;
     uint32_t particle[kLanes];  // each lane's particle
-    const DensityThisStep computes{g, position, idle, idleSteps, computingNear};
+    const ComputesThisStep computes{idle, idleSteps};
     for (int l = 0; l < lanes; ++l) {
       particle[l] = set.Particle(first + static_cast<uint32_t>(l));
       if (idle == nullptr || computes(static_cast<int>(particle[l]))) computing |= 1u << l;

@@ -74,19 +74,18 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
   // scratch of each element type (16 + 4 + 4 + 4) + the sort's temporary storage (about keys and values
   // again, 8) + the CPU density stage's block starts (4) + the host copy at creation (76). Neighbour
   // lists: 4 B per slot and a count (sim/src/stages.h NeighbourList). Reuse: the compacted list (4), the
-  // CPU density blocks' keys of it and every particle's rank in it (8; counted for CUDA too, erring high)
-  // and live density's list of the particles whose density is computed (4; counted for every hold);
+  // CPU density blocks' keys of it and every particle's rank in it (8; counted for CUDA too, erring high);
   // bodies: each fluid particle's pressure term for the reaction (4). Boundary: 16 B, plus its sort at
   // start-up (~40 B transient) and the host copy (16); with wall_density its pressure term (4). Grid:
   // 4 ranges of 4 B and the near-boundary flag per cell; with bodies their 2 ranges and near flag (9),
   // with wall_density the wall-cell list's first size (4), with reuse the cells' counts and crowding (8). Bodies'
   // own particles: body frame, index and alpha (24), sorted world copies of position, velocity and
   // force (48), keys, order and owner (12). DFSPH (sim/src/dfsph_solver.h): a kernel gradient per
-  // neighbour slot (12), the boundary terms (16), factor, increment and neighbour count (12), the
-  // step's start velocity (16) and the error terms (8).
-  const int64_t perFluid = 76 + 8 + 28 + 8 + 4 + 76 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 16 : 0) +
+  // neighbour slot (12), the boundary terms (16), factor, increment, neighbour count and the two
+  // stiffnesses (20), the step's start velocity (16) and the error terms (8).
+  const int64_t perFluid = 68 + 8 + 28 + 8 + 4 + 68 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 12 : 0) +
                            (counts.bodyParticles > 0 ? 4 : 0) +
-                           (counts.dfsph ? 12 * counts.neighbourSlots + 16 + 12 + 16 + 8 : 0);
+                           (counts.dfsph ? 12 * counts.neighbourSlots + 16 + 20 + 16 + 8 : 0);
   const int64_t perBoundary = 16 + 40 + 16 + (counts.wallDensity ? 4 : 0);
   const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0) + (counts.reuse ? 8 : 0);
   return counts.fluid * perFluid + counts.boundary * perBoundary + counts.gridCells * perCell +
@@ -97,9 +96,7 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
 
 namespace sphxr::sim {
 
-// The presets, chosen from the sweep in docs/reuse.md (bench/reuse.cpp), all with the impulse hold
-// (reuse.impulse 1) and the acceleration guard off: the impulse hold needs no guard, and live density
-// (impulse 2) measured slower with no accuracy gain (docs/reuse.md, "Why the impulse hold is stable").
+// The presets, chosen from the sweep in docs/design/impulse_hold.md (bench/reuse.cpp).
 // `balanced`: delta1 0 makes the classification the 27-cell crowding alone, so a cell's particles are
 // classified alike; T 1.5 keeps the free surface active (its crowding term is about 1.5); IDLE 3 is
 // the stable limit (IDLE 5 blew up both scenes). Deep tank 2.45x, dam_break_1m 1.78x by wall time.
@@ -110,13 +107,11 @@ bool ApplyReusePreset(const std::string& name, ReuseParams* reuse) {
     const char* name;
     float delta1, delta2, threshold;
     int idle;
-    float accelTolerance;  // |g|
-    int impulse;
   };
   static const Preset kPresets[] = {
-      {"accurate", 0.1f, 1.0f, 1.6f, 1, 0.0f, 1},
-      {"balanced", 0.0f, 1.0f, 1.5f, 3, 0.0f, 1},
-      {"fast", 0.0f, 1.0f, 1.8f, 3, 0.0f, 1},
+      {"accurate", 0.1f, 1.0f, 1.6f, 1},
+      {"balanced", 0.0f, 1.0f, 1.5f, 3},
+      {"fast", 0.0f, 1.0f, 1.8f, 3},
   };
   for (const Preset& p : kPresets) {
     if (name != p.name) continue;
@@ -125,8 +120,6 @@ bool ApplyReusePreset(const std::string& name, ReuseParams* reuse) {
     reuse->delta2 = p.delta2;
     reuse->threshold = p.threshold;
     reuse->idle = p.idle;
-    reuse->accelTolerance = p.accelTolerance;
-    reuse->impulse = p.impulse;
     return true;
   }
   return false;

@@ -71,20 +71,15 @@ int64_t AvailableHostBytes() {
 }
 
 Status ValidateReuse(const ReuseParams& r) {
-  const float values[] = {r.delta1, r.delta2, r.threshold, r.pressureScale, r.cellCount, r.accelTolerance};
-  const char* names[] = {"delta1", "delta2", "threshold", "pressure_scale", "cell_count", "accel_tolerance"};
-  for (int k = 0; k < 6; ++k) {
+  const float values[] = {r.delta1, r.delta2, r.threshold, r.pressureScale, r.cellCount};
+  const char* names[] = {"delta1", "delta2", "threshold", "pressure_scale", "cell_count"};
+  for (int k = 0; k < 5; ++k) {
     if (!std::isfinite(values[k]) || values[k] < 0.0f || values[k] > 1e9f) {
       return Status::Error(Format("reuse.%s = %g is invalid: must be a number from 0 to 1e9", names[k], values[k]));
     }
   }
   if (r.idle < 0 || r.idle > 1000) {
     return Status::Error(Format("reuse.idle = %d is invalid: must be 0 to 1000 steps", r.idle));
-  }
-  if (r.impulse < 0 || r.impulse > 2) {
-    return Status::Error(Format("reuse.impulse = %d is invalid: must be 2 (the impulse hold with live density), 1 (the "
-                                "impulse hold) or 0 (the held acceleration)",
-                                r.impulse));
   }
   return Status::Ok();
 }
@@ -240,12 +235,12 @@ Status ValidateScene(const SceneSetup& scene) {
 // Reuse settings measured unstable are named when they are set (at start-up and by SetReuse).
 void WarnAboutReuse(const ReuseParams& reuse) {
   constexpr int kStableIdle = 3;
-  if (reuse.enabled && reuse.impulse != 0 && reuse.idle > kStableIdle) {
-    // Measured (docs/reuse.md, "Why the impulse hold is stable"): at the CFL step the deep tank and
-    // dam_break_1m blew up at IDLE 5 with either impulse hold (and the deep tank at IDLE 7 before).
-    SPHXR_LOG_WARN("reuse.idle = %d with reuse.impulse = %d: IDLE above %d was measured unstable at the CFL step "
+  if (reuse.enabled && reuse.idle > kStableIdle) {
+    // Measured (docs/design/impulse_hold.md): at the CFL step the deep tank and dam_break_1m blew up at
+    // IDLE 5 with the impulse hold (and the deep tank at IDLE 7 before).
+    SPHXR_LOG_WARN("reuse.idle = %d: IDLE above %d was measured unstable at the CFL step "
                    "(the held kick outruns the pressure waves); use IDLE <= %d or a smaller cfl",
-                   reuse.idle, reuse.impulse, kStableIdle, kStableIdle);
+                   reuse.idle, kStableIdle, kStableIdle);
   }
 }
 
@@ -320,14 +315,6 @@ Physics MakePhysics(const SceneSetup& scene) {
   const float pc = r.pressureScale > 0.0f ? r.pressureScale : p.stiffness * (std::pow(1.01f, p.exponent) - 1.0f);
   ph.reuseInvPressureScale = 1.0f / pc;
   ph.reuseCellCount = r.cellCount > 0.0f ? r.cellCount : p.supportFactor * p.supportFactor * p.supportFactor;
-  {
-    const float g2 = Dot(scene.gravity, scene.gravity);
-    const float tol = r.accelTolerance * std::sqrt(g2 > 0.0f ? g2 : 9.81f * 9.81f);
-    ph.reuseAccelTolerance2 = r.accelTolerance > 0.0f ? tol * tol : 3.0e38f;
-    ph.reuseCooldown = r.idle + 1;
-  }
-  ph.reuseImpulse = r.impulse >= 1;
-  ph.reuseLiveDensity = r.impulse == 2;
   ph.reuseSyncStep = true;  // Solver::Step sets it from the step's number
   ph.stiffness = p.stiffness;
   ph.exponent = p.exponent;

@@ -30,7 +30,7 @@ namespace sphxr::sim {
 inline constexpr uint32_t kEmptyCell = 0xffffffffu;
 
 /// max(v, lo) and min(v, hi) as one comparison each. fmaxf and fminf are library calls on the host
-/// without -ffast-math (measured: 3 % of a step on an AVX2 EPYC, from the cell look-ups). Where v is
+/// without -ffast-math (measured: 3 % of a step on an AVX2 machine, from the cell look-ups). Where v is
 /// NaN these give lo and hi, as fmaxf(v, lo) and fminf(v, hi) do; lo and hi must not be NaN.
 SPHXR_HD SPHXR_INLINE float AtLeast(float v, float lo) { return v > lo ? v : lo; }
 SPHXR_HD SPHXR_INLINE float AtMost(float v, float hi) { return v < hi ? v : hi; }
@@ -169,11 +169,7 @@ struct Physics {
   int reuseIdle;
   float reuseInvPressureScale;  // 1 / P_pc
   float reuseCellCount;         // N_CPN
-  float reuseAccelTolerance2;   // (tolerance)^2, m^2/s^4: a larger change of acceleration keeps i active
-  int reuseCooldown;            // steps a particle so flagged stays active before it is classified again
-  bool reuseImpulse;            // the impulse hold (ReuseParams::impulse >= 1): synchronised and kicked
-  bool reuseLiveDensity;        // ReuseParams::impulse == 2: reusing neighbours of computing ones recompute density
-  bool reuseSyncStep;           // with the impulse hold: this step's number is a multiple of IDLE + 1
+  bool reuseSyncStep;           // this step's number is a multiple of IDLE + 1 (the impulse hold's schedule)
   bool wallDensity;             // walls with their own density (WallPressureStage), else mirrored pressure
   float bodyGradScale;          // as boundaryGradScale, for the one-sheet shells of moving bodies
   float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle
@@ -295,7 +291,7 @@ struct BoundaryNearStage {
 /// p_b = Tait(rho_b). The force's pair term p_i/rho_i^2 + p_b/rho_b^2 is then the derivative of an
 /// energy (the fluid's and the walls' own, each a function of the particle positions only), so still
 /// water comes to rest. Mirroring (p_b = p_i) is not such a derivative and pumps a ~1 cm/s circulation
-/// (docs/physics.md, "Hydrostatics").
+/// (docs/dev/physics.md, "Hydrostatics").
 /// One work item per grid cell holding wall particles (`cells`): a cell with no fluid in its 27 cells
 /// (most of a tank's walls) writes 0 for its particles after 27 look-ups, instead of every particle
 /// scanning its own 27 cells.
@@ -369,8 +365,8 @@ struct CellCountStage {
 /// in[c] + in[c + s], s the axis' stride, a neighbour outside the grid counting 0; the x, y and z passes
 /// in turn give each cell the particles of its 27 cells exactly (integers), with 9 loads per cell and no
 /// division. One work item per row of cells along x (row = cy + ny cz). Summing 27 cells per fluid cell
-/// instead took 3.2 % of a `dam_break_1m` step on the Zen 5 EPYC; per particle, 2.3 ms of a 39 ms
-/// one-thread `deep_tank` step on the AVX2 EPYC (docs/reuse.md).
+/// instead took 3.2 % of a `dam_break_1m` step on an AVX-512 machine; per particle, 2.3 ms of a 39 ms
+/// one-thread `deep_tank` step on an AVX2 machine.
 struct CellBoxSumStage {
   GridView grid;
   const uint32_t* in;
@@ -411,10 +407,8 @@ struct CellBoxSumStage {
 // Idle count IC: -1 active. A particle with IC > 0 reuses this step (density, pressure, acceleration
 // stay as they are) and counts down; at IC = 0, or when active, it computes this step and is classified
 // with its previous pressure and the crowding of its cells: ACT_i < T gives IC = IDLE, else -1. So a
-// particle never reuses more than IDLE consecutive steps. IC < -1: flagged by the force stage (its
-// acceleration changed by more than the tolerance), active for -1 - IC more steps before it is
-// classified again. After this stage, "computes this step" is exactly IC < 0 or IC == IDLE
-// (ComputesThisStep).
+// particle never reuses more than IDLE consecutive steps. After this stage, "computes this step" is
+// exactly IC < 0 or IC == IDLE (ComputesThisStep).
 struct ActivityStage {
   GridView grid;
   FluidView fluid;
@@ -431,14 +425,10 @@ struct ActivityStage {
       fluid.idle[i] = ic - 1;
       return;
     }
-    if (ic < -1) {  // flagged by the force stage: active, cooling down
-      fluid.idle[i] = ic + 1;
-      return;
-    }
     // The impulse hold's synchronised schedule: particles go inactive together, on every (IDLE + 1)-th
-    // step, so a calm region reuses over the same steps and computes on the same step (docs/reuse.md).
+    // step, so a calm region reuses over the same steps and computes on the same step (docs/design/impulse_hold.md).
     // On the other steps the crowding is not computed (BackendImpl::Step) and not read.
-    if (ph.reuseImpulse && !ph.reuseSyncStep) {
+    if (!ph.reuseSyncStep) {
       fluid.idle[i] = -1;
       return;
     }
@@ -458,46 +448,10 @@ struct ComputesThisStep {
   SPHXR_HD bool operator()(int i) const { return idle[i] < 0 || idle[i] == idleSteps; }
 };
 
-/// The impulse hold's live density: each cell's fluid particles that compute this step (every cell,
-/// empty ones 0), summed over the 27 cells around each cell by CellBoxSumStage's three passes.
-struct CellComputingStage {
-  GridView grid;
-  const int32_t* idle;
-  int32_t idleSteps;
-  uint32_t* count;
-  SPHXR_HD void operator()(int c) const {
-    uint32_t computing = 0;
-    if (grid.fluidStart[c] != kEmptyCell) {
-      const ComputesThisStep computes{idle, idleSteps};
-      for (uint32_t j = grid.fluidStart[c]; j < grid.fluidEnd[c]; ++j) computing += computes(static_cast<int>(j)) ? 1u : 0u;
-    }
-    count[c] = computing;
-  }
-};
-
-/// The particles whose density and pressure are computed this step: those that compute, and with the
-/// impulse hold also those that reuse with a computing particle in their 27 cells (live density), so
-/// that a computing particle never feels a neighbour's stale pressure. `computingNear`: the computing
-/// particles of the 27 cells around each cell (CellComputingStage, summed); nullptr: the held hold.
-struct DensityThisStep {
-  GridView grid;
-  const Vec4* position;
-  const int32_t* idle;
-  int32_t idleSteps;
-  const uint32_t* computingNear;
-  SPHXR_HD bool operator()(int i) const {
-    if (ComputesThisStep{idle, idleSteps}(i)) return true;
-    if (computingNear == nullptr) return false;
-    int cx, cy, cz;
-    grid.CellOf(Xyz(position[i]), &cx, &cy, &cz);
-    return computingNear[grid.Linear(cx, cy, cz)] > 0;
-  }
-};
-
 /// 1 for a particle i < n whose density is computed this step, else 0 (also for i = n: the CPU density
 /// blocks' rank scan runs over n + 1 items, cpu_stages.h BlockSet).
 struct ComputeFlag {
-  DensityThisStep density;
+  ComputesThisStep density;
   int n;
   SPHXR_HD uint32_t operator()(int i) const { return i < n && density(i) ? 1u : 0u; }
 };
@@ -698,7 +652,7 @@ struct ForceStage {
   }
 
   /// Given the fluid neighbours' acceleration `a` (and P's Shepard sums): the walls, the moving bodies,
-  /// gravity, the reuse guard, and the store.
+  /// gravity, and the store.
   SPHXR_HD SPHXR_INLINE void End(int i, const ForceParticle& P, Vec3 a) const {
     if (P.nearWall) {
       const WallTerms w = Walls(P);
@@ -718,8 +672,7 @@ struct ForceStage {
     Store(i, P, a);
   }
 
-  /// Given the fluid's and the walls' acceleration `a`: the moving bodies, gravity, the reuse guard, and
-  /// the store.
+  /// Given the fluid's and the walls' acceleration `a`: the moving bodies, gravity, and the store.
   SPHXR_HD SPHXR_INLINE void Store(int i, const ForceParticle& P, Vec3 a) const {
     // Moving boundaries (paddles): the walls' terms with the relative velocity v_i - v_b, so a moving
     // paddle pushes (pressure) and drags (viscosity) the water. BodyReactionStage applies the opposite.
@@ -730,14 +683,6 @@ struct ForceStage {
       a -= BodyAcceleration(grid, ph, P.xi, P.vi, P.rhoi, pairTerm, grid.bodyStart, grid.bodyEnd);
     }
     a += ph.gravity;
-    if (ph.reuseEnabled) {
-      // Our rule beyond the paper (docs/reuse.md): a particle whose acceleration changed by more than the
-      // tolerance since its last computation (over the steps it reused, or over one step) was not calm;
-      // it stays active for a cooldown before it is classified again. Without it, reuse at a CFL-limited
-      // step acts as a multiple of that step on the pressure waves and the calm region blows up.
-      const Vec3 da = a - Xyz(fluid.acceleration[i]);
-      if (Dot(da, da) > ph.reuseAccelTolerance2) fluid.idle[i] = -1 - ph.reuseCooldown;
-    }
     fluid.acceleration[i] = MakeVec4(a);
   }
 };
@@ -756,13 +701,13 @@ struct IntegrateStage {
     Vec4 a = fluid.acceleration[i];
     Vec4 v = fluid.velocity[i];
     Vec4 x = fluid.position[i];
-    // The impulse hold (docs/reuse.md): a particle that computed this step and reuses the next IDLE
+    // The impulse hold (docs/design/impulse_hold.md): a particle that computed this step and reuses the next IDLE
     // steps takes all their kicks now, (IDLE + 1) dt a, and drifts while it reuses. For a calm region
     // on the synchronised schedule that is symplectic Euler at step (IDLE + 1) dt for its forces:
     // stable where that step meets the pressure waves' limit, and conserving phase-space area, where
     // applying the held a on every step pumps energy into every sound mode.
     float kick = dt;
-    if (ph.reuseEnabled && ph.reuseImpulse && ph.reuseIdle > 0) {
+    if (ph.reuseEnabled && ph.reuseIdle > 0) {
       const int32_t ic = fluid.idle[i];
       if (ic == ph.reuseIdle) {
         kick = dt * static_cast<float>(ph.reuseIdle + 1);

@@ -103,7 +103,6 @@ TEST(CommandLineTest, EveryModeLoadsTheSceneWithTheSameOverrides) {
   ASSERT_TRUE(sim::ApplyReusePreset("balanced", &balanced));
   EXPECT_TRUE(scene.setup.reuse.enabled);
   EXPECT_FLOAT_EQ(scene.setup.reuse.threshold, balanced.threshold);
-  EXPECT_FLOAT_EQ(scene.setup.reuse.accelTolerance, balanced.accelTolerance);
   EXPECT_EQ(scene.setup.reuse.idle, 2) << "--set comes after the preset";
   EXPECT_FLOAT_EQ(scene.setup.params.stiffness, 123456.0f);
   EXPECT_FLOAT_EQ(scene.setup.params.spacing, 0.02f);

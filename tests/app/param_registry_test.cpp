@@ -25,10 +25,9 @@ TEST(ParamRegistryTest, SolverEntriesAreSimsTableWithTheirDefaults) {
   EXPECT_EQ(FindParam("reuse.idle")->defaultValue, static_cast<double>(reuse.idle));
   EXPECT_TRUE(FindParam("reuse.idle")->integer);
   EXPECT_EQ(FindParam("threshold"), nullptr) << "reuse keys need their section";
-  EXPECT_EQ(FindParam("reuse.impulse")->defaultValue, static_cast<double>(reuse.impulse));
-  EXPECT_TRUE(FindParam("reuse.impulse")->integer);
-  // delta1, delta2, threshold, pressure_scale, cell_count, accel_tolerance, idle, impulse
-  EXPECT_EQ(static_cast<int>(ParamRegistry().size()), solver + 8);
+  EXPECT_EQ(FindParam("reuse.impulse"), nullptr) << "retired: the impulse hold is the only hold";
+  // delta1, delta2, threshold, pressure_scale, cell_count, idle
+  EXPECT_EQ(static_cast<int>(ParamRegistry().size()), solver + 6);
 }
 
 TEST(ParamRegistryTest, SceneFilesAndSetReadReuseThroughTheRegistry) {
@@ -56,10 +55,6 @@ TEST(ParamRegistryTest, SceneFilesAndSetReadReuseThroughTheRegistry) {
   EXPECT_FLOAT_EQ(setup.params.stiffness, 2e5f);
   s = SetSolverParam(&setup, "reuse.idle=-1");
   EXPECT_NE(s.message().find("--set reuse.idle: -1 is out of range"), std::string::npos) << s.message();
-  ASSERT_TRUE(SetSolverParam(&setup, "reuse.impulse=0").ok());
-  EXPECT_EQ(setup.reuse.impulse, 0);
-  s = SetSolverParam(&setup, "reuse.impulse=3");
-  EXPECT_NE(s.message().find("--set reuse.impulse: 3 is out of range"), std::string::npos) << s.message();
   s = SetSolverParam(&setup, "nonsense=1");
   EXPECT_NE(s.message().find("reuse.idle"), std::string::npos) << "the known list names the reuse keys: " << s.message();
 }

@@ -1,4 +1,4 @@
-// How the water surface reaches GL (docs/rendering.md, "The surface's two paths"): copied to the host
+// How the water surface reaches GL (docs/dev/rendering.md, "The surface's two paths"): copied to the host
 // on the CPU backend, written in place through CUDA-GL interop when the solver runs on the CUDA device.
 // No GPU here: the choice and the CPU side are tested; the interop write itself has never run.
 #include <gtest/gtest.h>

@@ -409,10 +409,10 @@ TEST(PaddleFluid, HeldStillInWaterFeelsArchimedesBuoyancy) {
               fy, sum[2] / samples, buoyancy, rig.solver->FluidCount());
   // Measured: +21 % at 1 cm spacing (+24 % at 0.8 cm, so it does not shrink with the spacing over this
   // range). Partly explained: the equilibrium pressure gradient is up to 6 % steeper than rho0 g in this
-  // solver (docs/physics.md, the kernel gradient is not normalised on the lattice). The rest is not:
+  // solver (docs/dev/physics.md; the kernel gradient is not normalised on the lattice). The rest is not:
   // mirroring the pressure alone (p_b = p_i, no neighbour average) gives the same figure, so it is not
   // the wall-pressure extrapolation; the convex edges and corners, which the flat-wall correction leaves
-  // light, are a suspect. We assert the sign and the magnitude within 30 % (docs/paddles.md).
+  // light, are a suspect. We assert the sign and the magnitude within 30 % (docs/dev/paddles.md).
   EXPECT_GT(fy, 0.0);
   EXPECT_NEAR(fy, buoyancy, 0.30 * buoyancy);
   EXPECT_LT(std::abs(sum[0] / samples), 0.05 * buoyancy);
@@ -452,7 +452,7 @@ TEST(PaddleFluid, ParticlesNearAPaddleStayActiveUnderReuse) {
       for (const Vec4& x : body) nearest = std::min(nearest, sim::Length(Xyz(x) - Xyz(f.position[i])));
       if (nearest < reach) {
         ++checked;
-        // Active is IC < 0: -1, or below -1 when the force stage's acceleration guard flagged it (docs/reuse.md).
+        // Active is IC < 0: -1, or below -1 when the force stage's acceleration guard flagged it (docs/design/impulse_hold.md).
         EXPECT_LT(f.idle[i], 0) << "particle " << f.id[i] << " " << nearest << " m from the paddle reused at t = " << t;
       } else if (f.idle[i] >= 0) {
         ++idleFar;

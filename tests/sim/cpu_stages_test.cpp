@@ -719,6 +719,7 @@ TEST(Activity, CrowdCountsTheParticlesOfThe27CellsAroundAndClassifiesByIt) {
   s.ph.reuseThreshold = 1.3f;
   s.ph.reuseIdle = 3;
   s.ph.reuseInvPressureScale = 1.0f;
+  s.ph.reuseSyncStep = true;  // the impulse hold classifies on its synchronised steps only
   const ActivityStage activity{g, f, s.ph, crowd.data()};
   size_t inactive = 0, active = 0;
   for (size_t i = 0; i < s.position.size(); ++i) {

@@ -2,15 +2,15 @@
 // order, a stable sort and max reductions for the time step. Its SIMD stages hand out guided chunks, so
 // which thread takes which particles may change from run to run (backend_cpu.cpp). The same scene on 1,
 // 2 (twice) and 3 threads must give bit-identical positions and velocities, with reuse off; on 1 and 2
-// with reuse on (its compacted list); and the CPU density blocks' two layouts alike. omp_set_num_threads is process-global, so each solver is created and run to
-// the end before the next one is created.
+// with reuse on (its compacted list); and the CPU density blocks' two layouts alike. All in this process:
+// SolverConfig::threads sets the OpenMP team, which is process-global, so each solver is created and run
+// to the end before the next one is created. ctest runs it with OMP_WAIT_POLICY=passive
+// (tests/CMakeLists.txt): with libgomp's default active waiting, a 2-thread team on a 2-core machine that
+// another process also uses spins at every barrier and the test takes 30-45 s instead of a few.
 #include <gtest/gtest.h>
 #include <omp.h>
 
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -47,29 +47,6 @@ RunResult RunScene(const SceneSetup& scene, int threads, int steps, bool pairDen
 }
 
 bool SameBits(const Vec4& a, const Vec4& b) { return std::memcmp(&a, &b, 3 * sizeof(float)) == 0; }
-
-/// With libgomp's default (active) wait policy, a 2-thread team on a 2-core machine that another process
-/// also uses (ctest -j2, a build) spins at every barrier: this test then takes 30-45 s instead of under one.
-/// The policy is read when libgomp loads, so the test re-runs itself in a child with OMP_WAIT_POLICY=passive
-/// (which changes waiting only, not results) when the variable is not set.
-bool RerunWithPassiveWaiting() {
-  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return false;
-  const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::string filter = std::string(info->test_suite_name()) + "." + info->name();
-  std::error_code ec;
-  const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
-  if (ec || self.empty()) return false;  // run in this process instead
-  const std::string command = "OMP_WAIT_POLICY=passive '" + self + "' --gtest_filter=" + filter + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return false;  // run in this process instead
-  std::string output;
-  char buffer[4096];
-  while (size_t n = std::fread(buffer, 1, sizeof(buffer), pipe)) output.append(buffer, n);
-  const int status = pclose(pipe);
-  EXPECT_EQ(status, 0) << "the test failed in the child process (OMP_WAIT_POLICY=passive):\n" << output;
-  EXPECT_NE(output.find("[  PASSED  ] 1 test"), std::string::npos) << "the child did not run the test:\n" << output;
-  return true;
-}
 
 /// Compares two runs bit for bit (by particle id), after checking that the flow moved.
 void ExpectIdentical(const RunResult& one, const RunResult& two) {
@@ -109,7 +86,6 @@ void ExpectIdentical(const RunResult& one, const RunResult& two) {
 
 // A small dam break: 10 x 15 x 6 = 900 particles, 200 steps (the column is falling and spreading).
 TEST(DeterminismTest, OneAndTwoThreadsGiveIdenticalResults) {
-  if (RerunWithPassiveWaiting()) return;
   const SceneSetup scene = test::SmallDamBreak(0.01f);
   const RunResult one = RunScene(scene, 1, 200);
   {
@@ -129,7 +105,6 @@ TEST(DeterminismTest, OneAndTwoThreadsGiveIdenticalResults) {
 // With reuse the density and force stages run over the compacted list of computing particles (`balanced`;
 // its still column reuses at the start).
 TEST(DeterminismTest, OneAndTwoThreadsGiveIdenticalResultsWithReuse) {
-  if (RerunWithPassiveWaiting()) return;
   SceneSetup scene = test::SmallDamBreak(0.01f);
   ASSERT_TRUE(ApplyReusePreset("balanced", &scene.reuse));
   const RunResult one = RunScene(scene, 1, 200);
@@ -142,7 +117,6 @@ TEST(DeterminismTest, OneAndTwoThreadsGiveIdenticalResultsWithReuse) {
 // which sphxr_bench_blocks times against them), with reuse off and on. tests/sim/cpu_stages_test.cpp
 // checks the same for one density pass per layout on made-up particles; this runs the whole solver.
 TEST(DeterminismTest, DensityBlocksFittedToTheParticlesGiveThePairsBits) {
-  if (RerunWithPassiveWaiting()) return;
   SceneSetup scene = test::SmallDamBreak(0.01f);
   {
     SCOPED_TRACE("reuse off");

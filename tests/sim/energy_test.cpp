@@ -1,5 +1,5 @@
 // Walls with their own density (tank.wall_pressure = "wall_density") make fluid and walls one Hamiltonian
-// system (docs/physics.md, "Walls"): without viscosity the total energy (sim/measure.h SphEnergy, which
+// system (docs/design/walls.md): without viscosity the total energy (sim/measure.h SphEnergy, which
 // recomputes every density in double precision with its own kernel) is conserved up to the integrator's
 // error, and with viscosity it can only fall. Mirrored walls are not the derivative of any energy: without
 // viscosity the same measure runs away (the water is thrown about and hits the domain clamp), which
@@ -93,8 +93,8 @@ TEST(Energy, WallDensityWithoutViscosityConservesItToTheIntegratorsError) {
   RecordProperty("half_step_deviation_ratio", std::to_string(MaxDeviation(h) / MaxDeviation(t)));
   ASSERT_GT(t.maxKinetic, 1e-3) << "the column must have moved (it settles under its weight)";
   // A clamp takes energy out, which could hide energy the step puts in; so the samples are E plus what
-  // the clamps have taken out so far, the energy of the step alone. (The test asked for no clamp at all until
-  // 2026-12-02. Without viscosity a surface particle may graze a wall, where the walls push back only
+  // the clamps have taken out so far, the energy of the step alone. (The test once asked for no clamp at all.
+  // Without viscosity a surface particle may graze a wall, where the walls push back only
   // as much as its pressure, about zero at the surface: on the AVX-512 tier's rounding one does, for 6
   // steps at 0.76 s, taking out 5.0e-6 J against a deviation of 1.7e-4 J; on the AVX tier none does.)
   EXPECT_LT(MaxDeviation(t), 0.03 * t.maxKinetic) << t.clamped << " clamps";

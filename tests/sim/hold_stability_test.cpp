@@ -1,11 +1,10 @@
 // The solver's integrator (IntegrateStage, sim/src/stages.h) with an acceleration computed once and
 // held for k steps, as activity-based reuse holds it, against the analytic k-step map of one sound
-// mode x'' = -w^2 x (docs/reuse_history.md, "Why holding the acceleration cannot be stable at the CFL step";
-// bench/hold_stability.py prints the same table):
+// mode x'' = -w^2 x (docs/design/impulse_hold.md, why the held acceleration was retired):
 //   x_k = (1 - (w dt)^2 k(k+1)/2) x_0 + k u_0,   u_k = -k (w dt)^2 x_0 + u_0,   u = v dt,
 // whose determinant 1 + (w dt)^2 k(k-1)/2 exceeds 1 for every k >= 2. If the integrator changes (to
-// velocity Verlet, say), these tests fail and the page's argument must be redone. The impulse hold
-// (reuse.impulse >= 1) is checked against its own map below.
+// velocity Verlet, say), these tests fail and the page's argument must be redone. The impulse hold,
+// the hold the solver uses, is checked against its own map below.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -43,12 +42,11 @@ struct OneParticle {
     const IntegrateStage stage{View(), ph, dt};
     for (int s = 0; s < k; ++s) stage(0);
   }
-  // The same cycle under the impulse hold (reuse.impulse >= 1, IDLE = k - 1): the particle computes
+  // The same cycle under the impulse hold (IDLE = k - 1): the particle computes
   // and goes inactive (IC = IDLE), then reuses for IDLE steps (IC = IDLE - 1 ... 0), as ActivityStage
   // leaves the idle counts before each integration.
   void ImpulseCycle(double w, int k) {
     ph.reuseEnabled = true;
-    ph.reuseImpulse = true;
     ph.reuseIdle = k - 1;
     host.acceleration[0] = Vec4{static_cast<float>(-w * w * host.position[0].x), 0.0f, 0.0f, 0.0f};
     const IntegrateStage stage{View(), ph, dt};
@@ -121,7 +119,7 @@ TEST(HoldStability, HoldingForFourStepsGrowsAModeThatReuseOffKeepsBounded) {
   EXPECT_LT(held, 20.0 * std::pow(7.0, 5));
 }
 
-// The impulse hold (docs/reuse.md, "Why the impulse hold is stable"): kick k dt a on the computing step, then drift.
+// The impulse hold (docs/design/impulse_hold.md): kick k dt a on the computing step, then drift.
 // Its k-step map is symplectic Euler at the step k dt, x_k = (1 - k^2 (w dt)^2) x_0 + k u_0,
 // u_k = -k (w dt)^2 x_0 + u_0, with determinant exactly 1 (no phase-space growth) for every k.
 TEST(HoldStability, ImpulseHoldIsSymplecticEulerAtTheHeldStep) {

@@ -1,7 +1,7 @@
 // Activity-based property reuse (Huang et al. 2013, section 3.3): identical results when it cannot
-// skip anything, the IDLE bound during a splash, the classification in a deep tank at rest, the
-// guard against reuse's instability, and the fast preset through 10 s of a violent scene.
-// The measured trade is bench/reuse.cpp's (docs/reuse.md).
+// skip anything, the IDLE bound and the impulse hold's schedule during a splash, the classification in
+// a deep tank at rest, the impulse hold's stability there, and the fast preset through 10 s of a violent
+// scene. The measured trade is bench/reuse.cpp's (docs/design/impulse_hold.md).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -72,15 +72,14 @@ TEST(Reuse, DisabledIsBitIdenticalToTheCoreSolver) {
   ExpectBitIdenticalRuns(core, disabled);
 }
 
-// Both holds during a splash: no particle reuses more than IDLE consecutive steps, and with the
-// impulse hold particles go inactive only on the synchronised steps (numbers a multiple of IDLE + 1).
-void ExpectIdleBoundAndSchedule(int impulse, int idle) {
+// During a splash no particle reuses more than IDLE consecutive steps, and particles go inactive only
+// on the impulse hold's synchronised steps (numbers a multiple of IDLE + 1).
+void ExpectIdleBoundAndSchedule(int idle) {
   SceneSetup scene = SmallDamBreak();  // a splash: the column collapses and hits the far wall
   scene.reuse.enabled = true;
   scene.reuse.delta1 = 0.1f;
   scene.reuse.threshold = 1.3f;
   scene.reuse.idle = idle;
-  scene.reuse.impulse = impulse;
   auto solver = Make(scene);
   ASSERT_TRUE(solver);
   std::map<uint32_t, int> run;  // id -> consecutive steps reused so far
@@ -109,70 +108,11 @@ void ExpectIdleBoundAndSchedule(int impulse, int idle) {
   EXPECT_GT(reusedSteps, 0) << "the settings never let a particle reuse: the test would prove nothing";
   EXPECT_LE(longest, idle);
   EXPECT_EQ(solver->FluidCount(), static_cast<int>(host.size()));
-  if (impulse != 0) {
-    EXPECT_EQ(offSchedule, 0) << "of " << startSteps << " steps where particles went inactive";
-  } else {
-    EXPECT_GT(offSchedule, 0) << "the held acceleration has no schedule: particles start on any step";
-  }
+  EXPECT_EQ(offSchedule, 0) << "of " << startSteps << " steps where particles went inactive";
 }
 
 TEST(Reuse, NoParticleReusesMoreThanIdleConsecutiveSteps) {
-  ExpectIdleBoundAndSchedule(0, 4);  // the paper's held acceleration
-  ExpectIdleBoundAndSchedule(1, 3);  // the impulse hold
-  ExpectIdleBoundAndSchedule(2, 3);  // with live density
-}
-
-// Live density (reuse.impulse = 2): a reusing particle within one support radius of a computing one
-// (so in its 27 cells) gets its density recomputed; one with no computing particle within two cell
-// diagonals keeps it bit for bit, as every reusing particle does without live density.
-void LiveDensityCounts(int impulse, int64_t* nearChanged, int64_t* nearKept, int64_t* farChanged, int64_t* farKept) {
-  SceneSetup scene = SmallDamBreak();
-  scene.reuse.enabled = true;
-  scene.reuse.delta1 = 0.1f;
-  scene.reuse.threshold = 1.6f;
-  scene.reuse.idle = 3;
-  scene.reuse.impulse = impulse;
-  scene.reuse.accelTolerance = 0.0f;
-  auto solver = Make(scene);
-  ASSERT_TRUE(solver);
-  const float h = solver->SupportRadius();
-  const float far = 2.0f * std::sqrt(3.0f) * solver->Grid().cellSize;
-  *nearChanged = *nearKept = *farChanged = *farKept = 0;
-  HostFluid before, after;
-  while (solver->Time() < 0.15) {
-    solver->Download(&before);
-    ASSERT_TRUE(solver->Step().ok());
-    solver->Download(&after);
-    std::map<uint32_t, size_t> at;  // the particles are sorted every step: match them by id
-    for (size_t i = 0; i < before.size(); ++i) at[before.id[i]] = i;
-    std::vector<Vec3> computing;
-    for (size_t i = 0; i < after.size(); ++i) {
-      if (after.idle[i] < 0 || after.idle[i] == scene.reuse.idle) computing.push_back(Xyz(after.position[i]));
-    }
-    for (size_t i = 0; i < after.size(); ++i) {
-      if (!(after.idle[i] >= 0 && after.idle[i] < scene.reuse.idle)) continue;  // reused in this step
-      float nearest = 1e30f;
-      for (const Vec3& c : computing) nearest = std::min(nearest, Length(Xyz(after.position[i]) - c));
-      const bool changed = after.density[i] != before.density[at[after.id[i]]];
-      if (nearest < h) {
-        ++*(changed ? nearChanged : nearKept);
-      } else if (nearest > far) {
-        ++*(changed ? farChanged : farKept);
-      }
-    }
-  }
-}
-
-TEST(Reuse, LiveDensityRecomputesTheReusingNeighboursOfComputingParticles) {
-  int64_t nearChanged, nearKept, farChanged, farKept;
-  LiveDensityCounts(2, &nearChanged, &nearKept, &farChanged, &farKept);
-  ASSERT_GT(nearChanged + nearKept, 100) << "too few reusing particles next to computing ones to tell";
-  EXPECT_GT(nearChanged, 0.95 * static_cast<double>(nearChanged + nearKept)) << nearKept << " kept";
-  EXPECT_EQ(farChanged, 0) << "of " << farChanged + farKept << " reusing particles far from any computing one";
-  LiveDensityCounts(1, &nearChanged, &nearKept, &farChanged, &farKept);
-  ASSERT_GT(nearChanged + nearKept, 100);
-  EXPECT_EQ(nearChanged, 0) << "without live density every reusing particle keeps its density";
-  EXPECT_EQ(farChanged, 0);
+  ExpectIdleBoundAndSchedule(3);
 }
 
 // A deep pool (16 x 32 x 16 spacings) starting hydrostatic, settled with reuse off, then classified
@@ -194,7 +134,6 @@ TEST(Reuse, DeepTankAtRestIsMostlyInactiveButItsSurfaceIsActive) {
   ASSERT_TRUE(solver);
   ReuseParams reuse;
   ASSERT_TRUE(ApplyReusePreset("balanced", &reuse));
-  reuse.accelTolerance = 0.0f;  // the classification alone (the guard is the next test's)
   // The impulse hold lets particles go inactive only on steps whose number is a multiple of IDLE + 1:
   // settle to such a step.
   while (solver->Time() < 0.2 || (solver->Clock().steps + 1) % (reuse.idle + 1) != 0) {
@@ -250,45 +189,19 @@ float DeepTankMaxSpeed(const ReuseParams* reuse, double* active) {
   return v;
 }
 
-// Reusing accelerations at a CFL-limited step acts like a multiple of that step on the pressure
-// waves: with the paper's held acceleration and no guard (accel_tolerance 0) a deep tank at rest
-// blows up within 0.15 s (measured: 8 m/s, 2 % mean density error in docs/reuse_history.md); the guard keeps
-// it as calm as reuse off.
-TEST(Reuse, GuardKeepsADeepTankAsCalmAsReuseOff) {
+// Reusing accelerations at a CFL-limited step acts like a multiple of that step on the pressure waves:
+// the paper's held acceleration blew this tank up within 0.15 s (docs/design/impulse_hold.md). The
+// impulse hold with `balanced` (IDLE 3) stays as calm as reuse off, while most particles reuse.
+TEST(Reuse, ImpulseHoldKeepsADeepTankCalm) {
   double active = 1.0;
   const float off = DeepTankMaxSpeed(nullptr, &active);
-  ReuseParams held;
-  ASSERT_TRUE(ApplyReusePreset("balanced", &held));
-  held.impulse = 0;
-  held.idle = 3;
-  held.accelTolerance = 0.3f;
-  const float guarded = DeepTankMaxSpeed(&held, &active);
-  ASSERT_TRUE(std::isfinite(guarded));
-  EXPECT_LT(guarded, 2.0f * off) << "reuse off " << off << " m/s, held and guarded " << guarded << " m/s";
-  EXPECT_LT(active, 1.0) << "the guard must not switch reuse off entirely";
-  held.accelTolerance = 0.0f;
-  const float unguarded = DeepTankMaxSpeed(&held, &active);
-  EXPECT_FALSE(unguarded < 2.0f * off) << "held without the guard: " << unguarded << " m/s; the guard would be "
-                                       << "unnecessary and docs/reuse_history.md wrong";
-}
-
-// The impulse hold needs no guard: `balanced` (IDLE 3, guard off), with and without live density,
-// stays as calm as reuse off in the tank where the held acceleration blows up, while most particles
-// reuse.
-TEST(Reuse, ImpulseHoldKeepsADeepTankCalmWithoutTheGuard) {
-  double active = 1.0;
-  const float off = DeepTankMaxSpeed(nullptr, &active);
-  for (int hold : {1, 2}) {
-    ReuseParams impulse;
-    ASSERT_TRUE(ApplyReusePreset("balanced", &impulse));
-    ASSERT_EQ(impulse.accelTolerance, 0.0f) << "balanced runs without the guard";
-    ASSERT_EQ(impulse.idle, 3);
-    impulse.impulse = hold;
-    const float on = DeepTankMaxSpeed(&impulse, &active);
-    ASSERT_TRUE(std::isfinite(on));
-    EXPECT_LT(on, 2.0f * off) << "reuse off " << off << " m/s, the impulse hold (" << hold << ") " << on << " m/s";
-    EXPECT_LT(active, 0.6) << "most particles should reuse in a tank at rest (hold " << hold << ")";
-  }
+  ReuseParams impulse;
+  ASSERT_TRUE(ApplyReusePreset("balanced", &impulse));
+  ASSERT_EQ(impulse.idle, 3);
+  const float on = DeepTankMaxSpeed(&impulse, &active);
+  ASSERT_TRUE(std::isfinite(on));
+  EXPECT_LT(on, 2.0f * off) << "reuse off " << off << " m/s, the impulse hold " << on << " m/s";
+  EXPECT_LT(active, 0.6) << "most particles should reuse in a tank at rest";
 }
 
 // The fast preset through 10 simulated seconds of a violent scene: a 1 m dam break at 8 cm spacing

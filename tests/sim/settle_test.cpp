@@ -1,5 +1,5 @@
-// Solver::Settle: FIRE (Bitzek et al. 2006) on the solver's own steps before a run (docs/physics.md,
-// "Tenth session"). A minimiser goes downhill: the energy after settling longer is lower, measured by
+// Solver::Settle: FIRE (Bitzek et al. 2006) on the solver's own steps before a run
+// (docs/design/settle.md). A minimiser goes downhill: the energy after settling longer is lower, measured by
 // sim/measure.h SphEnergy (its own kernel, densities recomputed in double precision), with walls that
 // have their own density so that fluid and walls are one Hamiltonian system (energy_test.cpp). Then the
 // bookkeeping: the clock and the step count restart at 0 with every particle at rest, progress is

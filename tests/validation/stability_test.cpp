@@ -21,7 +21,7 @@ namespace {
 // Multiples of sqrt(2 g H), the free-fall speed from the column top. Measured (1 s each): base 2.2,
 // stiffness x0.1 1.4, x100 4.85 (a few particles shot out where the jet hits the far wall at c = 150 m/s),
 // viscosity 0 2.5, x100 0.58, spacing x0.5 2.45, x2 1.7; with walls of their own density (the walls'
-// pressure from the fluid beside them, docs/physics.md "Walls") base 1.34, viscosity 0 1.45.
+// pressure from the fluid beside them, docs/design/walls.md) base 1.34, viscosity 0 1.45.
 constexpr float kSpeedBound = 5.0f;
 
 struct Extreme {

@@ -239,10 +239,10 @@ TEST(XrApp, ScriptedControllersPaddleMovesTheWaterAndAsksForHaptics) {
     const auto haptics = headset.dir / "haptics.txt";
     headset.env.Set("SPHXR_SIM_XR_HAPTICS_LOG", haptics.string());
     Result r;
-    // Walls with their own density: water left alone comes to rest (docs/physics.md, "Walls"), so the
+    // Walls with their own density: water left alone comes to rest (docs/design/walls.md), so the
     // run with the paddle above the water measures only the start's settling. With mirrored walls it
     // keeps a circulation going: peak mean speed 0.056-0.058 m/s against a stirred 0.14-0.15 m/s on
-    // the AMD EPYC this test met on 2026-11-24 (0.29-0.49 on the earlier Xeon), too close for 3x.
+    // one machine (0.29-0.49 on another), too close for 3x.
     r.run = RunSphxr("--xr --scene " + WriteScene(headset.dir, kRightPaddle, "wall_density").string() +
                          " --frame-limit 270 --spacing 0.02 --set stiffness=10000" + kCommon,
                      headset.dir);

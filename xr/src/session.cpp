@@ -166,7 +166,7 @@ Status ProbeRuntime() {
   if (r == XR_ERROR_RUNTIME_UNAVAILABLE || r == XR_ERROR_RUNTIME_FAILURE || r == XR_ERROR_INSTANCE_LOST ||
       r == XR_ERROR_INITIALIZATION_FAILED)
     return Status::Error(Format("no OpenXR runtime available (the loader answered %s): start a runtime (Monado, "
-                                "SteamVR, ...) or point XR_RUNTIME_JSON at one; docs/xr.md shows the simulated headset",
+                                "SteamVR, ...) or point XR_RUNTIME_JSON at one; docs/dev/xr.md shows the simulated headset",
                                 ResultName(r)));
   SPHXR_XR_CHECK_RESULT(xrEnumerateInstanceExtensionProperties, r);
   std::vector<XrExtensionProperties> exts(count, {XR_TYPE_EXTENSION_PROPERTIES});

@@ -1,6 +1,6 @@
 #pragma once
 // The simulated headset: an OpenXR 1.0 runtime of our own, loaded by the Khronos loader through
-// its manifest (XR_RUNTIME_JSON). Private to the runtime library; see docs/xr.md for its settings.
+// its manifest (XR_RUNTIME_JSON). Private to the runtime library; see docs/dev/xr.md for its settings.
 //
 // One mutex guards everything: the runtime serves one application with one session, and nothing in
 // it is hot. Handles are pointers to the objects below, each starting with a tag checked on entry.
@@ -25,7 +25,7 @@
 
 namespace sphxr::xr::simrt {
 
-/// Settings, read from the environment at xrCreateInstance (docs/xr.md lists them).
+/// Settings, read from the environment at xrCreateInstance (docs/dev/xr.md lists them).
 struct Config {
   double rateHz = 90.0;
   int eyeWidth = 1024, eyeHeight = 1024;

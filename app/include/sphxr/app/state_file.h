@@ -1,6 +1,6 @@
 #pragma once
 // State files: the fluid and the clock of a run, to restart from (`sphxr --save-state FILE`,
-// `--load-state FILE`; docs/scenes.md "State files"). Every field of the one field list
+// `--load-state FILE`; docs/user/scenes.md "State files"). Every field of the one field list
 // (sim/fields.h) is stored with its name and element size, so a file from a build with other fields
 // is refused by name instead of being misread (DFSPH's warm-start fields kappa and kappaV may be
 // missing: zero). Binary, little-endian, version 3 (read too: version 2 lacks the method, version 1

@@ -8,7 +8,7 @@
 //     --> per step: the fluid's force and torque on the body (sum of the boundary particles' reactions)
 //     --> low-pass filtered --> haptic amplitude 0..1 per hand
 //
-// The rules for the commanded pose (docs/paddles.md):
+// The rules for the commanded pose (docs/dev/paddles.md):
 // - it moves towards the hand at most `maxSpeed` (m/s) and `maxAngularSpeed` (rad/s);
 // - teleport: a hand pose further than `teleportDistance` from the commanded pose (beyond what the
 //   hand's own measured velocity explains over the frame) is not followed at once: the paddle glides

@@ -30,8 +30,8 @@ struct MomentumSummary {
 };
 MomentumSummary Momentum(const HostFluid& fluid);
 
-/// The energy the solver's conservative forces derive from, in joules (docs/physics.md, "Why still water
-/// rattles"): kinetic, gravity (zero at y = 0), the fluid's Tait internal energy sum_i m e(rho_i) with
+/// The energy the solver's conservative forces derive from, in joules (docs/design/settle.md):
+/// kinetic, gravity (zero at y = 0), the fluid's Tait internal energy sum_i m e(rho_i) with
 /// e' = p / rho^2 (e = 0 at and below rho0, where p is clamped to 0), and, for walls with their own density
 /// (boundary.invReference not empty), the walls' sum_b M_b e(rho_b) with rho_b = rho0 invReference_b
 /// sum_f W_bf and M_b = m Psi_b / (rho0 invReference_b): the force of that energy on a fluid particle is

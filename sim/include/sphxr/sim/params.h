@@ -71,6 +71,10 @@ struct FluidBlock {
 /// delta2 N_CPN / N_i with P_i the previous step's pressure and N_i the mean particle count of the 27
 /// cells around i; ACT_i < threshold makes i inactive for `idle` steps, in which it keeps its density,
 /// pressure and acceleration. Disabled, the step is exactly the plain WCSPH step.
+/// How a particle that reuses moves: the impulse hold (docs/design/impulse_hold.md). A particle goes
+/// inactive only on steps whose number is a multiple of IDLE + 1 (the synchronised schedule), takes the
+/// kick of all its IDLE + 1 steps, (IDLE + 1) dt a, on the step it computes, and drifts at that velocity
+/// while it reuses; measured stable to IDLE 3 at the CFL step (IDLE 5 blew up).
 struct ReuseParams {
   bool enabled = false;
   float delta1 = 1.0f;
@@ -79,22 +83,10 @@ struct ReuseParams {
   int idle = 3;                  // IDLE: consecutive steps a particle reuses its values
   float pressureScale = 0.0f;    // P_pc, Pa; 0 = the Tait pressure at 1 % compression
   float cellCount = 0.0f;        // N_CPN; 0 = (cell size / spacing)^3, the rest lattice's count
-  /// Our rule beyond the paper: a particle whose acceleration changed by more than this many |g| since
-  /// its last computation stays active for IDLE + 1 steps before it is classified again (0 = off).
-  float accelTolerance = 0.1f;
-  /// How a particle that reuses moves (docs/reuse.md, "The algorithm as built"). 1 (the default) and 2,
-  /// the impulse hold: a particle goes inactive only on steps whose number is a multiple of IDLE + 1
-  /// (the synchronised schedule), takes the kick of all its IDLE + 1 steps, (IDLE + 1) dt a, on the step
-  /// it computes, and drifts at that velocity while it reuses; measured stable to IDLE 3 at the CFL
-  /// step (IDLE 5 blew up). 2 adds live density: a reusing particle with a computing one in its 27
-  /// cells recomputes its density and pressure (not its force); measured slower and no more accurate.
-  /// 0: the paper's held acceleration (applied on every step it is reused), which only the acceleration
-  /// tolerance keeps stable.
-  int impulse = 1;
 };
 
-/// The presets chosen from the measured trade (docs/reuse.md): "accurate", "balanced", "fast".
-/// Each sets delta1, delta2, threshold, idle, the acceleration tolerance and the hold (impulse) and turns reuse on; the derived constants
+/// The presets chosen from the measured trade (docs/design/impulse_hold.md): "accurate", "balanced", "fast".
+/// Each sets delta1, delta2, threshold and idle and turns reuse on; the derived constants
 /// (pressure_scale, cell_count) are left as they are. False for an unknown name.
 bool ApplyReusePreset(const std::string& name, ReuseParams* reuse);
 /// The preset names, for help texts and errors: "accurate, balanced, fast".
@@ -112,7 +104,7 @@ struct SceneSetup {
   /// A dry floor drags on a spreading front much more than glass side walls drag on the column.
   float floorViscosity = -1.0f;
   int boundaryLayers = 1;        // layers of boundary particles behind each wall
-  /// How a wall particle's pressure is found (docs/physics.md, "Walls"). kMirrored: p_b = the fluid
+  /// How a wall particle's pressure is found (docs/design/walls.md). kMirrored: p_b = the fluid
   /// particle's own pressure (at least its neighbours' Shepard average); matches Martin & Moyce, but
   /// is not the derivative of an energy and keeps still water circulating at ~1 cm/s. kWallDensity:
   /// each wall particle's own density from the fluid around it; energy-consistent, still water comes

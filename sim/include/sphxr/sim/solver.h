@@ -31,7 +31,7 @@ struct SolverConfig {
   bool validate = false;  // check every stage for non-finite values (slow)
   /// CPU backend: density blocks from pairs of cells only, not the boxes fitted to the particles, and
   /// with reuse drawn from every particle with the lanes that reuse masked, not from the compacted list
-  /// (docs/performance.md, "Density blocks fitted to the particles"): the layout before both. The
+  /// (docs/design/simd_stages.md): the layout before both. The
   /// results are the same bit for bit; sphxr_bench_blocks steps both layouts in lock-step to time them.
   bool pairDensityBlocks = false;
 };
@@ -119,7 +119,7 @@ class Solver {
   /// rolled back (the caller stops).
   Status Step();
 
-  /// Relaxes the water toward a rest state before a run (docs/physics.md, "Tenth session"): `seconds`
+  /// Relaxes the water toward a rest state before a run (docs/design/settle.md): `seconds`
   /// of the solver's own steps, each followed by FIRE's velocity mixing (Bitzek et al. 2006): while the
   /// forces do work (sum a.v > 0) v <- (1 - alpha) v + alpha |v| a/|a|, with alpha falling from 0.1 by
   /// 1 % per step after five such steps in a row; when they do not, every particle stops and alpha is
@@ -186,7 +186,7 @@ class Solver {
   /// Signed distance of a world point to body `body`'s solid at its current pose (negative inside).
   float BodyDistance(int body, Vec3 point) const;
 
-  /// The water surface by histogram-pyramid marching cubes (docs/surface.md), from the current particles.
+  /// The water surface by histogram-pyramid marching cubes (docs/dev/surface.md), from the current particles.
   /// Into the solver's own mesh buffer (grown when needed, reported in stats and the log); the view is
   /// valid until the next extraction.
   Status ExtractSurface(const SurfaceParams& params, SurfaceMeshView* view, SurfaceStats* stats = nullptr);

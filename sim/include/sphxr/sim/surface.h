@@ -9,7 +9,7 @@
 // 0.5 half a spacing outside the outermost particle layer of a flat surface. The surface is phi = iso.
 //
 // The mesh is a triangle soup: vertex 3t, 3t+1, 3t+2 is triangle t, counter-clockwise seen from outside
-// the water; positions and normals are float xyz (12 bytes each). No index buffer: see docs/surface.md.
+// the water; positions and normals are float xyz (12 bytes each). No index buffer: see docs/dev/surface.md.
 #include <cstdint>
 #include <vector>
 

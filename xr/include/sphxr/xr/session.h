@@ -33,7 +33,7 @@ enum class SessionState { kUnknown, kIdle, kReady, kSynchronized, kVisible, kFoc
 const char* SessionStateName(SessionState state);
 
 /// What the application hands in to make its GL context the session's. One member per platform
-/// binding of XR_KHR_opengl_enable; Linux uses Xlib/GLX, Windows would fill `win32` (see docs/xr.md).
+/// binding of XR_KHR_opengl_enable; Linux uses Xlib/GLX, Windows would fill `win32` (see docs/dev/xr.md).
 struct GraphicsBinding {
   /// Loads GL entry points (glfwGetProcAddress, eglGetProcAddress, ...): xr needs a few GL 3.0
   /// framebuffer functions and does not bring its own loader.
