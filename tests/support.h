@@ -63,15 +63,29 @@ inline SceneSetup SmallDamBreak(float spacing = 0.01f) {
   return s;
 }
 
-/// The backend the suites run on: `cpu`, or the one SPHXR_TEST_DEVICE names (cpu, cpu-reference, cuda).
-/// ctest runs the sim and interaction suites once more with SPHXR_TEST_DEVICE=cpu-reference, so that the
-/// CUDA backend's orchestration passes every behaviour test here (docs/dev/backends.md). An unknown
-/// name fails loudly rather than testing the wrong backend.
+/// The backend named by the argument --sphxr-device=NAME, else by SPHXR_TEST_DEVICE; empty: none named.
+/// ctest passes the argument (tests/CMakeLists.txt): gtest_discover_tests (CMake 3.25) splits a list in
+/// PROPERTIES, so a discovered test's ENVIRONMENT cannot hold a second variable beside OMP_WAIT_POLICY.
+/// gtest_main leaves arguments it does not know alone; the test reads its own command line.
+inline std::string TestDeviceName() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  const std::string flag = "--sphxr-device=";
+  for (std::string arg; std::getline(in, arg, '\0');) {
+    if (arg.rfind(flag, 0) == 0) return arg.substr(flag.size());
+  }
+  const char* env = std::getenv("SPHXR_TEST_DEVICE");
+  return env ? env : "";
+}
+
+/// The backend the suites run on: `cpu`, or the one TestDeviceName names (cpu, cpu-reference, cuda).
+/// ctest runs the sim and interaction suites once more on cpu-reference, so that the CUDA backend's
+/// orchestration passes every behaviour test here (docs/dev/backends.md). An unknown name fails loudly
+/// rather than testing the wrong backend.
 inline sim::Device TestDevice() {
-  const char* name = std::getenv("SPHXR_TEST_DEVICE");
+  const std::string name = TestDeviceName();
   sim::Device d = sim::Device::kCpu;
-  if (name && *name && (!sim::ParseDevice(name, &d) || d == sim::Device::kAuto)) {
-    std::fprintf(stderr, "SPHXR_TEST_DEVICE=%s: must be cpu, cpu-reference or cuda\n", name);
+  if (!name.empty() && (!sim::ParseDevice(name, &d) || d == sim::Device::kAuto)) {
+    std::fprintf(stderr, "test device '%s': must be cpu, cpu-reference or cuda\n", name.c_str());
     std::abort();
   }
   return d;
@@ -106,7 +120,7 @@ inline sim::SolverConfig TestConfig() {
 /// all cores.
 inline sim::SolverConfig AllCoresConfig() {
   sim::SolverConfig c;
-  if (std::getenv("SPHXR_TEST_DEVICE")) c.device = TestDevice();
+  if (!TestDeviceName().empty()) c.device = TestDevice();
   return c;
 }
 

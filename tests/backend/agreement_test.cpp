@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,10 @@ struct Pair {
   Device tested;
   const char* name;
 };
+
+// Readable parameters in gtest's and ctest's output.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const Pair& p, std::ostream* os) { *os << p.name; }
 
 class BackendAgreement : public ::testing::TestWithParam<std::tuple<Pair, Case>> {};
 
@@ -217,7 +222,9 @@ TEST_P(BackendAgreement, OneStepFromTheSameStateAgreesToRounding) {
     }
     worst.steps = step;
   }
-  if (setup.reuse.enabled) EXPECT_LT(leastActive, 0.9f) << "reuse never skipped a tenth of the particles";
+  if (setup.reuse.enabled) {
+    EXPECT_LT(leastActive, 0.9f) << "reuse never skipped a tenth of the particles";
+  }
   // For the record (ctest --output-on-failure, scripts/gpu_check.sh): the largest difference as a
   // fraction of its bound, and in SI units.
   std::printf("[agreement] %s %s vs cpu-reference, %d steps: worst |dx| %.3g m (%.3g of bound), |dv| %.3g m/s (%.3g), "
