@@ -7,6 +7,7 @@
 #include <string>
 
 #include "backend_guard.h"
+#include "support.h"
 
 namespace sphxr::sim {
 namespace {
@@ -34,6 +35,19 @@ TEST(GuardBackend, ASystemErrorIsOneLineWithItsText) {
       &last);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.message(), "cuda backend: the step (in its first stage) failed: parallel_for failed: cudaErrorIllegalAddress");
+}
+
+// A bug, not an error of the environment: an index past the bodies stops a debug build with the
+// condition and place (SPHXR_ASSERT); a release build compiles the check out.
+TEST(SphxrAssert, ABodyIndexPastTheBodiesStopsADebugBuild) {
+#ifdef NDEBUG
+  GTEST_SKIP() << "a release build: SPHXR_ASSERT is compiled out";
+#else
+  ::testing::GTEST_FLAG(death_test_style) = "threadsafe";
+  auto solver = test::CreateOrFail(test::SmallDamBreak(0.02f));
+  ASSERT_TRUE(solver);
+  EXPECT_DEATH((void)solver->BodyPose(0), "SPHXR_ASSERT\\(body >= 0 && body < BodyCount\\(\\)\\) failed");
+#endif
 }
 
 }  // namespace
