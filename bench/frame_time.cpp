@@ -25,19 +25,27 @@ namespace {
 using sphxr::bench::Median;
 using sphxr::bench::Ms;
 
-const char* kUsage = "usage: sphxr_bench_frame [--steps N] [--frames M] [--threads T]\n";
+const char* kUsage = "usage: sphxr_bench_frame [--steps N] [--frames M] [--threads T] [--device cpu|cuda|cpu-reference]\n";
 
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace sphxr;
   int steps = 30, frames = 10, threads = 0;  // threads 0: all cores
+  sim::Device device = sim::Device::kCpu;
   // All options are checked here, before the GL context: a typo fails at once, also without a display.
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
       std::printf("%s", kUsage);
       return 0;
+    }
+    if (a == "--device" && i + 1 < argc) {
+      if (!sim::ParseDevice(argv[++i], &device) || device == sim::Device::kAuto) {
+        std::fprintf(stderr, "sphxr_bench_frame: --device %s: must be cpu, cuda or cpu-reference\n", argv[i]);
+        return 2;
+      }
+      continue;
     }
     int* value = a == "--steps" ? &steps : a == "--frames" ? &frames : a == "--threads" ? &threads : nullptr;
     if (!value || i + 1 >= argc) {
@@ -74,7 +82,7 @@ int main(int argc, char** argv) {
     if (Status s = app::LoadScene(c.file, &scene); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
     if (c.spacing > 0.0f) scene.setup.params.spacing = c.spacing;
     sim::SolverConfig sc;
-    sc.device = sim::Device::kCpu;
+    sc.device = device;
     sc.threads = threads;
     std::unique_ptr<sim::Solver> solver;
     if (Status s = sim::Solver::Create(scene.setup, sc, &solver); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;

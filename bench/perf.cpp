@@ -48,6 +48,7 @@ constexpr double kBusyLoad = 0.5;
 struct Args {
   bool quick = false;
   int threads = 0;  // 0 = all cores
+  sim::Device device = sim::Device::kCpu;
   std::string csv;
   std::string scene = SPHXR_SCENES_DIR "/dam_break_1m.json";
   std::vector<float> spacings;  // empty: the defaults
@@ -56,8 +57,9 @@ struct Args {
 };
 
 const char* kUsage =
-    "usage: sphxr_bench_perf [--quick] [--threads N] [--csv FILE] [--scene FILE] [--spacing H]...\n"
+    "usage: sphxr_bench_perf [--quick] [--threads N] [--device D] [--csv FILE] [--scene FILE] [--spacing H]...\n"
     "                        [--warmup N] [--measured N]\n"
+    "  --device D    cpu (default), cuda or cpu-reference (scripts/gpu_check.sh times cuda)\n"
     "  --quick       20 warm-up + 20 measured steps, 50k particles only (a smoke run)\n"
     "  --threads N   CPU backend threads (default 0 = all cores)\n"
     "  --csv FILE    append one row per configuration to FILE (header written when the file is new)\n"
@@ -83,6 +85,12 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     } else if (a == "--threads") {
       if (!next(&v)) return false;
       if (!IntegerOption("sphxr_bench_perf", a, v, 0, 1024, &out->threads)) return false;
+    } else if (a == "--device") {
+      if (!next(&v)) return false;
+      if (!sim::ParseDevice(v, &out->device) || out->device == sim::Device::kAuto) {
+        std::fprintf(stderr, "sphxr_bench_perf: --device %s: must be cpu, cuda or cpu-reference\n", v);
+        return false;
+      }
     } else if (a == "--csv") {
       if (!next(&v)) return false;
       out->csv = v;
@@ -204,7 +212,7 @@ bool RunConfiguration(const Args& args, float spacing, int warmup, int measured,
   const auto begin = std::chrono::steady_clock::now();
 
   sim::SolverConfig config;
-  config.device = sim::Device::kCpu;
+  config.device = args.device;
   config.threads = args.threads;
   std::unique_ptr<sim::Solver> solver;
   if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) {

@@ -42,8 +42,9 @@ namespace {
 
 const char* kUsage =
     "usage: sphxr_bench_surface [--threads N] [--time S] [--repeat N] [--run K] [--compare-runs K,K,...]\n"
-    "                           [--csv FILE] [--scene FILE]\n"
+    "                           [--csv FILE] [--scene FILE] [--device D]\n"
     "  --threads N  CPU backend threads (default 2)\n"
+    "  --device D   cpu (default), cuda or cpu-reference (scripts/gpu_check.sh times cuda)\n"
     "  --time S     simulated time before measuring (default 0.5 s, mid-collapse)\n"
     "  --repeat N   extractions per cell size (default 15)\n"
     "  --run K      traversal vertices per work item (default 0: the backend's, 256)\n"
@@ -65,6 +66,7 @@ int Run(int argc, char** argv) {
   std::vector<int> compareRuns;
   double time = 0.5;
   std::string csv, scenePath = SPHXR_SCENES_DIR "/dam_break_1m.json";
+  sim::Device device = sim::Device::kCpu;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool hasValue = i + 1 < argc;
@@ -93,6 +95,12 @@ int Run(int argc, char** argv) {
         std::fprintf(stderr, "sphxr_bench_surface: --compare-runs %s: must be integers from 1 to 1000000, comma-separated\n",
                      v);
       }
+    } else if (a == "--device" && hasValue) {
+      const char* v = argv[++i];
+      if (!sim::ParseDevice(v, &device) || device == sim::Device::kAuto) {
+        std::fprintf(stderr, "sphxr_bench_surface: --device %s: must be cpu, cuda or cpu-reference\n", v);
+        ok = false;
+      }
     } else if (a == "--csv" && hasValue) csv = argv[++i];
     else if (a == "--scene" && hasValue) scenePath = argv[++i];
     else {
@@ -107,7 +115,7 @@ int Run(int argc, char** argv) {
     return 1;
   }
   sim::SolverConfig config;
-  config.device = sim::Device::kCpu;
+  config.device = device;
   config.threads = threads;
   std::unique_ptr<sim::Solver> solver;
   if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) {

@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -61,13 +63,64 @@ inline SceneSetup SmallDamBreak(float spacing = 0.01f) {
   return s;
 }
 
-/// The configuration the tests use unless they test threading or devices: the CPU backend on one thread.
-/// (ctest runs two test processes at once on a 2-core machine; two OpenMP teams of 2 spinning threads each
-/// slow every step down by two orders of magnitude.)
+/// The backend named by the argument --sphxr-device=NAME, else by SPHXR_TEST_DEVICE; empty: none named.
+/// ctest passes the argument (tests/CMakeLists.txt): gtest_discover_tests (CMake 3.25) splits a list in
+/// PROPERTIES, so a discovered test's ENVIRONMENT cannot hold a second variable beside OMP_WAIT_POLICY.
+/// gtest_main leaves arguments it does not know alone; the test reads its own command line.
+inline std::string TestDeviceName() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  const std::string flag = "--sphxr-device=";
+  for (std::string arg; std::getline(in, arg, '\0');) {
+    if (arg.rfind(flag, 0) == 0) return arg.substr(flag.size());
+  }
+  const char* env = std::getenv("SPHXR_TEST_DEVICE");
+  return env ? env : "";
+}
+
+/// The backend the suites run on: `cpu`, or the one TestDeviceName names (cpu, cpu-reference, cuda).
+/// ctest runs the sim and interaction suites once more on cpu-reference, so that the CUDA backend's
+/// orchestration passes every behaviour test here (docs/dev/backends.md). An unknown name fails loudly
+/// rather than testing the wrong backend.
+inline sim::Device TestDevice() {
+  const std::string name = TestDeviceName();
+  sim::Device d = sim::Device::kCpu;
+  if (!name.empty() && (!sim::ParseDevice(name, &d) || d == sim::Device::kAuto)) {
+    std::fprintf(stderr, "test device '%s': must be cpu, cpu-reference or cuda\n", name.c_str());
+    std::abort();
+  }
+  return d;
+}
+
+/// Every backend on this machine: cpu, cpu-reference, and cuda when a device answers (value-parameterised
+/// suites over backends).
+inline std::vector<sim::Device> AvailableDevices() {
+  std::vector<sim::Device> d = {sim::Device::kCpu, sim::Device::kCpuReference};
+  if (sim::CudaDeviceCount() > 0) d.push_back(sim::Device::kCuda);
+  return d;
+}
+
+/// A test name for a backend ("cpu_reference": gtest names take no '-').
+inline std::string DeviceTestName(sim::Device device) {
+  std::string s = sim::DeviceName(device);
+  for (char& c : s) c = c == '-' ? '_' : c;
+  return s;
+}
+
+/// The configuration the tests use unless they test threading or devices: the test backend (TestDevice)
+/// on one thread. (ctest runs two test processes at once on a 2-core machine; two OpenMP teams of 2
+/// spinning threads each slow every step down by two orders of magnitude.)
 inline sim::SolverConfig TestConfig() {
   sim::SolverConfig c;
-  c.device = sim::Device::kCpu;
+  c.device = TestDevice();
   c.threads = 1;
+  return c;
+}
+
+/// SolverConfig{} (the default device and every core) on the test backend, for the suites that run on
+/// all cores.
+inline sim::SolverConfig AllCoresConfig() {
+  sim::SolverConfig c;
+  if (!TestDeviceName().empty()) c.device = TestDevice();
   return c;
 }
 

@@ -221,7 +221,7 @@ int64_t StatsBytesToKeep(const std::string& path, const std::string& header, int
 std::string UsageText() {
   return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--settle S]\n"
          "             [--load-state FILE] [--save-state FILE]\n"
-         "             [--device auto|cpu|cuda] [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
+         "             [--device auto|cpu|cuda|cpu-reference] [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
          "             [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
@@ -249,7 +249,8 @@ std::string UsageText() {
          "                    file their save writes (the s key, the panel, the headset's save button)\n"
          "  --load-state FILE start from a state file instead of the scene's fluid (the same scene; its\n"
          "                    spacing is the file's); --time is then the end time on the file's clock\n"
-         "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda\n"
+         "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda; cpu-reference: the\n"
+         "                    CUDA backend's step run on the CPU (slow; for checking, docs/dev/backends.md)\n"
          "  --threads T       CPU backend threads (0 = all cores)\n"
          "  --spacing H       particle spacing in m (rescales the particle count of the scene)\n"
          "  --set KEY=VALUE   a parameter of the scene's \"solver\" section (stiffness=2e5) or \"reuse\" section\n"
@@ -326,7 +327,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->steps); !s) return s;
     } else if (arg == "--device") {
       if (Status s = value(&v); !s) return s;
-      if (!sim::ParseDevice(v, &out->device)) return Status::Error(arg + " " + v + ": must be auto, cpu or cuda");
+      if (!sim::ParseDevice(v, &out->device)) return Status::Error(arg + " " + v + ": must be auto, cpu or cuda (or cpu-reference)");
     } else if (arg == "--threads") {
       if (Status s = value(&v); !s) return s;
       int64_t t;

@@ -61,6 +61,9 @@ class Backend {
 
 /// `pairBlocks`: SolverConfig::pairDensityBlocks.
 std::unique_ptr<Backend> MakeCpuBackend(int threads, bool pairBlocks = false);
+/// The CUDA backend's orchestration on the host (backend_cpu_reference.cpp): every stage the per-particle
+/// form of stages.h, launched as backend_cuda.cu launches it, on thrust's OpenMP system.
+std::unique_ptr<Backend> MakeCpuReferenceBackend(int threads);
 /// Null when the CUDA backend is not compiled in; `*why` says so.
 std::unique_ptr<Backend> MakeCudaBackend(std::string* why);
 int CudaDevices();

@@ -13,7 +13,7 @@ struct OmpTraits {
   template <class T>
   using Vector = thrust::omp::vector<T>;
   static auto Policy() { return thrust::omp::par; }
-  static void Sync() {}
+  static Status Sync(const char* /*stage*/) { return Status::Ok(); }  // thrust's OpenMP calls return when done
   static constexpr const char* kName = "cpu";
   static constexpr bool kOnDevice = false;  // where the surface mesh lives
   static constexpr int kTraversalRun = 256;  // a descent per run of vertices: few threads, each stepping along the mesh

@@ -12,7 +12,17 @@ struct CudaTraits {
   template <class T>
   using Vector = thrust::cuda::vector<T>;
   static auto Policy() { return thrust::cuda::par; }
-  static void Sync() { cudaDeviceSynchronize(); }
+  /// Waits for the stage's kernels and reports the first error since the last check, naming the stage (a
+  /// kernel's fault surfaces here, at the stage boundary; a Debug build also synchronises and checks
+  /// after every launch: THRUST_DEBUG_SYNC, sim/CMakeLists.txt). An error here is sticky: the context
+  /// is lost, so the message tells the user to restart on another device.
+  static Status Sync(const char* stage) {
+    cudaError_t e = cudaDeviceSynchronize();
+    if (e == cudaSuccess) e = cudaGetLastError();
+    if (e == cudaSuccess) return Status::Ok();
+    return Status::Error(Format("cuda backend: %s in the %s stage (%s); restart, or use --device cpu",
+                                cudaGetErrorString(e), stage, cudaGetErrorName(e)));
+  }
   static constexpr const char* kName = "cuda";
   static constexpr bool kOnDevice = true;  // where the surface mesh lives
   static constexpr int kTraversalRun = 1;  // one descent per vertex: a thread each

@@ -20,12 +20,14 @@
 #include <type_traits>
 
 #include "backend.h"
+#include "backend_guard.h"
 #include "dfsph_solver.h"
 #include "surface_impl.h"
 
 namespace sphxr::sim {
 
-/// Traits: `template <class T> using Vector`, `static auto Policy()`, `static void Sync()`,
+/// Traits: `template <class T> using Vector`, `static auto Policy()`, `static Status Sync(const char* stage)`
+/// (waits for the work launched so far; CUDA: its error, naming the stage),
 /// `static const char* kName`, `static bool kOnDevice` (where the surface mesh lives), `static int
 /// kTraversalRun` (the surface traversal's vertices per work item).
 template <class Traits>
@@ -42,6 +44,19 @@ class BackendImpl final : public Backend {
 
   Status Init(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
               const HostBoundary& boundary) override {
+    return GuardBackend(Traits::kName, "setting up the particles", [&] { return InitArrays(grid, physics, fluid, boundary); });
+  }
+
+  Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
+              const StageHook& hook) override {
+    m_lastStage = nullptr;
+    return GuardBackend(Traits::kName, "the step", [&] { return StepStages(dt, physics, out, stageSeconds, hook); },
+                        &m_lastStage);
+  }
+
+ private:
+  Status InitArrays(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
+                    const HostBoundary& boundary) {
     // The force stage reads every wall particle's p_b/rho_b^2 under wall_density: without a reference
     // per boundary particle there would be nothing to compute it from.
     if (physics.wallDensity && boundary.invReference.size() != boundary.size()) {
@@ -100,18 +115,18 @@ class BackendImpl final : public Backend {
     // Which cells have boundary particles in their 27-cell neighbourhood (the walls never move).
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), static_cast<int>(cells),
                        BoundaryNearStage{View(), Raw(m_boundaryNear)});
-    Traits::Sync();
-    return Status::Ok();
+    return Traits::Sync("setup");
   }
 
-  Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
-              const StageHook& hook) override {
+  Status StepStages(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
+                    const StageHook& hook) {
     const int n = FluidCount();
     auto policy = Traits::Policy();
     *out = StepReduction{};
     auto clock = std::chrono::steady_clock::now();
     auto lap = [&](Stage stage) -> Status {
-      Traits::Sync();
+      if (Status s = Traits::Sync(StageName(stage)); !s) return s;
+      m_lastStage = StageName(stage);
       const auto now = std::chrono::steady_clock::now();
       stageSeconds[static_cast<int>(stage)] += std::chrono::duration<double>(now - clock).count();
       Status s = hook ? hook(stage) : Status::Ok();
@@ -299,11 +314,11 @@ class BackendImpl final : public Backend {
     return lap(Stage::kIntegrate);
   }
 
+ public:
   void RebuildGrid(std::vector<uint32_t>* fluidStart, std::vector<uint32_t>* fluidEnd) override {
     CellCodes();
     SortAndReorder();
     CellRanges();
-    Traits::Sync();
     fluidStart->resize(m_fluidStart.size());
     fluidEnd->resize(m_fluidEnd.size());
     thrust::copy(m_fluidStart.begin(), m_fluidStart.end(), fluidStart->begin());
@@ -574,6 +589,7 @@ class BackendImpl final : public Backend {
   Vector<uint8_t> m_movingNear;
   Vector<float> m_bodyPressureTerm;  // per fluid particle (ForceStage or DFSPH's Finish -> BodyReactionStage)
   DfsphSolver<Traits> m_dfsph;       // DFSPH's arrays (sized at its first step)
+  const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the
   // step's sort. Re-sorting here does not change the next step (its stable sort then keeps this order).
   SurfaceImpl<Traits> m_surface{[this] {

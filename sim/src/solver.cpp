@@ -347,6 +347,7 @@ const char* DeviceName(Device device) {
     case Device::kAuto: return "auto";
     case Device::kCpu: return "cpu";
     case Device::kCuda: return "cuda";
+    case Device::kCpuReference: return "cpu-reference";
   }
   return "?";
 }
@@ -355,6 +356,7 @@ bool ParseDevice(const std::string& text, Device* out) {
   if (text == "auto") *out = Device::kAuto;
   else if (text == "cpu") *out = Device::kCpu;
   else if (text == "cuda") *out = Device::kCuda;
+  else if (text == "cpu-reference") *out = Device::kCpuReference;
   else return false;
   return true;
 }
@@ -414,6 +416,8 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
       return Status::Error("--device cuda: no CUDA device available (no GPU or no driver); use --device cpu or auto");
     }
     solver->m_backend = MakeCudaBackend(&why);
+  } else if (device == Device::kCpuReference) {
+    solver->m_backend = MakeCpuReferenceBackend(config.threads);
   } else {
     solver->m_backend = MakeCpuBackend(config.threads, config.pairDensityBlocks);
   }
@@ -842,7 +846,10 @@ float Solver::MaxBodySpeed() const {
   return speed;
 }
 
-BodyMotionState Solver::BodyMotionOf(int body) const { return m_bodies[body]; }
+BodyMotionState Solver::BodyMotionOf(int body) const {
+  SPHXR_ASSERT(body >= 0 && body < BodyCount());
+  return m_bodies[body];
+}
 
 Status Solver::SetBodyMotion(int body, const BodyMotionState& m) {
   if (body < 0 || body >= BodyCount()) return Status::Error(Format("SetBodyMotion: no body %d (%d bodies)", body, BodyCount()));
@@ -901,6 +908,7 @@ void Solver::DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velo
 }
 
 float Solver::BodyDistance(int body, Vec3 point) const {
+  SPHXR_ASSERT(body >= 0 && body < BodyCount());
   const BodyMotion& b = m_bodies[body];
   const Vec3 p = Rotate(Conjugate(b.pose.orientation), point - b.pose.position);
   Vec3 n;

@@ -21,6 +21,7 @@
 
 #include "kernel.h"
 #include "morton.h"
+#include "sphxr/common/assert.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/hd.h"
 #include "sphxr/sim/vec.h"
@@ -474,6 +475,7 @@ struct DensityStage {
   NeighbourList list;
   Physics ph;
   SPHXR_HD void operator()(int i) const {
+    SPHXR_ASSERT(i >= 0 && i < fluid.count);  // an entry of the compacted list, on CUDA a thread's index
     const Vec3 xi = Xyz(fluid.position[i]);
     float sumFluid = 0.0f;
     uint32_t found = 0;
@@ -617,6 +619,7 @@ struct ForceStage {
   }
 
   SPHXR_HD SPHXR_INLINE ForceParticle Begin(int i) const {
+    SPHXR_ASSERT(i >= 0 && i < fluid.count);
     ForceParticle P;
     P.xi = Xyz(fluid.position[i]);
     P.vi = Xyz(fluid.velocity[i]);

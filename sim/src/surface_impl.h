@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "sphxr/common/log.h"
+#include "backend_guard.h"
 #include "surface_extractor.h"
 #include "surface_stages.h"
 
@@ -51,6 +52,10 @@ class SurfaceImpl final : public SurfaceExtractor {
   }
 
   Status BuildFromParticles(const SurfaceJob& job, SurfaceStats* stats) override {
+    return GuardBackend(Traits::kName, "the surface", [&] { return BuildFromParticlesGuarded(job, stats); });
+  }
+
+  Status BuildFromParticlesGuarded(const SurfaceJob& job, SurfaceStats* stats) {
     const auto begin = Clock::now();
     auto policy = Traits::Policy();
     const SurfaceParticles p = m_source();
@@ -135,8 +140,7 @@ class SurfaceImpl final : public SurfaceExtractor {
       return Status::Error(Format("surface: the mesh has %lld vertices, the target holds %lld: grow it and write again",
                                   static_cast<long long>(m_vertices), static_cast<long long>(target.capacity)));
     }
-    Traverse(target.positions, target.normals, stats);
-    return Status::Ok();
+    return GuardBackend(Traits::kName, "the surface", [&] { return Traverse(target.positions, target.normals, stats); });
   }
 
   Status WriteOwned(SurfaceMeshView* view, SurfaceStats* stats) override {
@@ -152,7 +156,10 @@ class SurfaceImpl final : public SurfaceExtractor {
       stats->grew = true;
     }
     stats->capacity = m_capacity;
-    Traverse(Raw(m_positions), Raw(m_normals), stats);
+    if (Status s = GuardBackend(Traits::kName, "the surface", [&] { return Traverse(Raw(m_positions), Raw(m_normals), stats); });
+        !s) {
+      return s;
+    }
     m_written = m_vertices;
     view->positions = Raw(m_positions);
     view->normals = Raw(m_normals);
@@ -183,7 +190,7 @@ class SurfaceImpl final : public SurfaceExtractor {
   /// (at least two levels: the base and the apex).
   Status BuildPyramid(const SurfaceGrid& grid, float iso, Clock::time_point begin, SurfaceStats* stats) {
     auto policy = Traits::Policy();
-    Traits::Sync();
+    if (Status s = Traits::Sync("surface field"); !s) return s;
     const auto fieldDone = Clock::now();
     m_grid = grid;
     m_iso = iso;
@@ -229,7 +236,7 @@ class SurfaceImpl final : public SurfaceExtractor {
       stats->baseBytes = cells * static_cast<int64_t>(sizeof(uint32_t));
       stats->pyramidBytes = total * static_cast<int64_t>(sizeof(uint32_t));
     }
-    Traits::Sync();
+    if (Status s = Traits::Sync("surface pyramid"); !s) return s;
     const auto pyramidDone = Clock::now();
     stats->grid = grid;
     stats->vertices = m_vertices;
@@ -242,7 +249,7 @@ class SurfaceImpl final : public SurfaceExtractor {
     return Status::Ok();
   }
 
-  void Traverse(float* positions, float* normals, SurfaceStats* stats) {
+  Status Traverse(float* positions, float* normals, SurfaceStats* stats) {
     const auto begin = Clock::now();
     if (m_vertices > 0) {
       const int64_t items = (m_vertices + m_traversalRun - 1) / m_traversalRun;
@@ -250,8 +257,9 @@ class SurfaceImpl final : public SurfaceExtractor {
                          TraverseStage{Field(m_grid, m_iso), m_pyramid, Raw(m_edges), positions, normals, m_vertices,
                                        m_traversalRun});
     }
-    Traits::Sync();
+    if (Status s = Traits::Sync("surface traversal"); !s) return s;
     stats->traversalSeconds = std::chrono::duration<double>(Clock::now() - begin).count();
+    return Status::Ok();
   }
 
   std::function<SurfaceParticles()> m_source;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "backend.h"
 #include "support.h"
@@ -62,6 +63,8 @@ TEST(CudaAgreementTest, CpuAndCudaAgreeAfter100Steps) {
   }
   EXPECT_EQ(bad, 0) << "worst difference " << worst / scene.params.spacing << " spacings";
   RecordProperty("worst_difference_in_spacings", std::to_string(worst / scene.params.spacing));
+  std::printf("[agreement] small dam break, 100 steps, cuda vs cpu: worst position difference %.3g spacings (bound 1e-4)\n",
+              worst / scene.params.spacing);
 }
 
 TEST(CudaAgreementTest, SurfaceFieldAndMeshAgree) {

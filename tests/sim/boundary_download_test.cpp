@@ -9,6 +9,7 @@
 #include "kernel.h"
 #include "sampling.h"
 #include "sphxr/sim/solver.h"
+#include "support.h"
 
 namespace sphxr::sim {
 namespace {
@@ -25,7 +26,7 @@ SceneSetup SmallTank(SceneSetup::WallPressure walls) {
 TEST(BoundaryDownload, WallDensityReferencesFollowTheSortedPositions) {
   const SceneSetup scene = SmallTank(SceneSetup::WallPressure::kWallDensity);
   std::unique_ptr<Solver> solver;
-  ASSERT_TRUE(Solver::Create(scene, SolverConfig{}, &solver).ok());
+  ASSERT_TRUE(Solver::Create(scene, ::sphxr::test::AllCoresConfig(), &solver).ok());
   HostBoundary b;
   solver->DownloadBoundary(&b);
   ASSERT_EQ(b.invReference.size(), b.size());
@@ -46,7 +47,7 @@ TEST(BoundaryDownload, WallDensityReferencesFollowTheSortedPositions) {
 
 TEST(BoundaryDownload, MirroredWallsHaveNoReferences) {
   std::unique_ptr<Solver> solver;
-  ASSERT_TRUE(Solver::Create(SmallTank(SceneSetup::WallPressure::kMirrored), SolverConfig{}, &solver).ok());
+  ASSERT_TRUE(Solver::Create(SmallTank(SceneSetup::WallPressure::kMirrored), ::sphxr::test::AllCoresConfig(), &solver).ok());
   HostBoundary b;
   solver->DownloadBoundary(&b);
   EXPECT_GT(b.size(), 0u);

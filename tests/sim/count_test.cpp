@@ -8,6 +8,7 @@
 
 #include "sampling.h"
 #include "sphxr/sim/solver.h"
+#include "support.h"
 
 namespace sphxr::sim {
 namespace {
@@ -56,7 +57,7 @@ TEST(CountParticles, ScenesTooLargeAreRefusedBeforeAllocating) {
   huge.tank = {{0.0f, 0.0f, 0.0f}, {5e9f, 5e9f, 5e9f}};
   huge.fluid.push_back({{{0.0f, 0.0f, 0.0f}, {4.0f, 4.0f, 4.0f}}, {}});
   std::unique_ptr<Solver> solver;
-  Status s = Solver::Create(huge, SolverConfig{}, &solver);
+  Status s = Solver::Create(huge, ::sphxr::test::AllCoresConfig(), &solver);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("neighbour grid"), std::string::npos) << s.message();
 
@@ -67,7 +68,7 @@ TEST(CountParticles, ScenesTooLargeAreRefusedBeforeAllocating) {
   many.tank = {{0.0f, 0.0f, 0.0f}, {8.2f, 8.2f, 8.2f}};
   many.fluid.push_back({{{0.0f, 0.0f, 0.0f}, {8.2f, 8.2f, 8.2f}}, {}});
   ASSERT_GE(CountParticles(many).fluid, int64_t{1} << 29);
-  s = Solver::Create(many, SolverConfig{}, &solver);
+  s = Solver::Create(many, ::sphxr::test::AllCoresConfig(), &solver);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("at most 536870911 of each"), std::string::npos) << s.message();
   EXPECT_EQ(s.message().find('\n'), std::string::npos) << s.message();

@@ -15,6 +15,7 @@
 
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
+#include "support.h"
 #include "stages.h"  // sim/src: WasClamped, the clamp flag's encoding
 #include "test_scenes.h"
 
@@ -33,7 +34,7 @@ struct Trace {
 
 Trace RunAndMeasure(const SceneSetup& scene, int steps, int every) {
   std::unique_ptr<Solver> solver;
-  EXPECT_TRUE(Solver::Create(scene, SolverConfig{}, &solver).ok());
+  EXPECT_TRUE(Solver::Create(scene, ::sphxr::test::AllCoresConfig(), &solver).ok());
   Trace t;
   HostBoundary walls;
   solver->DownloadBoundary(&walls);

@@ -10,6 +10,7 @@
 
 #include "sampling.h"
 #include "sphxr/sim/solver.h"
+#include "support.h"
 
 namespace sphxr::sim {
 namespace {
@@ -71,7 +72,7 @@ TEST(HydrostaticStart, LayersFollowTheTaitColumnAndStandOnTheFloor) {
 // (3.4 mm) was a gap under the water and the lowest layer fell at 0.3 m/s by step 20.
 TEST(HydrostaticStart, DeepColumnDoesNotFall) {
   std::unique_ptr<Solver> solver;
-  const Status st = Solver::Create(Column(), SolverConfig{}, &solver);
+  const Status st = Solver::Create(Column(), ::sphxr::test::AllCoresConfig(), &solver);
   ASSERT_TRUE(st.ok()) << st.message();
   for (int i = 0; i < 30; ++i) ASSERT_TRUE(solver->Step().ok());
   HostFluid h;

@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "sphxr/sim/solver.h"
+#include "support.h"
 
 namespace sphxr::sim {
 namespace {
@@ -26,7 +27,7 @@ SceneSetup SmallDamBreak() {
 
 std::unique_ptr<Solver> Make(const SceneSetup& scene) {
   std::unique_ptr<Solver> solver;
-  const Status s = Solver::Create(scene, SolverConfig{}, &solver);
+  const Status s = Solver::Create(scene, ::sphxr::test::AllCoresConfig(), &solver);
   EXPECT_TRUE(s.ok()) << s.message();
   return solver;
 }

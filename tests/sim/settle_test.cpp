@@ -13,6 +13,7 @@
 
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
+#include "support.h"
 #include "test_scenes.h"
 
 namespace sphxr::sim {
@@ -31,12 +32,12 @@ EnergySummary Energy(const Solver& solver) {
 TEST(SettleTest, GoesDownhillInEnergyAndEndsAtRest) {
   const SceneSetup scene = Tank();
   std::unique_ptr<Solver> start;
-  ASSERT_TRUE(Solver::Create(scene, SolverConfig{}, &start).ok());
+  ASSERT_TRUE(Solver::Create(scene, ::sphxr::test::AllCoresConfig(), &start).ok());
   double previous = Energy(*start).Total();
   // The CPU backend is deterministic: settling for 2 s passes through the state settled for 1 s.
   for (double time : {0.5, 1.0, 2.0}) {
     std::unique_ptr<Solver> solver;
-    ASSERT_TRUE(Solver::Create(scene, SolverConfig{}, &solver).ok());
+    ASSERT_TRUE(Solver::Create(scene, ::sphxr::test::AllCoresConfig(), &solver).ok());
     SettleReport report;
     ASSERT_TRUE(solver->Settle(time, &report).ok());
     const EnergySummary e = Energy(*solver);
@@ -51,7 +52,7 @@ TEST(SettleTest, GoesDownhillInEnergyAndEndsAtRest) {
 
 TEST(SettleTest, RestartsTheClockWithEveryParticleAtRest) {
   std::unique_ptr<Solver> solver;
-  ASSERT_TRUE(Solver::Create(Tank(), SolverConfig{}, &solver).ok());
+  ASSERT_TRUE(Solver::Create(Tank(), ::sphxr::test::AllCoresConfig(), &solver).ok());
   SettleReport report;
   ASSERT_TRUE(solver->Settle(0.05, &report).ok());
   EXPECT_GE(report.time, 0.05);
@@ -72,7 +73,7 @@ TEST(SettleTest, RestartsTheClockWithEveryParticleAtRest) {
 
 TEST(SettleTest, ProgressIsReportedAndCanStopIt) {
   std::unique_ptr<Solver> solver;
-  ASSERT_TRUE(Solver::Create(Tank(), SolverConfig{}, &solver).ok());
+  ASSERT_TRUE(Solver::Create(Tank(), ::sphxr::test::AllCoresConfig(), &solver).ok());
   int calls = 0;
   double last = 0.0;
   SettleReport report;
@@ -90,7 +91,7 @@ TEST(SettleTest, ProgressIsReportedAndCanStopIt) {
 
 TEST(SettleTest, RefusesBadTimesAndALateCall) {
   std::unique_ptr<Solver> solver;
-  ASSERT_TRUE(Solver::Create(Tank(), SolverConfig{}, &solver).ok());
+  ASSERT_TRUE(Solver::Create(Tank(), ::sphxr::test::AllCoresConfig(), &solver).ok());
   SettleReport report;
   for (double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     const Status s = solver->Settle(bad, &report);
@@ -110,7 +111,7 @@ TEST(SettleTest, ANonFiniteStateStopsItWithAnError) {
   SceneSetup scene = Tank();
   ASSERT_TRUE(ApplyReusePreset("balanced", &scene.reuse));  // the settle turns reuse off while it runs
   std::unique_ptr<Solver> solver;
-  ASSERT_TRUE(Solver::Create(scene, SolverConfig{}, &solver).ok());
+  ASSERT_TRUE(Solver::Create(scene, ::sphxr::test::AllCoresConfig(), &solver).ok());
   HostFluid fluid;
   solver->Download(&fluid);
   fluid.velocity[17].y = std::numeric_limits<float>::quiet_NaN();

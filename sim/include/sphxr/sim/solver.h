@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "sphxr/common/assert.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/params.h"
@@ -16,9 +17,11 @@
 
 namespace sphxr::sim {
 
-enum class Device { kAuto, kCpu, kCuda };
+/// kCpuReference: the CUDA backend's step (backend_impl.h with the per-particle stages, no SIMD) on the
+/// host, so that the CUDA orchestration runs wherever the tests run (docs/dev/backends.md). Slow.
+enum class Device { kAuto, kCpu, kCuda, kCpuReference };
 const char* DeviceName(Device device);
-/// Parses "auto" | "cpu" | "cuda".
+/// Parses "auto" | "cpu" | "cuda" | "cpu-reference".
 bool ParseDevice(const std::string& text, Device* out);
 /// True when the CUDA backend was compiled into this binary.
 bool CudaBackendCompiled();
@@ -27,7 +30,7 @@ int CudaDeviceCount();
 
 struct SolverConfig {
   Device device = Device::kAuto;
-  int threads = 0;        // CPU backend: 0 = all cores
+  int threads = 0;        // CPU backends (cpu, cpu-reference): 0 = all cores
   bool validate = false;  // check every stage for non-finite values (slow)
   /// CPU backend: density blocks from pairs of cells only, not the boxes fitted to the particles, and
   /// with reuse drawn from every particle with the lanes that reuse masked, not from the compacted list
@@ -172,15 +175,27 @@ class Solver {
   /// particles carry the rigid velocity that takes them there. A target time not after Time() relocates
   /// the body at once, at rest (no velocity from the jump). Errors: bad index, non-finite values.
   Status SetBodyTarget(int body, const RigidPose& target, double targetTime);
-  RigidPose BodyPose(int body) const { return m_bodies[body].pose; }
+  RigidPose BodyPose(int body) const {
+    SPHXR_ASSERT(body >= 0 && body < BodyCount());
+    return m_bodies[body].pose;
+  }
   /// The body's whole motion (a state file), and setting it back (before the first step, like Restore).
   BodyMotionState BodyMotionOf(int body) const;
   Status SetBodyMotion(int body, const BodyMotionState& motion);
   /// Linear velocity of the body origin and angular velocity during the last step.
-  Vec3 BodyVelocity(int body) const { return m_bodies[body].velocity; }
-  Vec3 BodyAngularVelocity(int body) const { return m_bodies[body].angular; }
+  Vec3 BodyVelocity(int body) const {
+    SPHXR_ASSERT(body >= 0 && body < BodyCount());
+    return m_bodies[body].velocity;
+  }
+  Vec3 BodyAngularVelocity(int body) const {
+    SPHXR_ASSERT(body >= 0 && body < BodyCount());
+    return m_bodies[body].angular;
+  }
   /// Force and torque of the fluid on the body in the last step (zero before the first).
-  const BodyLoad& LastBodyLoad(int body) const { return m_bodyLoads[body]; }
+  const BodyLoad& LastBodyLoad(int body) const {
+    SPHXR_ASSERT(body >= 0 && body < static_cast<int>(m_bodyLoads.size()));
+    return m_bodyLoads[body];
+  }
   /// The body's boundary particles in the last step: world positions (w = Psi) and velocities (w = alpha).
   void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const;
   /// Signed distance of a world point to body `body`'s solid at its current pose (negative inside).

@@ -1,0 +1,34 @@
+// The CUDA backend's step on the host: backend_impl.h with backend_cuda.cu's orchestration (a work item
+// per particle over the full or compacted lists, the per-particle DensityStage and ForceStage, the
+// per-cell WallPressureStage, a traversal work item per surface vertex) on thrust's OpenMP system. No
+// machine here has a GPU, so this is how every suite exercises the code the CUDA backend runs; the
+// `cpu` backend replaces density, forces and wall pressure by the SIMD forms of cpu_stages.h and is
+// held against this one step by step (tests/sim/backend_agreement_test.cpp). Slow: that is fine.
+#include <omp.h>
+#include <thrust/system/omp/execution_policy.h>
+#include <thrust/system/omp/vector.h>
+
+#include "backend_impl.h"
+
+namespace sphxr::sim {
+namespace {
+
+struct OmpReferenceTraits {
+  template <class T>
+  using Vector = thrust::omp::vector<T>;
+  static auto Policy() { return thrust::omp::par; }
+  static Status Sync(const char* /*stage*/) { return Status::Ok(); }
+  static constexpr const char* kName = "cpu-reference";
+  static constexpr bool kOnDevice = false;   // the mesh is host memory (CUDA's is device memory: the only difference)
+  static constexpr int kTraversalRun = 1;    // as CUDA: one descent per vertex
+  static constexpr bool kSimdStages = false; // as CUDA: a work item per particle (DensityStage, ForceStage)
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> MakeCpuReferenceBackend(int threads) {
+  omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
+  return std::make_unique<BackendImpl<OmpReferenceTraits>>();
+}
+
+}  // namespace sphxr::sim
