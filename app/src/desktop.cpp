@@ -408,6 +408,11 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
   ImGui::Text("%d fluid + %d boundary particles", snap.fluidCount, snap.boundaryCount);
   ImGui::Text("t = %.3f s, step %lld, dt %.2e s", snap.last.time, static_cast<long long>(snap.steps), snap.last.dt);
   ImGui::Text("simulation %.1f steps/s, %.3g simulated s per wall s", snap.stepsPerSecond, snap.simSecondsPerWallSecond);
+  // The worker never runs ahead of wall time; when it falls behind, the water is shown slower than real.
+  if (snap.simSecondsPerWallSecond > 0.0 && snap.simSecondsPerWallSecond < 0.95) {
+    ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "x%.2f real time (this machine cannot keep up)",
+                       snap.simSecondsPerWallSecond);
+  }
   ImGui::Text("display %.1f fps, render %.2f ms", ImGui::GetIO().Framerate, renderMs);
 
   // Timing graph per stage

@@ -515,6 +515,7 @@ Status ApplyAutoQuality(const Options& options, bool wanted, const StateFile* st
   QualityChoice choice;
   if (Status s = ChooseQuality(*setup, config, 1.0, 1.0, &choice); !s) return Status::Error(options.scenePath + ": " + s.message());
   setup->params.spacing = choice.spacing;
+  setup->method = choice.method;
   return Status::Ok();
 }
 

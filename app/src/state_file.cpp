@@ -58,10 +58,6 @@ bool Sound(const interaction::PaddleRestart& p) {
          std::isfinite(p.lastFrame);
 }
 
-// Fields a file may lack: DFSPH's stiffnesses only warm-start its next solve, so a file saved before
-// they existed (or by a WCSPH run, where they stay 0) starts that solve cold.
-bool OptionalField(const char* name) { return std::strcmp(name, "kappa") == 0 || std::strcmp(name, "kappaV") == 0; }
-
 class Reader {
  public:
   explicit Reader(std::vector<char> data) : m_data(std::move(data)) {}
@@ -300,7 +296,7 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   // The fields' bytes must be there before anything is allocated (a damaged count must not ask for
   // gigabytes).
   uint64_t perParticle = 0;
-#define SPHXR_FIELD_BYTES(type, name) perParticle += OptionalField(#name) ? 0 : sizeof(type);
+#define SPHXR_FIELD_BYTES(type, name) perParticle += sizeof(type);
   SPHXR_FLUID_FIELDS(SPHXR_FIELD_BYTES)
 #undef SPHXR_FIELD_BYTES
   if (static_cast<uint64_t>(fluid) * perParticle > r.Left()) return truncated();
@@ -329,7 +325,7 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
     if (!known) return Status::Error(path + ": field '" + name + "' is not one this build knows (saved by another version)");
   }
 #define SPHXR_CHECK_SEEN(type, name)                                                                        \
-  if (!OptionalField(#name) && std::find(seen.begin(), seen.end(), #name) == seen.end()) {                 \
+  if (std::find(seen.begin(), seen.end(), #name) == seen.end()) {                                           \
     return Status::Error(path + ": field '" #name "' of this build is not in the file (saved by another version)"); \
   }
   SPHXR_FLUID_FIELDS(SPHXR_CHECK_SEEN)

@@ -132,6 +132,9 @@ struct XrApp {
     if (const std::string saved = worker->SaveMessage(); !saved.empty()) ImGui::TextWrapped("%s", saved.c_str());
     ImGui::Text("%d fluid + %d boundary particles", snap.fluidCount, snap.boundaryCount);
     ImGui::Text("t = %.3f s, %.3g simulated s per wall s", snap.last.time, snap.simSecondsPerWallSecond);
+    if (snap.simSecondsPerWallSecond > 0.0 && snap.simSecondsPerWallSecond < 0.95) {
+      ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "x%.2f real time", snap.simSecondsPerWallSecond);
+    }
     const xr::FrameTimings& t = session->lastFrameTimings();
     ImGui::Text("frame %lld: wait %.2f, update %.2f, eyes %.2f ms", static_cast<long long>(out.frames), t.waitMs,
                 t.updateMs, t.renderMs);

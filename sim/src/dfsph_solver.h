@@ -11,25 +11,31 @@
 //                   until the drift), the boundary terms gB_i = sum_b V_b grad W_ib and
 //                   sB_i = sum_b V_b v_b . grad W_ib, and alpha_i = 1 / (|sum_j G_ij + gB_i|^2 +
 //                   sum_j |G_ij|^2), in the density-ratio form (rho^ = rho / rho0)       [BK17 eq. 11]
-//   3. divergence   warm start of the compressed particles, then Jacobi iterations on D rho^_i/Dt = sum_j (v_i - v_j) . G_ij +
+//   3. divergence   Jacobi iterations on D rho^_i/Dt = sum_j (v_i - v_j) . G_ij +
 //                   v_i . gB_i - sB_i until its mean over the fluid, times dt, is below
 //                   divergence_tolerance                                         [BK17 §4.2, alg. 2]
 //   4. forces       viscosity and gravity: the WCSPH force stage with every pressure zero, v* = v + dt a
-//   5. density      warm start of the compressed particles, then Jacobi iterations on rho^*_i = rho^_i + dt D rho^_i/Dt until the mean
+//   5. density      Jacobi iterations on rho^*_i = rho^_i + dt D rho^_i/Dt until the mean
 //                   compression max(0, rho^* - 1) is below density_tolerance       [BK17 §4.1, alg. 3]
 //   6. finish       pressure p_i = rho_i^2 (kappa_i + kappa^v_i) / rho0 for probes, haptics and the
 //                   paddles' reaction; acceleration = (v - v*) / dt + a; drift x += dt v, domain clamp
 //
 // Each iteration is two passes: Predict (the residual of every particle and its stiffness increment
-// delta_i) and Correct (v_i -= c (sum_j (delta_i + delta_j) G_ij + delta_i gB_i), c = 1/dt for the
+// delta_i) and Correct (v_i -= c (sum_j (delta_i + delta_j) G_ij + 2 delta_i gB_i), c = 1/dt for the
 // density solve, 1 for the divergence solve; kappa_i += delta_i). As in the paper the residuals are
 // clamped at 0, so every increment pushes: the Jacobi iteration then cannot oscillate (a projected form
 // that let increments take pressure back diverged on the rest lattice, whose checkerboard mode an
-// undamped Jacobi step overshoots). The totals are stored in the field list (kappa x dt^2 and kappa^v x
-// dt, SPlisHSPlasH's scaling) and warm-start the next step: sorted with the particles and kept in state
-// files.
-// Boundary particles (walls and paddles, Akinci et al. 2012) carry no stiffness of their own: their
-// term is delta_i alone, and the paddles enter the divergence through their velocities (sB_i).
+// undamped Jacobi step overshoots).
+// Boundary particles (walls and paddles, Akinci et al. 2012) mirror the fluid particle's stiffness,
+// kappa_b = kappa_i, as the WCSPH walls mirror its pressure: the pair term is kappa_i + kappa_b =
+// 2 kappa_i, and alpha_i's diagonal follows it, (sum_j G_ij + gB_i) . (sum_j G_ij + 2 gB_i) +
+// sum_j |G_ij|^2. With kappa_i alone (SPlisHSPlasH's form) a flat wall gives half the push of the fluid
+// it replaces, and the first layer slid into the walls at rest density: still water put 12 % of its
+// particles on the domain clamp every step, and its pressure came out 7-12 % above hydrostatic.
+// The paddles enter the divergence through their velocities (sB_i).
+// There is no warm start: the clamped increments cannot take back a stiffness that a warm start
+// over-applies, so it ratchets up (still water after 1 s: pressure 2.3-4.2x hydrostatic and 4 cm/s of
+// motion starting from the last step's stiffness, 0.8-1.6x with half of it, within 1.12x without).
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -37,7 +43,6 @@
 #include <thrust/reduce.h>
 
 #include <cstdint>
-#include <cstdlib>
 
 #include "stages.h"
 
@@ -45,6 +50,8 @@ namespace sphxr::sim {
 
 /// The solve's per-particle arrays (scratch of one step, rebuilt after every sort).
 struct DfsphView {
+  float* kappa;           // the density solve's stiffness so far, times dt^2
+  float* kappaV;          // the divergence solve's, times dt
   Vec3* grad;             // [i * maxNeighbours + k]: G_ij of neighbour slot k of the NeighbourList
   Vec4* boundary;         // xyz gB_i, w sB_i
   float* factor;          // alpha_i
@@ -146,7 +153,7 @@ struct DfsphFactorStage {
       }
     }
     const Vec3 g = sum + gB;
-    const float denominator = Dot(g, g) + sum2;
+    const float denominator = Dot(g, sum + gB * 2.0f) + sum2;  // the walls mirror kappa_i (see the top)
     view.factor[i] = denominator > 0.0f ? 1.0f / denominator : 0.0f;
     view.boundary[i] = MakeVec4(gB, sB);
     view.neighbours[i] = neighbours;
@@ -196,7 +203,7 @@ struct DfsphPredictStage {
   }
 };
 
-/// v_i -= c (sum_j (delta_i + delta_j) G_ij + delta_i gB_i); kappa_i += delta_i (BK17 eq. 10 and 12 in
+/// v_i -= c (sum_j (delta_i + delta_j) G_ij + 2 delta_i gB_i); kappa_i += delta_i (BK17 eq. 10 and 12 in
 /// the stored scaling: c = 1/dt for the density solve, 1 for the divergence solve).
 struct DfsphCorrectStage {
   GridView grid;
@@ -208,35 +215,14 @@ struct DfsphCorrectStage {
   bool density;  // commits to kappa, else to kappaV
   SPHXR_HD void operator()(int i) const {
     const float di = view.delta[i];
-    Vec3 dv = Xyz(view.boundary[i]) * di;
+    Vec3 dv = Xyz(view.boundary[i]) * (2.0f * di);
     ForEachGradient(grid, fluid, list, view.grad, ph, i, [&](uint32_t j, Vec3 g) { dv += g * (di + view.delta[j]); });
     Vec4 v = fluid.velocity[i];
     v.x -= scale * dv.x;
     v.y -= scale * dv.y;
     v.z -= scale * dv.z;
     fluid.velocity[i] = v;
-    if (density) {
-      fluid.kappa[i] += di;
-    } else {
-      fluid.kappaV[i] += di;
-    }
-  }
-};
-
-/// The warm start (after a Predict pass): a particle that the current velocities compress (delta_i > 0)
-/// takes the last step's stiffness, times `scale`, as this pass's increment, which Correct applies and
-/// adds to the total; any other particle starts from 0. Applied everywhere, a stiffness that the water
-/// no longer needs pushes it apart step after step (clamped residuals can never take it back): still
-/// water boiled at 3 m/s within 0.1 s (SPlisHSPlasH warm-starts the compressed particles only too).
-struct DfsphWarmStartStage {
-  FluidView fluid;
-  DfsphView view;
-  float scale;
-  bool density;
-  SPHXR_HD void operator()(int i) const {
-    float* kappa = density ? fluid.kappa : fluid.kappaV;
-    view.delta[i] = view.delta[i] > 0.0f ? scale * kappa[i] : 0.0f;
-    kappa[i] = 0.0f;
+    (density ? view.kappa : view.kappaV)[i] += di;
   }
 };
 
@@ -277,7 +263,7 @@ struct DfsphFinishStage {
     // The physical stiffnesses of this step: kappa / dt^2 and kappa^v / dt. Their velocity change is the
     // one a pressure p_i = rho_i^2 kappa_i / rho0 gives in the WCSPH momentum equation (m p_i / rho_i^2 =
     // V kappa_i), so the probes, the haptics and the paddles' reaction read the same pressure field.
-    const float kappa = fluid.kappa[i] / (dt * dt) + fluid.kappaV[i] / dt;
+    const float kappa = view.kappa[i] / (dt * dt) + view.kappaV[i] / dt;
     const float term = kappa * ph.invRestDensity;  // p_i / rho_i^2
     const float rho = fluid.density[i];
     fluid.pressure[i] = term * rho * rho;
@@ -326,6 +312,8 @@ class DfsphSolver {
       m_delta.resize(n);
       m_error.resize(n);
       m_velocityStart.resize(n);
+      m_kappa.resize(n);
+      m_kappaV.resize(n);
     }
     ForEach(fluid.count, DfsphFactorStage{grid, fluid, list, ph, View()});
   }
@@ -356,12 +344,9 @@ class DfsphSolver {
                bool density, int minIterations, int maxIterations, float tolerance) {
     const int n = fluid.count;
     const DfsphView view = View();
-    // (SPlisHSPlasH's warm starts: the whole density stiffness, half the divergence one.)
     const float scale = density ? 1.0f / dt : 1.0f;
-    ForEach(n, DfsphPredictStage{grid, fluid, list, ph, view, dt, density});
-    static const float kWs = getenv("SPHXR_WS") ? atof(getenv("SPHXR_WS")) : 1.0f;  // TEMP experiment
-    ForEach(n, DfsphWarmStartStage{fluid, view, kWs * (density ? 1.0f : 0.5f), density});
-    ForEach(n, DfsphCorrectStage{grid, fluid, list, ph, view, scale, density});
+    auto& kappa = density ? m_kappa : m_kappaV;
+    thrust::fill(Traits::Policy(), kappa.begin(), kappa.end(), 0.0f);
     Result result;
     for (;;) {
       ForEach(n, DfsphPredictStage{grid, fluid, list, ph, view, dt, density});
@@ -385,7 +370,7 @@ class DfsphSolver {
 
   DfsphView View() {
     auto raw = [](auto& v) { return thrust::raw_pointer_cast(v.data()); };
-    return DfsphView{raw(m_grad), raw(m_boundary), raw(m_factor), raw(m_neighbours), raw(m_delta), raw(m_error),
+    return DfsphView{raw(m_kappa), raw(m_kappaV), raw(m_grad), raw(m_boundary), raw(m_factor), raw(m_neighbours), raw(m_delta), raw(m_error),
                      raw(m_velocityStart)};
   }
 
@@ -396,6 +381,7 @@ class DfsphSolver {
   Vector<float> m_delta;
   Vector<uint64_t> m_error;
   Vector<Vec4> m_velocityStart;
+  Vector<float> m_kappa, m_kappaV;
 };
 
 }  // namespace sphxr::sim

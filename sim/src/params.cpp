@@ -28,7 +28,7 @@ const std::array<ParamInfo, 15> kParams = {{
     {"divergence_tolerance", "%", "dfsph: the divergence solve stops at this mean compression per step", 1e-5, 100.0,
      &SolverParams::divergenceTolerance},
     {"min_iterations", "", "dfsph: density solve iterations at least", 0.0, 1000.0, &SolverParams::minIterations, true},
-    {"max_iterations", "", "dfsph: density solve iterations at most (reaching it is a warning)", 1.0, 10000.0,
+    {"max_iterations", "", "dfsph: density solve iterations at most (reaching it is a warning; 0 = no density solve)", 0.0, 10000.0,
      &SolverParams::maxIterations, true},
     {"max_divergence_iterations", "", "dfsph: divergence solve iterations at most (0 = no divergence solve)", 0.0,
      10000.0, &SolverParams::maxDivergenceIterations, true},
@@ -70,9 +70,9 @@ ParticleCounts CountParticles(const SceneSetup& scene) {
 }
 
 int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
-  // sim/src/backend_impl.h's members. Fluid: the field list (76 B) + sort keys and order (8) + reorder
+  // sim/src/backend_impl.h's members. Fluid: the field list (68 B) + sort keys and order (8) + reorder
   // scratch of each element type (16 + 4 + 4 + 4) + the sort's temporary storage (about keys and values
-  // again, 8) + the CPU density stage's block starts (4) + the host copy at creation (76). Neighbour
+  // again, 8) + the CPU density stage's block starts (4) + the host copy at creation (68). Neighbour
   // lists: 4 B per slot and a count (sim/src/stages.h NeighbourList). Reuse: the compacted list (4), the
   // CPU density blocks' keys of it and every particle's rank in it (8; counted for CUDA too, erring high);
   // bodies: each fluid particle's pressure term for the reaction (4). Boundary: 16 B, plus its sort at

@@ -2,9 +2,8 @@
 // State files: the fluid and the clock of a run, to restart from (`sphxr --save-state FILE`,
 // `--load-state FILE`; docs/user/scenes.md "State files"). Every field of the one field list
 // (sim/fields.h) is stored with its name and element size, so a file from a build with other fields
-// is refused by name instead of being misread (DFSPH's warm-start fields kappa and kappaV may be
-// missing: zero). Binary, little-endian, version 3 (read too: version 2 lacks the method, version 1
-// also the step count):
+// is refused by name instead of being misread. Binary, little-endian, version 3 (read too: version 2
+// lacks the method, version 1 also the step count):
 //
 //   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
 //   f64 time  f32 last max speed  f32 last max |a|  i64 step  f32 spacing  i32 fluid  i32 boundary

@@ -4,7 +4,7 @@
 // can never be forgotten by the sort. Columns: type, name, what it holds.
 //
 // Hot fields (read in the 27-cell loops) come first; `id` is cold (read by export and tests only).
-// Bytes per fluid particle in these fields: 16+16+16+4+4+4+4+4+4+4 = 76.
+// Bytes per fluid particle in these fields: 16+16+16+4+4+4+4+4 = 68.
 #include <cstdint>
 #include <vector>
 
@@ -18,8 +18,6 @@
   X(float, pressure)                  /* Pa, Tait equation of state         */ \
   X(float, pressureTerm)              /* p / rho^2, for the force stage     */ \
   X(int32_t, idle)                    /* reuse idle count IC: -1 active     */ \
-  X(float, kappa)                     /* DFSPH density solve's stiffness x dt^2 (warm start) */ \
-  X(float, kappaV)                    /* DFSPH divergence solve's stiffness x dt (warm start) */ \
   X(uint32_t, id)                     /* stable particle identity           */
 
 namespace sphxr::sim {

@@ -1,0 +1,101 @@
+// DFSPH (Bender & Koschier 2017) on still water and a violent dam break: hydrostatic pressure, water
+// started from the lattice coming to rest without a settle, and ten seconds without a NaN or a lost
+// particle. (Martin & Moyce under DFSPH: dam_break_test.cpp.)
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "sphxr/app/scene_file.h"
+#include "sphxr/sim/solver.h"
+#include "support.h"
+
+namespace sphxr {
+namespace {
+
+/// scenes/tank_rest.json under DFSPH, from the lattice (no settle), one second.
+std::unique_ptr<sim::Solver> RestTankAfterOneSecond(app::SceneFile* scene) {
+  EXPECT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/tank_rest.json", scene).ok());
+  scene->setup.method = sim::SolverMethod::kDfsph;
+  sim::SolverConfig config = test::TestConfig();
+  config.threads = 0;
+  auto solver = test::CreateOrFail(scene->setup, config);
+  if (!solver) return solver;
+  while (solver->Time() < 1.0) {
+    if (!test::StepN(*solver, 1)) return nullptr;
+  }
+  return solver;
+}
+
+TEST(DfsphStillWater, ComesToRestFromTheLatticeWithoutASettle) {
+  app::SceneFile scene;
+  auto solver = RestTankAfterOneSecond(&scene);
+  ASSERT_TRUE(solver);
+  const sim::HostFluid f = test::DownloadFluid(*solver);
+  double sum = 0.0;
+  for (const sim::Vec4& v : f.velocity) sum += std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  const double mean = sum / static_cast<double>(f.size());
+  RecordProperty("mean_speed_mm_s", std::to_string(1e3 * mean));
+  EXPECT_LT(mean, 0.005) << "mean speed after 1 s of tank_rest under DFSPH (m/s)";
+}
+
+TEST(DfsphStillWater, PressureIsHydrostaticOverTheLowerEightyPercent) {
+  app::SceneFile scene;
+  auto solver = RestTankAfterOneSecond(&scene);
+  ASSERT_TRUE(solver);
+  // Layer means over 50 steps: one spacing thick, counted from the free surface (the top particle's
+  // centre plus half a spacing), against rho0 g depth at the layer's mean depth.
+  const float dx = scene.setup.params.spacing;
+  std::map<int, std::pair<double, double>> layers;  // layer -> (sum of pressure, sum of depth)
+  std::map<int, int> counts;
+  for (int s = 0; s < 50; ++s) {
+    ASSERT_TRUE(test::StepN(*solver, 1));
+    const sim::HostFluid f = test::DownloadFluid(*solver);
+    float top = -1e30f;
+    for (const sim::Vec4& x : f.position) top = std::max(top, x.y);
+    const float surface = top + 0.5f * dx;
+    for (size_t i = 0; i < f.size(); ++i) {
+      const float depth = surface - f.position[i].y;
+      const int layer = static_cast<int>(depth / dx);
+      layers[layer].first += f.pressure[i];
+      layers[layer].second += depth;
+      ++counts[layer];
+    }
+  }
+  const int deepest = layers.rbegin()->first;
+  int checked = 0;
+  for (const auto& [layer, sums] : layers) {
+    if (layer < deepest / 5) continue;  // the lower 80 % of the depth
+    const double p = sums.first / counts[layer];
+    const double expected = scene.setup.params.restDensity * 9.81 * sums.second / counts[layer];
+    EXPECT_NEAR(p / expected, 1.0, 0.05) << "layer " << layer << ": " << p << " Pa against " << expected << " Pa";
+    ++checked;
+  }
+  EXPECT_GE(checked, 10);
+}
+
+TEST(DfsphExtremes, TenSecondsOfAViolentDamBreak) {
+  // A column thrown down and forward at 3 m/s in a small tank: it hits the far wall within 0.1 s and
+  // sloshes for ten seconds.
+  sim::SceneSetup scene = test::SmallDamBreak(0.01f);
+  scene.method = sim::SolverMethod::kDfsph;
+  scene.fluid[0].velocity = sim::Vec3{3.0f, -1.0f, 0.0f};
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  const int n = solver->FluidCount();
+  while (solver->Time() < 10.0) ASSERT_TRUE(test::StepN(*solver, 1)) << "t = " << solver->Time();
+  const sim::HostFluid f = test::DownloadFluid(*solver);
+  EXPECT_EQ(test::FirstNonFinite(f), "");
+  EXPECT_EQ(static_cast<int>(f.size()), n);
+  for (const sim::Vec4& x : f.position) {
+    ASSERT_TRUE(x.x >= scene.tank.min.x && x.x <= scene.tank.max.x && x.y >= scene.tank.min.y &&
+                x.z >= scene.tank.min.z && x.z <= scene.tank.max.z)
+        << "a particle left the tank";
+  }
+  RecordProperty("clamps_per_1000_particle_steps",
+                 std::to_string(1e3 * solver->GetTotals().clampedEvents / (double(n) * solver->GetTotals().steps)));
+}
+
+}  // namespace
+}  // namespace sphxr
