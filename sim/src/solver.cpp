@@ -274,7 +274,7 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
   if (wcsph) {
     WarnAboutReuse(scene.reuse);
   } else if (scene.reuse.enabled) {
-    SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method dfsph (docs/reuse.md, \"Under DFSPH\")");
+    SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method dfsph (docs/design/dfsph.md)");
   }
   for (size_t i = 0; i < scene.fluid.size(); ++i) {
     const Aabb& b = scene.fluid[i].box;
@@ -305,7 +305,7 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.bodyGradScale = WallGradientCorrection(ph.kernel, p.spacing, 1) / WallDensityCorrection(ph.kernel, p.spacing, 1);
   ph.bodyClearance = 0.25f * p.spacing;
   const ReuseParams& r = scene.reuse;
-  ph.reuseEnabled = r.enabled && !ph.dfsph;  // reuse is WCSPH's (docs/reuse.md, "Under DFSPH")
+  ph.reuseEnabled = r.enabled && !ph.dfsph;  // reuse is WCSPH's (docs/design/dfsph.md)
   ph.reuseDelta1 = r.delta1;
   ph.reuseDelta2 = r.delta2;
   ph.reuseThreshold = r.threshold;
