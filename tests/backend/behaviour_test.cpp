@@ -96,6 +96,30 @@ TEST_P(Behaviour, ARestoreContinuesTheRunBitForBit) {
   EXPECT_TRUE(BitIdentical(test::DownloadFluid(*through), test::DownloadFluid(*restored)));
 }
 
+TEST_P(Behaviour, DfsphRerunsThreadCountsAndRestoresAreBitIdentical) {
+  SceneSetup scene = test::SmallDamBreak(0.01f);
+  scene.method = sim::SolverMethod::kDfsph;
+  HostFluid runs[3];
+  for (int k = 0; k < 3; ++k) {
+    auto solver = test::CreateOrFail(scene, Config(k == 2 ? 2 : 1));
+    ASSERT_TRUE(solver);
+    ASSERT_TRUE(test::StepN(*solver, 80));
+    EXPECT_GT(solver->GetTotals().densityIterations, 0);
+    solver->Download(&runs[k]);
+  }
+  EXPECT_TRUE(BitIdentical(runs[0], runs[1])) << "two runs on one thread";
+  if (GetParam() != Device::kCuda) {
+    EXPECT_TRUE(BitIdentical(runs[0], runs[2])) << "one thread against two (the solves' stopping sums are integers)";
+  }
+  auto first = test::CreateOrFail(scene, Config());
+  ASSERT_TRUE(first && test::StepN(*first, 40));
+  auto restored = test::CreateOrFail(scene, Config());
+  ASSERT_TRUE(restored);
+  ASSERT_TRUE(restored->Restore(test::DownloadFluid(*first), first->Clock()).ok());
+  ASSERT_TRUE(test::StepN(*restored, 40));
+  EXPECT_TRUE(BitIdentical(runs[0], test::DownloadFluid(*restored))) << "40 + 40 steps through a restore";
+}
+
 TEST_P(Behaviour, EveryReusePresetSkipsWorkAndStaysCalm) {
   for (const char* preset : {"accurate", "balanced", "fast"}) {
     SCOPED_TRACE(preset);
