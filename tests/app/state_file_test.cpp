@@ -189,6 +189,25 @@ TEST(StateFile, APaddleWithANonFiniteStateIsRefused) {
   ExpectRefused(bad, "non-finite paddle clock");
 }
 
+TEST(StateFile, RecordsTheSolverMethod) {
+  test::TempDir dir("state_method");
+  sim::SceneSetup scene = test::SmallDamBreak(0.01f);
+  scene.method = sim::SolverMethod::kDfsph;
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver && test::StepN(*solver, 3));
+  const std::string path = dir.File("dfsph.state");
+  ASSERT_TRUE(WriteStateFile(path, *solver, "s").ok());
+  StateFile read;
+  ASSERT_TRUE(ReadStateFile(path, &read).ok());
+  EXPECT_EQ(read.method, sim::SolverMethod::kDfsph);
+  // Continued under the other method (the scene or --set says so): allowed, and said.
+  test::LogCapture log;
+  sim::SceneSetup wcsph = test::SmallDamBreak(0.01f);
+  std::shared_ptr<const StateFile> start;
+  ASSERT_TRUE(ReadStartState(path, 0.0f, "s", &wcsph, &start).ok());
+  EXPECT_EQ(log.Count("saved under solver.method dfsph", LogLevel::kWarn), 1) << log.All();
+}
+
 // Version 1 (the first session's files) had no step count: it is still read, with the step unknown
 // (-1: a continued run numbers from 0), and the fluid as saved.
 TEST(StateFile, AVersionOneFileIsReadWithoutItsStepCount) {
@@ -200,6 +219,8 @@ TEST(StateFile, AVersionOneFileIsReadWithoutItsStepCount) {
   std::string bytes = Bytes(v2);
   bytes[12] = 1;                            // the version
   bytes.erase(8 + 4 + 4 + 8 + 2 * 4, 8);    // and no step count after the clock
+  // nor the solver method (version 3) after the scene's name "s": spacing, two counts, the name
+  bytes.erase(8 + 4 + 4 + 8 + 2 * 4 + 4 + 2 * 4 + 4 + 1, 4 + 5);
   Put(v1, bytes);
   StateFile a, b;
   ASSERT_TRUE(ReadStateFile(v2, &a).ok());
@@ -207,6 +228,7 @@ TEST(StateFile, AVersionOneFileIsReadWithoutItsStepCount) {
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_EQ(a.step, 4);
   EXPECT_EQ(b.step, -1);
+  EXPECT_EQ(b.method, sim::SolverMethod::kWcsph) << "files before version 3 ran the only method there was";
   EXPECT_EQ(b.clock.time, a.clock.time);
   EXPECT_EQ(b.spacing, a.spacing);
   ASSERT_EQ(b.fluid.size(), a.fluid.size());

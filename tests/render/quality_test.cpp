@@ -33,7 +33,9 @@ TEST(QualityTest, ChoiceIsMeasuredLoggedAndWithinTheAllowedRange) {
   SceneSetup chosen = scene;
   chosen.params.spacing = choice.spacing;
   EXPECT_EQ(choice.fluid, sim::CountParticles(chosen).fluid);
-  EXPECT_EQ(log.Count("quality auto: spacing", LogLevel::kInfo), 1) << log.All();
+  EXPECT_EQ(log.Count(std::string("quality auto: method ") + sim::SolverMethodName(choice.method) + ", spacing",
+                      LogLevel::kInfo), 1)
+      << log.All();
 }
 
 }  // namespace
