@@ -292,6 +292,7 @@ class BackendImpl final : public Backend {
 
   void Download(HostFluid* out) const override {
     out->resize(m_fluid.position.size());
+    if (out->size() == 0) return;  // (thrust's host copy of nothing passes a null pointer to memmove: UB)
 #define SPHXR_DOWNLOAD_FIELD(type, name) thrust::copy(m_fluid.name.begin(), m_fluid.name.end(), out->name.begin());
     SPHXR_FLUID_FIELDS(SPHXR_DOWNLOAD_FIELD)
 #undef SPHXR_DOWNLOAD_FIELD
