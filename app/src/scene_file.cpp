@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <limits>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 #include "sphxr/app/param_registry.h"
@@ -30,6 +31,15 @@ std::string Brief(const json& j) {
   return text;
 }
 
+// A key from the file in a message or warning: at most kMaxEcho characters, control characters as '?'.
+std::string Shown(const std::string& key) {
+  std::string out = key.size() > kMaxEcho ? key.substr(0, kMaxEcho - 3) + "..." : key;
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
+
 // Text from the file shown on a terminal (names): printable ASCII and UTF-8, no control characters.
 bool Printable(const std::string& text) {
   for (const char c : text) {
@@ -49,7 +59,7 @@ class StructureScan {
     struct Frame {
       bool object;
       std::string path;
-      std::vector<std::pair<std::string, int>> keys;  // key, line
+      std::unordered_map<std::string, int> keys;  // key -> its line (a map: an object may have 100,000 keys)
       std::string pendingKey;
       size_t index = 0;
     };
@@ -83,16 +93,13 @@ class StructureScan {
           }
         }
         Frame& f = stack.back();
-        for (const auto& [seen, seenLine] : f.keys) {
-          if (seen != key) continue;
-          std::string shown = json(key).dump(-1, ' ', true, json::error_handler_t::replace);
-          if (shown.size() > kMaxEcho) shown = shown.substr(0, kMaxEcho - 3) + "...";
-          const std::string where = f.path.empty() ? "at the top level" : "in " + f.path;
+        if (const auto seen = f.keys.find(key); seen != f.keys.end()) {
+          const std::string where = f.path.empty() ? "at the top level" : "in " + Shown(f.path);
           return Status::Error(Format("%s: key %s appears twice %s (lines %d and %d): the second would replace the "
                                       "first; keep one",
-                                      origin.c_str(), shown.c_str(), where.c_str(), seenLine, line));
+                                      origin.c_str(), Brief(json(key)).c_str(), where.c_str(), seen->second, line));
         }
-        f.keys.emplace_back(key, line);
+        f.keys.emplace(key, line);
         f.pendingKey = key;
       } else if (c == '{' || c == '[') {
         if (static_cast<int>(stack.size()) >= kMaxDepth) {
@@ -128,11 +135,24 @@ class Reader {
     std::set<std::string> names(known.begin(), known.end());
     for (auto it = obj.begin(); it != obj.end(); ++it) {
       if (!names.count(it.key())) {
-        const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
-        m_out->warnings.push_back("unknown key '" + key + "' ignored");
-        SPHXR_LOG_WARN("%s: unknown key '%s' ignored", m_out->path.c_str(), key.c_str());
+        const std::string key = prefix.empty() ? Shown(it.key()) : prefix + "." + Shown(it.key());
+        Unknown(key);
       }
     }
+  }
+
+  // An unknown key is warned about by name, the first kMaxWarnings of them (a file of 100,000 would
+  // be 100,000 lines); Parse counts the rest in one line.
+  static constexpr int kMaxWarnings = 20;
+  void Unknown(const std::string& key) {
+    if (++m_unknown > kMaxWarnings) return;
+    m_out->warnings.push_back("unknown key '" + key + "' ignored");
+    SPHXR_LOG_WARN("%s: unknown key '%s' ignored", m_out->path.c_str(), key.c_str());
+  }
+  void CountUnknown() const {
+    if (m_unknown <= kMaxWarnings) return;
+    m_out->warnings.push_back(Format("%d more unknown keys ignored", m_unknown - kMaxWarnings));
+    SPHXR_LOG_WARN("%s: %d more unknown keys ignored", m_out->path.c_str(), m_unknown - kMaxWarnings);
   }
 
   Status Number(const json& j, const std::string& key, double* v) const {
@@ -182,8 +202,7 @@ class Reader {
       for (auto it = solver.begin(); it != solver.end(); ++it) {
         const sim::ParamInfo* info = sim::FindSolverParam(it.key());
         if (!info) {
-          m_out->warnings.push_back("unknown key 'solver." + it.key() + "' ignored");
-          SPHXR_LOG_WARN("%s: unknown key 'solver.%s' ignored", m_out->path.c_str(), it.key().c_str());
+          Unknown("solver." + Shown(it.key()));
           continue;
         }
         double v;
@@ -475,8 +494,12 @@ class Reader {
         if (!p.contains("trajectory") || !p["trajectory"].is_string()) {
           return Error(key + ".trajectory", "a scripted paddle needs a trajectory file (CSV of timed poses)");
         }
+        const std::string name = p["trajectory"].get<std::string>();
+        if (name.empty() || name.size() > 4096 || !Printable(name)) {
+          return Error(key + ".trajectory", "must be a file name (printable, at most 4096 characters)");
+        }
         // Relative to the scene file's folder.
-        std::filesystem::path file = p["trajectory"].get<std::string>();
+        std::filesystem::path file = name;
         if (file.is_relative()) file = std::filesystem::path(m_out->path).parent_path() / file;
         m_out->inputs.push_back(file.string());
         if (Status st = interaction::Trajectory::Load(file.string(), &d.trajectory); !st) {
@@ -494,6 +517,7 @@ class Reader {
 
  private:
   SceneFile* m_out;
+  int m_unknown = 0;
 };
 
 }  // namespace
@@ -529,7 +553,9 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
   }
   if (Status s = scan.Run(origin); !s) return s;
   Reader reader(out);
-  return reader.Parse(root);
+  const Status s = reader.Parse(root);
+  reader.CountUnknown();
+  return s;
 }
 
 Status LoadScene(const std::string& path, SceneFile* out) {

@@ -15,6 +15,7 @@
 #include "sphxr/app/state_file.h"
 #include "sphxr/interaction/paddle.h"
 #include "sphxr/interaction/trajectory.h"
+#include "sphxr/common/log.h"
 #include "support.h"
 
 namespace sphxr::app {
@@ -75,6 +76,22 @@ TEST(Hardening, DuplicateKeysAreRefusedNamingTheKeyAndBothLines) {
   // The same key in two objects is fine.
   const std::string fine = R"({"tank": {"min": [0,0,0], "max": [1,1,1]}, "fluid": [{"min": [0,0,0], "max": [1,0.5,1]}]})";
   EXPECT_TRUE(Parse(fine, &scene).ok());
+}
+
+TEST(Hardening, AHundredThousandKeysParseAtOnceWithFewWarnings) {
+  std::string text = R"({"tank": {"min": [0,0,0], "max": [1,1,1]})";
+  for (int k = 0; k < 100000; ++k) text += ",\"k" + std::to_string(k) + "\": 1";
+  text += "}";
+  SceneFile scene;
+  const LogLevel level = GetLogLevel();
+  SetLogLevel(LogLevel::kError);
+  Status s;
+  const double seconds = SecondsOf([&] { s = Parse(text, &scene); });
+  SetLogLevel(level);
+  EXPECT_TRUE(s.ok()) << s.message();
+  EXPECT_LT(seconds, 1.0) << "the duplicate check is not quadratic";
+  ASSERT_EQ(scene.warnings.size(), 21u) << "20 by name, then one line counting the rest";
+  EXPECT_EQ(scene.warnings.back(), "99980 more unknown keys ignored");
 }
 
 TEST(Hardening, NamesWithTerminalEscapesAreRefused) {
