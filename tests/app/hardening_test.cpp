@@ -2,6 +2,7 @@
 // (issue 39): each must now be refused in one short line, at once, before anything large is allocated.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -208,6 +209,30 @@ TEST(Hardening, OutputDirectoriesAreMadeOnlyInADirectoryThatExists) {
   options.outDir = "out";
   options.statsPath = dir.File("missing/stats.csv");
   ExpectBriefRefusal(RunHeadless(options, &summary), "does not exist; make it first");
+}
+
+// A --save-state that fails after the run (a full disk; here its temporary file's place is taken by
+// a directory) is one error line after the summary, not instead of it.
+TEST(Hardening, AFailedSaveStillPrintsTheSummary) {
+  test::TempDir dir("hardening_save");
+  const std::string scene = dir.Write("scene.json", test::kSmallTankScene);
+  const std::string state = dir.File("end.state");
+  std::filesystem::create_directory(state + ".tmp");
+  const std::string errPath = dir.File("err.txt");
+  const std::string command = std::string(SPHXR_BINARY) + " --headless --scene '" + scene + "' --steps 2 --threads 1 " +
+                              "--no-progress --save-state '" + state + "' 2>'" + errPath + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_TRUE(pipe);
+  std::string out;
+  char buffer[4096];
+  while (size_t n = std::fread(buffer, 1, sizeof(buffer), pipe)) out.append(buffer, n);
+  const int status = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status;
+  EXPECT_NE(out.find("sphxr summary"), std::string::npos) << out;
+  const std::string err = test::ReadFile(errPath);
+  const size_t at = err.find("sphxr: error: --save-state");
+  ASSERT_NE(at, std::string::npos) << err;
+  EXPECT_EQ(err.find('\n', at), err.size() - 1) << "one line, the last: " << err;
 }
 
 // State files are checked as scenes are: finite but absurd values were restored (every particle
