@@ -292,7 +292,7 @@ class BackendImpl final : public Backend {
 
   void Download(HostFluid* out) const override {
     out->resize(m_fluid.position.size());
-    if (out->size() == 0) return;  // (thrust's host copy of nothing passes a null pointer to memmove: UB)
+    if (out->size() == 0) return;  // (thrust's host copy of nothing dereferences a null begin: UB)
 #define SPHXR_DOWNLOAD_FIELD(type, name) thrust::copy(m_fluid.name.begin(), m_fluid.name.end(), out->name.begin());
     SPHXR_FLUID_FIELDS(SPHXR_DOWNLOAD_FIELD)
 #undef SPHXR_DOWNLOAD_FIELD
@@ -304,7 +304,9 @@ class BackendImpl final : public Backend {
     out->viscosity.resize(m_boundaryAlpha.size());
     thrust::copy(m_boundaryAlpha.begin(), m_boundaryAlpha.end(), out->viscosity.begin());
     out->invReference.resize(m_boundaryInvReference.size());  // empty unless the walls have their own density
-    thrust::copy(m_boundaryInvReference.begin(), m_boundaryInvReference.end(), out->invReference.begin());
+    if (!out->invReference.empty()) {  // (a copy of nothing dereferences the empty vector's null begin: UB)
+      thrust::copy(m_boundaryInvReference.begin(), m_boundaryInvReference.end(), out->invReference.begin());
+    }
   }
 
   void Upload(const HostFluid& fluid) override {
@@ -390,6 +392,7 @@ class BackendImpl final : public Backend {
   void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const override {
     position->resize(m_bodyPos.size());
     velocity->resize(m_bodyVel.size());
+    if (m_bodyPos.empty()) return;  // (as in Download)
     thrust::copy(m_bodyPos.begin(), m_bodyPos.end(), position->begin());
     thrust::copy(m_bodyVel.begin(), m_bodyVel.end(), velocity->begin());
   }
