@@ -313,7 +313,7 @@ class BackendImpl final : public Backend {
     const size_t n = fluid.size();
 #define SPHXR_UPLOAD_FIELD(type, name) \
   m_fluid.name.resize(n);              \
-  thrust::copy(fluid.name.begin(), fluid.name.end(), m_fluid.name.begin());
+  if (n > 0) thrust::copy(fluid.name.begin(), fluid.name.end(), m_fluid.name.begin());  /* (as in Download) */
     SPHXR_FLUID_FIELDS(SPHXR_UPLOAD_FIELD)
 #undef SPHXR_UPLOAD_FIELD
     m_keys.resize(n);

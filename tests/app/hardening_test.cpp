@@ -90,7 +90,8 @@ TEST(Hardening, AHundredThousandKeysParseAtOnceWithFewWarnings) {
   const double seconds = SecondsOf([&] { s = Parse(text, &scene); });
   SetLogLevel(level);
   EXPECT_TRUE(s.ok()) << s.message();
-  EXPECT_LT(seconds, 1.0) << "the duplicate check is not quadratic";
+  // (0.3 s in a release build, 3 s under the sanitizers; a quadratic check takes minutes.)
+  EXPECT_LT(seconds, 20.0) << "the duplicate check is not quadratic";
   ASSERT_EQ(scene.warnings.size(), 21u) << "20 by name, then one line counting the rest";
   EXPECT_EQ(scene.warnings.back(), "99980 more unknown keys ignored");
 }
