@@ -20,6 +20,7 @@ mkdir -p "$work" "$artifacts"
 for t in scene state trajectory; do mkdir -p "$work/corpus_$t" "$work/seeds_$t"; done
 cp scenes/*.json "$work/seeds_scene/"
 cp scenes/*.csv "$work/seeds_trajectory/"
+cp scenes/*.csv "$work/"  # the trajectories the seed scenes name, relative to the working directory
 # A state file to start from: a few steps of the small stirring scene, at a coarse spacing.
 if [ ! -f "$work/seeds_state/stir.state" ]; then
   ASAN_OPTIONS=detect_leaks=0 "$build/app/sphxr" --headless --scene scenes/stir.json --spacing 0.03 --steps 3 \

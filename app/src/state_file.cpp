@@ -306,6 +306,11 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
   out->clock.steps = out->step < 0 ? 0 : out->step;
   if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return truncated();
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
+  // The scene's name is shown in messages and the log: control characters (a damaged file, or a name
+  // with terminal escapes) become '?'.
+  for (char& c : out->scene) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
   const sim::ParamInfo* spacing = sim::FindSolverParam("spacing");
   if (!std::isfinite(out->spacing) || out->spacing < spacing->min || out->spacing > spacing->max) {
     return Status::Error(Format("%s: spacing %g m is outside %g to %g m: the file is damaged", path.c_str(), out->spacing,
@@ -366,6 +371,11 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
     std::string name;
     uint32_t element = 0;
     if (!r.String(&name, 256) || !r.Get(&element)) return truncated();
+    // (Named in messages: a damaged name must not put control characters or a newline on the terminal.)
+    const bool identifier = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+    });
+    if (!identifier) return Status::Error(Format("%s: field %u has no name: the file is damaged", path.c_str(), f));
     if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
       return Status::Error(path + ": field '" + name + "' appears twice: the file is damaged");
     }

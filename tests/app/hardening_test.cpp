@@ -259,6 +259,16 @@ class StateChecks : public ::testing::Test {
 
 TEST_F(StateChecks, TheSavedStateRestores) { EXPECT_TRUE(Restore(m_state).ok()); }
 
+// Found by the fuzz target: a damaged field name was quoted raw, newlines and all.
+TEST_F(StateChecks, ADamagedFieldNameIsRefusedInOneLine) {
+  std::string bytes = test::ReadFile(m_dir.File("a.state"));
+  const size_t at = bytes.find("velocity");
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 3] = '\n';
+  StateFile state;
+  ExpectBriefRefusal(ParseStateFile(std::vector<char>(bytes.begin(), bytes.end()), "a.state", &state), "has no name");
+}
+
 TEST_F(StateChecks, ParticlesOutsideTheTankAreRefused) {
   StateFile s = m_state;
   for (sim::Vec4& p : s.fluid.position) p.x += 10.0f;
