@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 packages=(build-essential cmake ninja-build pkg-config libthrust-dev nlohmann-json3-dev libgtest-dev libgmock-dev
           python3 python3-matplotlib libepoxy-dev libglm-dev libglfw3-dev libimgui-dev libstb-dev libegl-dev
           libegl-mesa0 libgl1-mesa-dri xvfb xauth
-          libopenxr-dev libopenxr-loader1 openxr-layer-corevalidation libgl-dev libx11-dev libpng-dev)
+          libopenxr-dev libopenxr-loader1 openxr-layer-corevalidation libgl-dev libx11-dev libpng-dev
+          clang-14 libclang-rt-14-dev libomp-14-dev)  # the last three: scripts/sanitize.sh and fuzz.sh
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string_view>
 
 #include "sphxr/app/export.h"
@@ -184,6 +185,74 @@ Status CheckPlaceToWrite(const std::string& flag, const std::string& path, const
   return Status::Ok();
 }
 
+/// The stats CSV's rows, written whole: held here and handed to the file at least once a second of wall
+/// time (and before each checkpoint, and at the end, also of a run stopped by a signal), so that a kill
+/// loses at most a second of rows and never leaves half a row (the stream's own 8 kB blocks did).
+class CsvRows {
+ public:
+  explicit CsvRows(std::ofstream* out) : m_out(out) {}
+  ~CsvRows() { Flush(); }
+  CsvRows(const CsvRows&) = delete;
+  CsvRows& operator=(const CsvRows&) = delete;
+  void Add(const std::string& row) { m_pending += row; }
+  bool Due() const {
+    return m_pending.size() > (size_t{1} << 20) || std::chrono::steady_clock::now() - m_last >= std::chrono::seconds(1);
+  }
+  /// False when the file refused the rows (disk full).
+  bool Flush() {
+    m_last = std::chrono::steady_clock::now();
+    if (m_pending.empty() || !m_out->is_open()) return true;
+    m_out->write(m_pending.data(), static_cast<std::streamsize>(m_pending.size()));
+    m_out->flush();
+    m_pending.clear();
+    return static_cast<bool>(*m_out);
+  }
+
+ private:
+  std::ofstream* m_out;
+  std::string m_pending;
+  std::chrono::steady_clock::time_point m_last = std::chrono::steady_clock::now();
+};
+
+/// --checkpoint-every: the state saved to `path` (atomically, WriteStateFile), the `keep` - 1 before it
+/// moved to path.1 (the newest), path.2, ... first. `path` itself always holds a whole state.
+Status WriteCheckpoint(const std::string& path, int keep, const sim::Solver& solver, const std::string& sceneName,
+                       const interaction::PaddleSystem* paddles, double paddleClock, int64_t stepsBefore) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::string base = fs::is_symlink(fs::symlink_status(path, ec)) ? fs::weakly_canonical(path, ec).string() : path;
+  if (keep > 1 && fs::is_regular_file(base, ec)) {
+    for (int k = keep - 1; k >= 2; --k) {
+      const std::string older = base + "." + std::to_string(k - 1);
+      if (fs::exists(older, ec)) fs::rename(older, base + "." + std::to_string(k), ec);
+    }
+    // A second name for the current file, so that `path` is never missing while the next is written.
+    const std::string previous = base + ".1";
+    fs::remove(previous, ec);
+    fs::create_hard_link(base, previous, ec);
+    if (ec) fs::copy_file(base, previous, fs::copy_options::overwrite_existing, ec);
+  }
+  return WriteStateFile(path, solver, sceneName, paddles, paddleClock, stepsBefore);
+}
+
+/// An output directory: made when missing, but only in a directory that exists (a typo, or a path
+/// under /, must not make a tree of directories, as root anywhere).
+Status MakeOutputDirectory(const std::string& flag, const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return Status::Ok();
+  if (fs::exists(dir, ec)) return Status::Error(flag + " " + dir + ": exists and is not a directory");
+  fs::path normal = fs::path(dir).lexically_normal();
+  if (!normal.has_filename()) normal = normal.parent_path();  // "out/"
+  const fs::path parent = normal.parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    return Status::Error(flag + " " + dir + ": " + parent.string() + " does not exist; make it first");
+  }
+  fs::create_directory(dir, ec);
+  if (ec) return Status::Error(flag + " " + dir + ": cannot create the directory: " + ec.message());
+  return Status::Ok();
+}
+
 /// How much of an earlier `--stats` file a run continued from a state saved at step `stepsBefore`
 /// keeps: the bytes of the header and the rows up to that step, when it is a regular file with this
 /// run's header, rows in step order and a row for that step (the first half's CSV); else -1, and the
@@ -220,7 +289,7 @@ int64_t StatsBytesToKeep(const std::string& path, const std::string& header, int
 
 std::string UsageText() {
   return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--settle S]\n"
-         "             [--load-state FILE] [--save-state FILE]\n"
+         "             [--load-state FILE] [--save-state FILE [--checkpoint-every S [--checkpoint-keep N]]]\n"
          "             [--device auto|cpu|cuda|cpu-reference] [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
@@ -247,6 +316,9 @@ std::string UsageText() {
          "  --save-state FILE write the fluid and the clock to FILE at the end of the run (also when it is\n"
          "                    stopped early), to start another run from; in the window and --xr, the\n"
          "                    file their save writes (the s key, the panel, the headset's save button)\n"
+         "  --checkpoint-every S  also save the state to the --save-state FILE every S simulated seconds\n"
+         "                    during a headless run (atomically; a kill loses at most S), keeping the last N\n"
+         "                    (--checkpoint-keep, default 2: FILE and FILE.1)\n"
          "  --load-state FILE start from a state file instead of the scene's fluid (the same scene; its\n"
          "                    spacing is the file's); --time is then the end time on the file's clock\n"
          "  --device D        auto (CUDA when a GPU answers, else CPU), cpu, or cuda; cpu-reference: the\n"
@@ -278,8 +350,23 @@ std::string UsageText() {
 
 Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
   *out = Options{};
+  // Each option once (a repeated --steps kept the last without a word), except --set; the mode flags
+  // and --progress/--no-progress count as one option each.
+  std::vector<std::string> seen;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg != "--set" && arg.rfind("--", 0) == 0) {
+      const bool modeFlag = arg == "--headless" || arg == "--desktop" || arg == "--xr";
+      const bool progressFlag = arg == "--progress" || arg == "--no-progress";
+      const std::string group = modeFlag ? "mode" : progressFlag ? "progress" : arg;
+      for (const std::string& earlier : seen) {
+        if (earlier.substr(0, earlier.find(' ')) != group) continue;
+        const std::string first = earlier.substr(earlier.find(' ') + 1);
+        if (first == arg) return Status::Error(arg + " is given twice: give it once");
+        return Status::Error(first + " and " + arg + ": give one of them");
+      }
+      seen.push_back(group + " " + arg);
+    }
     auto value = [&](const char** v) -> Status {
       if (i + 1 >= argc) return Status::Error(arg + ": missing value (see --help)");
       *v = argv[++i];
@@ -311,6 +398,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       out->progress = 0;
     } else if (arg == "--scene") {
       if (Status s = value(&v); !s) return s;
+      if (*v == '\0') return Status::Error("--scene: give a file name (without --scene: the default scene)");
       out->scenePath = v;
     } else if (arg == "--time") {
       if (Status s = value(&v); !s) return s;
@@ -409,6 +497,14 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       const std::string r = v;
       if (r != "water" && r != "particles") return Status::Error("--render " + r + ": must be water or particles");
       out->particleImages = r == "particles";
+    } else if (arg == "--checkpoint-every") {
+      if (Status s = value(&v); !s) return s;
+      if (Status s = ParseDouble(arg, v, 1e-6, 1e6, &out->checkpointEvery); !s) return s;
+    } else if (arg == "--checkpoint-keep") {
+      if (Status s = value(&v); !s) return s;
+      int64_t n = 0;
+      if (Status s = ParseInt(arg, v, 1, 100, &n); !s) return s;
+      out->checkpointKeep = static_cast<int>(n);
     } else if (arg == "--stats") {
       if (Status s = value(&v); !s) return s;
       if (v[0] == '\0') return Status::Error("--stats: needs a file name");
@@ -418,20 +514,38 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     }
   }
   if (out->time > 0.0 && out->steps > 0) return Status::Error("--time and --steps: give one, not both");
+  for (const std::string& set : out->sets) {
+    if (out->spacing > 0.0f && set.rfind("spacing=", 0) == 0) {
+      return Status::Error("--spacing and --set " + set.substr(0, 40) + ": give one of them");
+    }
+  }
+
   if (out->scenePath.empty()) out->scenePath = SPHXR_SCENES_DIR "/dam_break.json";
   return Status::Ok();
 }
 
 namespace {
 
-// Two paths name the same file: the same inode when both exist (links, "./a" and "a"), else the same
-// absolute, normalised path.
+// Where a path leads: its symbolic links followed, dangling ones too (weakly_canonical stops at a
+// dangling link, so `link.csv -> z.csv` and `z.csv` looked like two files until z.csv existed).
+std::filesystem::path Resolve(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec);
+  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) break;
+    p = target.is_absolute() ? target : p.parent_path() / target;
+  }
+  return fs::weakly_canonical(p, ec);
+}
+
+// Two paths name the same file: the same inode when both exist (hard links, "./a" and "a"), else the
+// same path once links are followed.
 bool SameFile(const std::string& a, const std::string& b) {
   std::error_code ec;
   if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) return std::filesystem::equivalent(a, b, ec);
-  const auto ca = std::filesystem::weakly_canonical(std::filesystem::absolute(a, ec), ec);
-  const auto cb = std::filesystem::weakly_canonical(std::filesystem::absolute(b, ec), ec);
-  return !ec && ca == cb;
+  return Resolve(a) == Resolve(b);
 }
 
 // An output that is one of the run's inputs, or another output, would be destroyed by it (a typo in
@@ -490,6 +604,7 @@ std::string HeadlessOnlyOptions(const Options& options) {
   add(options.time > 0.0, "--time");
   add(options.steps > 0, "--steps");
   add(options.settle >= 0.0, "--settle");
+  add(options.checkpointEvery > 0.0, "--checkpoint-every");
   return out;
 }
 
@@ -525,6 +640,9 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (Status s = LoadSceneWithOptions(options, &scene); !s) return s;
   // A state file is read before anything is allocated; it fixes the spacing (ReadStartState refuses a
   // --spacing that differs) and replaces the settle.
+  if (options.checkpointEvery > 0.0 && options.saveState.empty()) {
+    return Status::Error("--checkpoint-every: needs --save-state FILE (the checkpoints are that file)");
+  }
   if (!options.loadState.empty() && options.settle > 0.0) {
     return Status::Error("--settle and --load-state: the state file is the start; settle in the run that saves it");
   }
@@ -558,6 +676,11 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   // (below), and a run refused at start-up leaves the file as it was.
   std::ofstream stats;
   if (!options.statsPath.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(options.statsPath).parent_path();
+    std::error_code ec;
+    if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
+      return Status::Error("--stats " + options.statsPath + ": " + parent.string() + " does not exist; make it first");
+    }
     stats.open(options.statsPath, std::ios::app);
     if (!stats) return Status::Error("--stats " + options.statsPath + ": cannot open for writing");
   }
@@ -569,17 +692,13 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                    options.outDir.c_str());
   }
   if (options.exportEvery > 0 || options.exportSurfaceEvery > 0) {
-    std::error_code ec;
-    std::filesystem::create_directories(options.outDir, ec);
-    if (ec) return Status::Error("--out " + options.outDir + ": cannot create the directory: " + ec.message());
+    if (Status s = MakeOutputDirectory("--out", options.outDir); !s) return s;
   }
   // Pictures: the GL context is made before the run, so a machine without EGL fails in a second.
   std::unique_ptr<OfflinePictures> pictures;
   if (!options.screenshotPath.empty() || !options.framesDir.empty()) {
     if (!options.framesDir.empty()) {
-      std::error_code ec;
-      std::filesystem::create_directories(options.framesDir, ec);
-      if (ec) return Status::Error("--frames " + options.framesDir + ": cannot create the directory: " + ec.message());
+      if (Status s = MakeOutputDirectory("--frames", options.framesDir); !s) return s;
     }
     if (Status s = OfflinePictures::Create(options.imageWidth, options.imageHeight, &pictures, options.glDebug); !s) {
       return Status::Error("--screenshot/--frames: " + s.message());
@@ -674,7 +793,9 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       }
       stats << header << "\n";
     }
+    stats.flush();
   }
+  CsvRows rows(&stats);
 
   const bool showProgress = options.progress == 1 || (options.progress == -1 && isatty(STDERR_FILENO));
   const bool progressLines = options.progress == -1 && !showProgress;  // a log file: a line a minute
@@ -784,6 +905,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   double activeSum = 0.0;
   double forceSum = 0.0;
   double nextFrame = paddleClock;  // paddles: the next display frame (a state file's, or now)
+  // Checkpoints at whole multiples of the interval on the simulated clock (a continued run keeps the grid).
+  double nextCheckpoint = options.checkpointEvery > 0.0
+                              ? (std::floor(solver->Time() / options.checkpointEvery + 1e-9) + 1.0) * options.checkpointEvery
+                              : 0.0;
   const auto begin = std::chrono::steady_clock::now();
   while (targetSteps > 0 ? solver->GetTotals().steps < targetSteps : solver->Time() < targetTime - 1e-9) {
     if (g_interrupt) break;
@@ -818,26 +943,42 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
                                   static_cast<long long>(wholeStep), info.time));
     }
     if (stats.is_open()) {
-      stats << wholeStep << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
-            << info.maxDensityError << ',' << info.clamped << ',' << info.activeFraction;
+      std::ostringstream row;
+      row << wholeStep << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
+          << info.maxDensityError << ',' << info.clamped << ',' << info.activeFraction;
       if (probeEveryStep) {
         solver->Download(&host);
         const DamBreakMeasure m = MeasureDamBreak(*scene.damBreak, host, spacing);
-        stats << ',' << m.front << ',' << m.height;
+        row << ',' << m.front << ',' << m.height;
       }
       if (dfsph) {
         stats << ',' << info.densityIterations << ',' << info.divergenceIterations << ',' << info.solverDensityError << ','
               << info.solverDivergenceError;
       }
       if (paddles) {
-        stats << ',' << info.pushedOut;
+        row << ',' << info.pushedOut;
         for (int k = 0; k < paddles->Count(); ++k) {
           const interaction::PaddleState& p = paddles->State(k);
-          stats << ',' << p.force.x << ',' << p.force.y << ',' << p.force.z << ',' << p.haptic;
+          row << ',' << p.force.x << ',' << p.force.y << ',' << p.force.z << ',' << p.haptic;
         }
       }
-      stats << '\n';
-      if (!stats) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?) at step " + std::to_string(wholeStep));
+      row << '\n';
+      rows.Add(row.str());
+      if (rows.Due() && !rows.Flush()) {
+        return Status::Error("--stats " + options.statsPath + ": write failed (disk full?) at step " + std::to_string(wholeStep));
+      }
+    }
+    if (options.checkpointEvery > 0.0 && solver->Time() >= nextCheckpoint - 1e-9) {
+      // The CSV first: a run continued from this checkpoint keeps the rows up to its step.
+      if (!rows.Flush()) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?)");
+      if (Status s = WriteCheckpoint(options.saveState, options.checkpointKeep, *solver, scene.name, paddles.get(),
+                                     nextFrame, savedStep);
+          !s) {
+        return Status::Error("--checkpoint-every: " + s.message());
+      }
+      ++summary->checkpoints;
+      summary->checkpointTime = solver->Time();
+      nextCheckpoint = (std::floor(solver->Time() / options.checkpointEvery + 1e-9) + 1.0) * options.checkpointEvery;
     }
     if (options.exportEvery > 0 && wholeStep % options.exportEvery == 0) {
       if (Status s = exportNow(wholeStep); !s) return s;
@@ -871,10 +1012,19 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       if (Status s = exportSurface(step); !s) return s;
     }
   }
+  // The rows of a run stopped by a signal too; a failed save is reported after the summary (which covers
+  // the run), not instead of it.
+  Status saveStatus;
+  if (!rows.Flush()) return Status::Error("--stats " + options.statsPath + ": write failed (disk full?)");
   if (!options.saveState.empty()) {
-    if (Status s = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame, savedStep); !s) {
-      return Status::Error("--save-state " + s.message());
-    }
+    saveStatus = WriteStateFile(options.saveState, *solver, scene.name, paddles.get(), nextFrame, savedStep);
+  }
+  if (!saveStatus) {
+    saveStatus = Status::Error("--save-state " + saveStatus.message() +
+                               (summary->checkpoints > 0 ? Format(" (the last checkpoint, t = %.6g s, is there)",
+                                                                 summary->checkpointTime)
+                                                         : ""));
+  } else if (!options.saveState.empty()) {
     summary->stateSaved = options.saveState;
     // The file does not record how it was made: a run from it skips the scene's settle as if it were done.
     if (summary->settle.stopped) {
@@ -1024,11 +1174,16 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (summary->exports > 0) {
     std::printf("  exported        %lld files to %s\n", static_cast<long long>(summary->exports), options.outDir.c_str());
   }
+  if (summary->checkpoints > 0) {
+    std::printf("  checkpoints     %lld, the last at t = %.6g s in %s%s\n", static_cast<long long>(summary->checkpoints),
+                summary->checkpointTime, options.saveState.c_str(),
+                summary->stateSaved.empty() ? "" : " (then replaced by the state at the end; older ones: .1, .2, ...)");
+  }
   if (!summary->stateSaved.empty()) {
     std::printf("  state           saved to %s at t = %.6g s (sphxr --load-state %s continues from there)\n",
                 summary->stateSaved.c_str(), summary->simulatedTime, summary->stateSaved.c_str());
   }
-  return Status::Ok();
+  return saveStatus;
 }
 
 }  // namespace sphxr::app

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <limits>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 #include "sphxr/app/param_registry.h"
@@ -17,6 +18,110 @@ namespace sphxr::app {
 namespace {
 
 using nlohmann::json;
+
+constexpr int kMaxDepth = 64;        // no scene nests deeper than 6; the cap keeps every walk shallow
+constexpr size_t kMaxEcho = 80;      // characters of a bad value quoted in a message
+
+// A bad value as a message quotes it: at most kMaxEcho characters, ASCII only (control characters and
+// terminal escapes are escaped by dump's ensure_ascii), so a message stays one short line whatever the
+// file holds. (Depth is capped at parse time, so dump's recursion is bounded.)
+std::string Brief(const json& j) {
+  std::string text = j.dump(-1, ' ', true, json::error_handler_t::replace);
+  if (text.size() > kMaxEcho) text = text.substr(0, kMaxEcho - 3) + "...";
+  return text;
+}
+
+// A key from the file in a message or warning: at most kMaxEcho characters, control characters as '?'.
+std::string Shown(const std::string& key) {
+  std::string out = key.size() > kMaxEcho ? key.substr(0, kMaxEcho - 3) + "..." : key;
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
+
+// Text from the file shown on a terminal (names): printable ASCII and UTF-8, no control characters.
+bool Printable(const std::string& text) {
+  for (const char c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return false;
+  }
+  return true;
+}
+
+// What nlohmann's parser does not say: nesting deeper than kMaxDepth, and a key given twice in one
+// object (the parser keeps the last, so a second "solver" silently replaced the first). A scan of the
+// raw text, so that the message can give the line of each; run on text the parser accepted.
+class StructureScan {
+ public:
+  explicit StructureScan(const std::string& text) : m_text(text) {}
+
+  Status Run(const std::string& origin) {
+    struct Frame {
+      bool object;
+      std::string path;
+      std::unordered_map<std::string, int> keys;  // key -> its line (a map: an object may have 100,000 keys)
+      std::string pendingKey;
+      size_t index = 0;
+    };
+    std::vector<Frame> stack;
+    int line = 1;
+    auto childPath = [&]() -> std::string {
+      if (stack.empty()) return "";
+      const Frame& f = stack.back();
+      if (f.object) return f.path.empty() ? f.pendingKey : f.path + "." + f.pendingKey;
+      return f.path + "[" + std::to_string(f.index) + "]";
+    };
+    for (size_t i = 0; i < m_text.size(); ++i) {
+      const char c = m_text[i];
+      if (c == '\n') {
+        ++line;
+      } else if (c == '"') {
+        const size_t start = i;
+        for (++i; i < m_text.size() && m_text[i] != '"'; ++i) {
+          if (m_text[i] == '\\') ++i;
+        }
+        if (stack.empty() || !stack.back().object) continue;
+        // A key is a string followed by ':'.
+        size_t k = i + 1;
+        while (k < m_text.size() && (m_text[k] == ' ' || m_text[k] == '\t' || m_text[k] == '\r' || m_text[k] == '\n')) ++k;
+        if (k >= m_text.size() || m_text[k] != ':') continue;
+        std::string key = m_text.substr(start + 1, i - start - 1);
+        if (key.find('\\') != std::string::npos) {  // escapes: compare keys as the parser reads them
+          try {
+            key = json::parse(m_text.substr(start, i - start + 1)).get<std::string>();
+          } catch (const json::exception&) {
+          }
+        }
+        Frame& f = stack.back();
+        if (const auto seen = f.keys.find(key); seen != f.keys.end()) {
+          const std::string where = f.path.empty() ? "at the top level" : "in " + Shown(f.path);
+          return Status::Error(Format("%s: key %s appears twice %s (lines %d and %d): the second would replace the "
+                                      "first; keep one",
+                                      origin.c_str(), Brief(json(key)).c_str(), where.c_str(), seen->second, line));
+        }
+        f.keys.emplace(key, line);
+        f.pendingKey = key;
+      } else if (c == '{' || c == '[') {
+        if (static_cast<int>(stack.size()) >= kMaxDepth) {
+          return Status::Error(Format("%s: line %d: nested more than %d levels deep: not a scene", origin.c_str(), line,
+                                      kMaxDepth));
+        }
+        Frame f;
+        f.object = c == '{';
+        f.path = childPath();
+        stack.push_back(std::move(f));
+      } else if (c == '}' || c == ']') {
+        if (!stack.empty()) stack.pop_back();
+      } else if (c == ',' && !stack.empty() && !stack.back().object) {
+        ++stack.back().index;
+      }
+    }
+    return Status::Ok();
+  }
+
+ private:
+  const std::string& m_text;
+};
 
 class Reader {
  public:
@@ -30,26 +135,39 @@ class Reader {
     std::set<std::string> names(known.begin(), known.end());
     for (auto it = obj.begin(); it != obj.end(); ++it) {
       if (!names.count(it.key())) {
-        const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
-        m_out->warnings.push_back("unknown key '" + key + "' ignored");
-        SPHXR_LOG_WARN("%s: unknown key '%s' ignored", m_out->path.c_str(), key.c_str());
+        const std::string key = prefix.empty() ? Shown(it.key()) : prefix + "." + Shown(it.key());
+        Unknown(key);
       }
     }
   }
 
+  // An unknown key is warned about by name, the first kMaxWarnings of them (a file of 100,000 would
+  // be 100,000 lines); Parse counts the rest in one line.
+  static constexpr int kMaxWarnings = 20;
+  void Unknown(const std::string& key) {
+    if (++m_unknown > kMaxWarnings) return;
+    m_out->warnings.push_back("unknown key '" + key + "' ignored");
+    SPHXR_LOG_WARN("%s: unknown key '%s' ignored", m_out->path.c_str(), key.c_str());
+  }
+  void CountUnknown() const {
+    if (m_unknown <= kMaxWarnings) return;
+    m_out->warnings.push_back(Format("%d more unknown keys ignored", m_unknown - kMaxWarnings));
+    SPHXR_LOG_WARN("%s: %d more unknown keys ignored", m_out->path.c_str(), m_unknown - kMaxWarnings);
+  }
+
   Status Number(const json& j, const std::string& key, double* v) const {
-    if (!j.is_number()) return Error(key, "must be a number, got " + std::string(j.type_name()) + " " + j.dump());
+    if (!j.is_number()) return Error(key, "must be a number, got " + std::string(j.type_name()) + " " + Brief(j));
     *v = j.get<double>();
     if (!std::isfinite(*v)) return Error(key, "must be finite");
     // Every scene number is stored as a float: beyond its range the conversion is undefined.
     if (std::fabs(*v) > static_cast<double>(std::numeric_limits<float>::max())) {
-      return Error(key, "is " + j.dump() + ", beyond the range of a float (3.4e38)");
+      return Error(key, "is " + Brief(j) + ", beyond the range of a float (3.4e38)");
     }
     return Status::Ok();
   }
 
   Status Vec(const json& j, const std::string& key, sim::Vec3* v) const {
-    if (!j.is_array() || j.size() != 3) return Error(key, "must be an array of three numbers, got " + j.dump());
+    if (!j.is_array() || j.size() != 3) return Error(key, "must be an array of three numbers, got " + Brief(j));
     double c[3];
     for (int i = 0; i < 3; ++i) {
       if (Status s = Number(j[i], key + "[" + std::to_string(i) + "]", &c[i]); !s) return s;
@@ -73,6 +191,7 @@ class Reader {
     if (root.contains("name")) {
       if (!root["name"].is_string()) return Error("name", "must be a string");
       m_out->name = root["name"].get<std::string>();
+      if (!Printable(m_out->name)) return Error("name", "has control characters (terminal escapes?): use plain text");
     }
     if (root.contains("description") && root["description"].is_string()) {
       m_out->description = root["description"].get<std::string>();
@@ -88,8 +207,7 @@ class Reader {
         }
         const sim::ParamInfo* info = sim::FindSolverParam(it.key());
         if (!info) {
-          m_out->warnings.push_back("unknown key 'solver." + it.key() + "' ignored");
-          SPHXR_LOG_WARN("%s: unknown key 'solver.%s' ignored", m_out->path.c_str(), it.key().c_str());
+          Unknown("solver." + Shown(it.key()));
           continue;
         }
         double v;
@@ -327,6 +445,7 @@ class Reader {
       if (p.contains("name")) {
         if (!p["name"].is_string()) return Error(key + ".name", "must be a string");
         d.name = p["name"].get<std::string>();
+        if (!Printable(d.name)) return Error(key + ".name", "has control characters (terminal escapes?): use plain text");
       }
       const std::string hand = p.contains("hand") && p["hand"].is_string() ? p["hand"].get<std::string>() : "";
       if (hand == "left") d.holder = interaction::Holder::kLeftHand;
@@ -388,8 +507,12 @@ class Reader {
         if (!p.contains("trajectory") || !p["trajectory"].is_string()) {
           return Error(key + ".trajectory", "a scripted paddle needs a trajectory file (CSV of timed poses)");
         }
+        const std::string name = p["trajectory"].get<std::string>();
+        if (name.empty() || name.size() > 4096 || !Printable(name)) {
+          return Error(key + ".trajectory", "must be a file name (printable, at most 4096 characters)");
+        }
         // Relative to the scene file's folder.
-        std::filesystem::path file = p["trajectory"].get<std::string>();
+        std::filesystem::path file = name;
         if (file.is_relative()) file = std::filesystem::path(m_out->path).parent_path() / file;
         m_out->inputs.push_back(file.string());
         if (Status st = interaction::Trajectory::Load(file.string(), &d.trajectory); !st) {
@@ -407,6 +530,7 @@ class Reader {
 
  private:
   SceneFile* m_out;
+  int m_unknown = 0;
 };
 
 }  // namespace
@@ -414,9 +538,21 @@ class Reader {
 Status ParseScene(const std::string& text, const std::string& origin, SceneFile* out) {
   *out = SceneFile{};
   out->path = origin;
+  StructureScan scan(text);
   json root;
   try {
-    root = json::parse(text);
+    // The parser is not recursive, but dump (the messages) and a json's copies are: deeper values are
+    // dropped as they are read, and the scene refused.
+    int deepest = 0;
+    json::parser_callback_t depthCap = [&](int depth, json::parse_event_t, json&) {
+      if (depth > kMaxDepth) deepest = depth;
+      return depth <= kMaxDepth;
+    };
+    root = json::parse(text, depthCap);
+    if (deepest > 0) {
+      if (Status s = scan.Run(origin); !s) return s;  // names the line
+      return Status::Error(Format("%s: nested more than %d levels deep: not a scene", origin.c_str(), kMaxDepth));
+    }
   } catch (const json::exception& e) {  // parse errors, and numbers too large for a double
     // (The parser quotes the bytes it read last: a binary file given by mistake must not put raw control
     // bytes on the terminal.)
@@ -424,10 +560,15 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
     for (char& c : what) {
       if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
     }
+    // ("last read" quotes the whole token: a 5 MB unterminated string would be a 5 MB message.)
+    if (what.size() > 2 * kMaxEcho) what = what.substr(0, 2 * kMaxEcho - 3) + "...";
     return Status::Error(origin + ": not valid JSON: " + what);
   }
+  if (Status s = scan.Run(origin); !s) return s;
   Reader reader(out);
-  return reader.Parse(root);
+  const Status s = reader.Parse(root);
+  reader.CountUnknown();
+  return s;
 }
 
 Status LoadScene(const std::string& path, SceneFile* out) {

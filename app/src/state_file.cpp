@@ -87,6 +87,66 @@ class Reader {
   size_t m_at = 0;
 };
 
+// A state file is checked as a scene is (sim's ValidateScene): finite is not enough. Every particle
+// outside the tank was clamped back in (a density error of 127,229 %), a body at y = 1e9 m moved at
+// 3.5e9 m/s in its first step, and particles with one id are not one particle's history.
+constexpr double kMaxFluidSpeed = 1000.0;  // m/s: a scene's fluid block may start at most this fast
+
+Status CheckAgainstScene(const StateFile& state, const sim::SceneSetup& scene) {
+  const sim::HostFluid& f = state.fluid;
+  const float slack = scene.params.spacing;  // the domain clamp keeps particles inside the walls
+  const sim::Aabb& t = scene.tank;
+  for (size_t i = 0; i < f.size(); ++i) {
+    const sim::Vec4 p = f.position[i];
+    const float top = t.max.y + slack;  // (an open tank's domain ends at its rim too)
+    if (!(p.x >= t.min.x - slack && p.x <= t.max.x + slack && p.y >= t.min.y - slack && p.y <= top &&
+          p.z >= t.min.z - slack && p.z <= t.max.z + slack)) {
+      return Status::Error(Format("particle %zu (id %u) at [%g %g %g] is outside the tank [%g %g %g] to [%g %g %g]: "
+                                  "saved from another scene, or damaged",
+                                  i, f.id[i], p.x, p.y, p.z, t.min.x, t.min.y, t.min.z, t.max.x, t.max.y, t.max.z));
+    }
+    const sim::Vec4 v = f.velocity[i];
+    const double speed = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+    if (!(speed <= kMaxFluidSpeed)) {
+      return Status::Error(Format("particle %zu (id %u) moves at %g m/s; at most %g m/s is supported: damaged", i,
+                                  f.id[i], speed, kMaxFluidSpeed));
+    }
+  }
+  std::vector<uint32_t> ids(f.id);
+  std::sort(ids.begin(), ids.end());
+  if (const auto twin = std::adjacent_find(ids.begin(), ids.end()); twin != ids.end()) {
+    return Status::Error(Format("particle id %u appears twice: damaged", *twin));
+  }
+  // Bodies (paddles) may be withdrawn above the water, not far away: within the tank's diagonal of it.
+  const double reach = sim::Length(t.max - t.min);
+  auto near = [&](const sim::Vec3& x) {
+    const double dx = std::max({double(t.min.x) - x.x, 0.0, double(x.x) - t.max.x});
+    const double dy = std::max({double(t.min.y) - x.y, 0.0, double(x.y) - t.max.y});
+    const double dz = std::max({double(t.min.z) - x.z, 0.0, double(x.z) - t.max.z});
+    return std::sqrt(dx * dx + dy * dy + dz * dz) <= reach;
+  };
+  for (size_t k = 0; k < state.bodies.size(); ++k) {
+    const sim::BodyMotionState& m = state.bodies[k];
+    for (const sim::RigidPose* pose : {&m.pose, &m.from, &m.to}) {
+      if (!sim::Finite(pose->position) || !near(pose->position)) {
+        return Status::Error(Format("body %zu's pose [%g %g %g] is more than the tank's diagonal (%g m) from the tank: "
+                                    "damaged",
+                                    k, pose->position.x, pose->position.y, pose->position.z, reach));
+      }
+    }
+    const double speed = sim::Finite(m.velocity) ? double(sim::Length(m.velocity)) : HUGE_VAL;
+    if (!(speed <= kMaxFluidSpeed)) {
+      return Status::Error(Format("body %zu moves at %g m/s; at most %g m/s is supported: damaged", k, speed, kMaxFluidSpeed));
+    }
+  }
+  for (size_t k = 0; k < state.paddles.size(); ++k) {
+    if (!near(state.paddles[k].state.commanded.position)) {
+      return Status::Error(Format("paddle %zu's commanded pose is more than the tank's diagonal from the tank: damaged", k));
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
@@ -213,10 +273,19 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   if (in.gcount() != static_cast<std::streamsize>(size - sizeof(head))) {
     return Status::Error(path + ": read failed: the file changed while it was read");
   }
+  return ParseStateFile(std::move(data), path, out);
+}
+
+Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile* out) {
+  *out = StateFile{};
+  out->path = path;
+  if (data.size() < sizeof(kMagic) || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
+    return Status::Error(path + ": not an sphxr state file (written by sphxr --save-state)");
+  }
   Reader r(std::move(data));
   auto truncated = [&]() { return Status::Error(Format("%s: truncated at byte %zu: not a whole state file", path.c_str(), r.At())); };
   char magic[sizeof(kMagic)];
-  r.Bytes(magic, sizeof(magic));  // checked above, before the file was read whole
+  r.Bytes(magic, sizeof(magic));  // checked above
   uint32_t order = 0, version = 0;
   if (!r.Get(&order) || !r.Get(&version)) return truncated();
   if (order != kByteOrder) return Status::Error(path + ": written on a machine of the other byte order");
@@ -243,8 +312,13 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
     std::string method;
     if (!r.String(&method, 64)) return truncated();
     if (!sim::ParseSolverMethod(method, &out->method)) {
-      return Status::Error(path + ": solver method '" + method.substr(0, 16) + "' is not one this build knows");
+      return Status::Error(path + ": its solver method is not wcsph or dfsph: the file is damaged or from a newer build");
     }
+  }
+  // The scene's name is shown in messages and the log: control characters (a damaged file, or a name
+  // with terminal escapes) become '?'.
+  for (char& c : out->scene) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
   }
   const sim::ParamInfo* spacing = sim::FindSolverParam("spacing");
   if (!std::isfinite(out->spacing) || out->spacing < spacing->min || out->spacing > spacing->max) {
@@ -306,6 +380,11 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
     std::string name;
     uint32_t element = 0;
     if (!r.String(&name, 256) || !r.Get(&element)) return truncated();
+    // (Named in messages: a damaged name must not put control characters or a newline on the terminal.)
+    const bool identifier = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+    });
+    if (!identifier) return Status::Error(Format("%s: field %u has no name: the file is damaged", path.c_str(), f));
     if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
       return Status::Error(path + ": field '" + name + "' appears twice: the file is damaged");
     }
@@ -383,6 +462,7 @@ Status RestoreState(const StateFile& state, sim::Solver* solver) {
                                 path.c_str(), state.scene.c_str(), state.fluidCount, state.boundaryCount, state.spacing,
                                 solver->FluidCount(), solver->BoundaryCount(), spacing));
   }
+  if (Status s = CheckAgainstScene(state, solver->Scene()); !s) return Status::Error(path + ": " + s.message());
   if (Status s = solver->Restore(state.fluid, state.clock); !s) return Status::Error(path + ": " + s.message());
   if (static_cast<int>(state.bodies.size()) == solver->BodyCount()) {  // the same bodies: their whole motion
     for (int k = 0; k < solver->BodyCount(); ++k) {

@@ -166,6 +166,34 @@ Status PaddleSystem::Create(std::vector<PaddleDesc> paddles, const sim::SceneSet
       }
       if (!box && !Positive(s.radius)) return Status::Error(key + ": a capsule needs a positive radius");
     }
+    // Sized from closed forms before anything is sampled (a capsule of radius 100 m asked for 8.9 GB of
+    // boundary particles before sim's ValidateBodies saw it): the reach ValidateBodies allows, and a
+    // particle count a sheet over the shapes' surfaces cannot exceed by much.
+    const float tankSize = sim::Length(scene.tank.max - scene.tank.min);
+    double reach = 0.0, area = 0.0;
+    for (const ShapePrimitive& s : d.shapes) {
+      if (s.kind == ShapePrimitive::Kind::kBox) {
+        const double x = std::fabs(s.a.x) + s.b.x, y = std::fabs(s.a.y) + s.b.y, z = std::fabs(s.a.z) + s.b.z;
+        reach = std::max(reach, std::sqrt(x * x + y * y + z * z));
+        area += 8.0 * (double(s.b.x) * s.b.y + double(s.b.y) * s.b.z + double(s.b.x) * s.b.z);
+      } else {
+        const double length = sim::Length(s.b - s.a);
+        reach = std::max(reach, std::max<double>(sim::Length(s.a), sim::Length(s.b)) + s.radius);
+        area += 2.0 * kPi * s.radius * length + 4.0 * kPi * double(s.radius) * s.radius;
+      }
+    }
+    reach -= 0.5 * dx;  // the sheet lies half a spacing inside the surface
+    if (!std::isfinite(reach) || reach > tankSize) {
+      return Status::Error(Format("%s: its shapes reach %g m from its origin, more than the tank's %g m diagonal",
+                                  key.c_str(), reach, tankSize));
+    }
+    constexpr double kMaxPaddleParticles = double(1 << 26);
+    const double estimate = area / (double(dx) * dx);
+    if (estimate > kMaxPaddleParticles) {
+      return Status::Error(Format("%s: its shapes need about %.3g boundary particles at spacing %g m; at most %.3g "
+                                  "are supported: use a larger spacing or smaller shapes",
+                                  key.c_str(), estimate, dx, kMaxPaddleParticles));
+    }
     Paddle p;
     p.desc = std::move(d);
     p.points = SamplePaddle(p.desc.shapes, dx);

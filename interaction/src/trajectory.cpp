@@ -32,6 +32,18 @@ bool ToDouble(const std::string& text, double* v) {
   return *end == '\0' && std::isfinite(*v);
 }
 
+constexpr double kMaxTime = 1e9;        // s: the solver's clock limit (32 years)
+constexpr double kMaxCoordinate = 1e6;  // m, and the other columns: far past any tank, well inside a float
+
+// A field quoted in a message: at most 80 characters, control characters shown as '?'.
+std::string Shown(const std::string& field) {
+  std::string out = field.size() > 80 ? field.substr(0, 77) + "..." : field;
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
+
 }  // namespace
 
 Status Trajectory::FromKeys(std::vector<TrajectoryKey> keys, Trajectory* out) {
@@ -73,7 +85,15 @@ Status Trajectory::Parse(const std::string& text, const std::string& origin, Tra
     for (size_t c = 0; c < n; ++c) {
       if (!ToDouble(f[c], &v[c])) {
         return Status::Error(Format("%s:%d: column %zu '%s' is not a finite number", origin.c_str(), lineNumber, c + 1,
-                                    f[c].c_str()));
+                                    Shown(f[c]).c_str()));
+      }
+      // Within what a float holds and a clock runs: 1e300 (and 3e38, which the pose arithmetic
+      // overflows) ended in "non-finite target for body 0" with no file or line.
+      const double limit = c == 0 ? kMaxTime : kMaxCoordinate;
+      if (std::fabs(v[c]) > limit) {
+        return Status::Error(Format("%s:%d: column %zu is %.3g; %s must be within +-%g %s", origin.c_str(), lineNumber,
+                                    c + 1, v[c], c == 0 ? "a time" : c < 4 ? "a position" : "this column", limit,
+                                    c == 0 ? "s" : c < 4 ? "m" : ""));
       }
     }
     TrajectoryKey key;

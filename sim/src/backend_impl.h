@@ -327,6 +327,7 @@ class BackendImpl final : public Backend {
 
   void Download(HostFluid* out) const override {
     out->resize(m_fluid.position.size());
+    if (out->size() == 0) return;  // (thrust's host copy of nothing dereferences a null begin: UB)
 #define SPHXR_DOWNLOAD_FIELD(type, name) thrust::copy(m_fluid.name.begin(), m_fluid.name.end(), out->name.begin());
     SPHXR_FLUID_FIELDS(SPHXR_DOWNLOAD_FIELD)
 #undef SPHXR_DOWNLOAD_FIELD
@@ -338,14 +339,16 @@ class BackendImpl final : public Backend {
     out->viscosity.resize(m_boundaryAlpha.size());
     thrust::copy(m_boundaryAlpha.begin(), m_boundaryAlpha.end(), out->viscosity.begin());
     out->invReference.resize(m_boundaryInvReference.size());  // empty unless the walls have their own density
-    thrust::copy(m_boundaryInvReference.begin(), m_boundaryInvReference.end(), out->invReference.begin());
+    if (!out->invReference.empty()) {  // (a copy of nothing dereferences the empty vector's null begin: UB)
+      thrust::copy(m_boundaryInvReference.begin(), m_boundaryInvReference.end(), out->invReference.begin());
+    }
   }
 
   void Upload(const HostFluid& fluid) override {
     const size_t n = fluid.size();
 #define SPHXR_UPLOAD_FIELD(type, name) \
   m_fluid.name.resize(n);              \
-  thrust::copy(fluid.name.begin(), fluid.name.end(), m_fluid.name.begin());
+  if (n > 0) thrust::copy(fluid.name.begin(), fluid.name.end(), m_fluid.name.begin());  /* (as in Download) */
     SPHXR_FLUID_FIELDS(SPHXR_UPLOAD_FIELD)
 #undef SPHXR_UPLOAD_FIELD
     m_keys.resize(n);
@@ -424,6 +427,7 @@ class BackendImpl final : public Backend {
   void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const override {
     position->resize(m_bodyPos.size());
     velocity->resize(m_bodyVel.size());
+    if (m_bodyPos.empty()) return;  // (as in Download)
     thrust::copy(m_bodyPos.begin(), m_bodyPos.end(), position->begin());
     thrust::copy(m_bodyVel.begin(), m_bodyVel.end(), velocity->begin());
   }

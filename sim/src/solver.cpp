@@ -212,9 +212,32 @@ Status ValidateScene(const SceneSetup& scene) {
                                   scene.params.spacing, dims[a], "xyz"[a], kMaxGridDim));
     }
   }
-  const ParticleCounts counts = CountParticles(scene);
   // The CPU's SIMD stages gather a particle's Vec4 fields with 32-bit offsets of 4 floats per particle.
   constexpr int64_t kMaxParticles = int64_t{1} << 29;
+  if (!scene.obstacles.empty() || !scene.bodies.empty()) {
+    // CountParticles walks the fluid lattice when obstacles or bodies take part of it (1.1e9 sites took
+    // 20 s before a refusal): the lattice without them, a closed form, is checked first. Its memory is
+    // an upper bound, so a scene refused here says "up to".
+    SceneSetup open;
+    open.params = scene.params;
+    open.fluid = scene.fluid;
+    ParticleCounts bound;
+    bound.fluid = SampleFluid(open, nullptr);
+    bound.boundary = SampleBoundary(scene, nullptr);
+    bound.gridCells = grid.Cells();
+    bound.neighbourSlots = NeighbourCapacity(scene.params.supportFactor);
+    for (const RigidBodySetup& b : scene.bodies) bound.bodyParticles += static_cast<int64_t>(b.points.size());
+    bound.reuse = scene.reuse.enabled;
+    bound.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity;
+    const double needBound = static_cast<double>(EstimateMemoryBytes(bound));
+    if (bound.fluid >= kMaxParticles || needBound > static_cast<double>(AvailableHostBytes())) {
+      return Status::Error(Format("solver.spacing = %g gives up to %lld fluid particles (%.1f GiB) before the obstacles "
+                                  "and paddles take their room; at most %lld and %.1f GiB: use a larger spacing",
+                                  scene.params.spacing, static_cast<long long>(bound.fluid), needBound / 1073741824.0,
+                                  static_cast<long long>(kMaxParticles - 1), AvailableHostBytes() / 1073741824.0));
+    }
+  }
+  const ParticleCounts counts = CountParticles(scene);
   if (counts.fluid >= kMaxParticles || counts.boundary >= kMaxParticles) {
     return Status::Error(Format("solver.spacing = %g gives %lld fluid and %lld boundary particles; at most %lld of each "
                                 "are supported: use a larger spacing",
@@ -282,6 +305,14 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
     if (thin < 3.0f * scene.params.spacing) {
       SPHXR_LOG_WARN("fluid[%zu] is only %.1f spacings thick: too coarse to behave like water", i,
                      thin / scene.params.spacing);
+    }
+    // Weak compressibility holds below Mach 0.1 (about 1 % compression); a block started at 1,000 m/s
+    // compressed by 885 % without a word.
+    const float speed = Length(scene.fluid[i].velocity);
+    if (speed > 0.1f * soundSpeed) {
+      SPHXR_LOG_WARN("fluid[%zu].velocity: %.3g m/s is %.2gx the sound speed %.3g m/s: expect large density errors "
+                     "(WCSPH wants below 0.1x; raise solver.stiffness or lower the speed)",
+                     i, speed, speed / soundSpeed, soundSpeed);
     }
   }
 }

@@ -171,6 +171,7 @@ class SurfaceImpl final : public SurfaceExtractor {
   void DownloadMesh(SurfaceMesh* out) const override {
     out->positions.resize(static_cast<size_t>(3 * m_written));
     out->normals.resize(static_cast<size_t>(3 * m_written));
+    if (m_written == 0) return;  // (thrust's host copy of nothing dereferences a null begin: UB)
     thrust::copy(m_positions.begin(), m_positions.begin() + 3 * m_written, out->positions.begin());
     thrust::copy(m_normals.begin(), m_normals.begin() + 3 * m_written, out->normals.begin());
   }

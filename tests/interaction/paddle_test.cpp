@@ -293,10 +293,11 @@ TEST(PaddleFluid, OneMetreTeleportIsNotAHugeVelocity) {
   EXPECT_EQ(rig.paddles->State(0).mode, PaddleMode::kFollowing);
   EXPECT_NEAR(sim::Length(rig.solver->BodyPose(0).position - inWater), 0.0f, 1e-4f);
   // The paddle never moved faster than the re-entry speed (1 m/s; a 1 m jump in one 90 Hz frame would be
-  // 90 m/s), and the water stays below 3 m/s: the re-entry speed plus the free-fall speed of the water's
-  // depth, sqrt(2 g 0.1 m) = 1.4 m/s, with room for the splash.
+  // 90 m/s), and the water stays below what a wall moving at that speed can give it: twice the wall's
+  // speed (a particle reflected off it) plus the free-fall speed of the water's depth, sqrt(2 g 0.1 m) =
+  // 1.4 m/s, so 3.4 m/s. (The splash's peak is chaotic: 2.9-3.0 m/s, by optimisation level.)
   EXPECT_LE(bodySpeed, limits.reentrySpeed * 1.001f);
-  EXPECT_LT(fluidSpeed, 3.0f);
+  EXPECT_LT(fluidSpeed, 2.0f * limits.reentrySpeed + std::sqrt(2.0f * 9.81f * 0.1f));
   std::printf("teleports: paddle at most %.3f m/s, water at most %.3f m/s\n", bodySpeed, fluidSpeed);
 }
 

@@ -19,6 +19,8 @@ struct Options {
   int64_t steps = 0;        // 0 = use time
   std::string loadState;    // --load-state: the run starts from this state file (state_file.h)
   std::string saveState;    // --save-state: the state at the end of the run (also when stopped early)
+  double checkpointEvery = 0.0;  // --checkpoint-every: simulated s between saves of saveState during the run (0: none)
+  int checkpointKeep = 2;        // --checkpoint-keep: checkpoints kept (saveState, saveState.1, ...)
   double settle = -1.0;     // s of Solver::Settle before the run; -1 = the scene's run.settle, 0 = none
   sim::Device device = sim::Device::kAuto;
   int threads = 0;          // 0 = all cores
@@ -106,6 +108,8 @@ struct RunSummary {
   double startTime = 0.0;            // s on the clock at the first step (a --load-state's time, else 0)
   int64_t stepsBefore = 0;           // the --load-state's step count (steps, exports and CSV rows number on from it)
   std::string stateSaved;            // --save-state: the file written
+  int64_t checkpoints = 0;           // --checkpoint-every: states saved during the run
+  double checkpointTime = -1.0;      // s on the clock of the last checkpoint (-1: none)
 };
 
 /// Runs a scene headless: load, apply overrides, simulate, export, summarise. The summary is printed

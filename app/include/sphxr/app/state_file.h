@@ -56,6 +56,9 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
 /// Reads a state file; a one-line error names the path and what is wrong (not a state file, another
 /// version or byte order, a field this build does not have or lacks, truncated).
 Status ReadStateFile(const std::string& path, StateFile* out);
+/// The same for the bytes of a file (`path` names it in messages): what ReadStateFile does once the
+/// file is read, and what the fuzz target drives.
+Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile* out);
 /// `--load-state path` for every mode: reads the file, refuses a `spacingOption` (--spacing, 0 when not
 /// given) other than the file's, warns when it was saved from a scene of another name than `sceneName`,
 /// and sets `setup`'s spacing to the file's. An empty path reads nothing.
