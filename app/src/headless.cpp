@@ -952,8 +952,8 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
         row << ',' << m.front << ',' << m.height;
       }
       if (dfsph) {
-        stats << ',' << info.densityIterations << ',' << info.divergenceIterations << ',' << info.solverDensityError << ','
-              << info.solverDivergenceError;
+        row << ',' << info.densityIterations << ',' << info.divergenceIterations << ',' << info.solverDensityError << ','
+            << info.solverDivergenceError;
       }
       if (paddles) {
         row << ',' << info.pushedOut;

@@ -355,6 +355,28 @@ TEST(HeadlessTest, RunsASmallSceneWithStatsAndExports) {
   }
 }
 
+TEST(HeadlessTest, DfsphStatsCarryTheSolvesIterationsAndErrors) {
+  test::TempDir dir("headless_dfsph");
+  const std::string scene = dir.Write("scene.json", kSmallScene);
+  const std::string csv = dir.File("stats.csv");
+  const Result r = RunBinary("--headless --scene " + Quote(scene) + " --steps 10 --set method=dfsph --stats " +
+                                 Quote(csv) + " --threads 1 --no-progress",
+                             dir);
+  ASSERT_TRUE(r.Exited()) << r.err;
+  ASSERT_EQ(r.Code(), 0) << "stdout:\n" << r.out << "\nstderr:\n" << r.err;
+  const std::vector<std::string> lines = Lines(test::ReadFile(csv));
+  ASSERT_EQ(lines.size(), 11u);
+  EXPECT_EQ(lines[0], "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction,"
+                      "density_iterations,divergence_iterations,solver_density_error,solver_divergence_error");
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> cells = Split(lines[i], ',');
+    ASSERT_EQ(cells.size(), 12u) << "row " << i << ": " << lines[i];
+    EXPECT_EQ(cells[0], std::to_string(i)) << "row " << i << ": " << lines[i];
+    EXPECT_GE(std::stoi(cells[8]), 2) << "at least min_iterations density iterations: " << lines[i];
+    EXPECT_LE(std::stod(cells[10]), 1e-4) << "the density solve's error within its tolerance (0.01 %): " << lines[i];
+  }
+}
+
 TEST(HeadlessTest, ExportsTheSurfaceAsPlyAndObj) {
   // The small scene with a surface section: a finer lattice than the spacing.
   std::string text = kSmallScene;
