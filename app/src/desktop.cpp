@@ -477,6 +477,19 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     return edited;
   };
   if (ImGui::CollapsingHeader("solver (edits rebuild the scene)")) {
+    // The pressure solver by name, as the scene's solver.method (docs/design/dfsph.md).
+    for (sim::SolverMethod m : {sim::SolverMethod::kWcsph, sim::SolverMethod::kDfsph}) {
+      if (m != sim::SolverMethod::kWcsph) ImGui::SameLine();
+      if (ImGui::RadioButton(sim::SolverMethodName(m), setup.method == m) && setup.method != m) {
+        setup.method = m;
+        Rebuild();
+      }
+    }
+    if (setup.method == sim::SolverMethod::kDfsph) {
+      ImGui::Text("last step: %d density, %d divergence iterations; errors %.3g %%, %.3g %%",
+                  snap.last.densityIterations, snap.last.divergenceIterations, 100.0 * snap.last.solverDensityError,
+                  100.0 * snap.last.solverDivergenceError);
+    }
     for (const ParamDesc& p : ParamRegistry()) {
       if (p.group == "solver" && editor(p)) Rebuild();
     }
