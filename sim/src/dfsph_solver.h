@@ -276,14 +276,7 @@ struct DfsphFinishStage {
     a.x += (v.x - v0.x) * inv;
     a.y += (v.y - v0.y) * inv;
     a.z += (v.z - v0.z) * inv;
-    Vec4 x = fluid.position[i];
-    x.x += dt * v.x;
-    x.y += dt * v.y;
-    x.z += dt * v.z;
-    a.w = ClampToDomain(ph, &x, &v) ? 1.0f : 0.0f;
-    fluid.acceleration[i] = a;
-    fluid.velocity[i] = v;
-    fluid.position[i] = x;
+    DriftAndStore(fluid, ph, dt, i, fluid.position[i], v, a);
   }
 };
 

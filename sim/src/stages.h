@@ -205,6 +205,20 @@ SPHXR_HD SPHXR_INLINE bool ClampToDomain(const Physics& ph, Vec4* x, Vec4* v) {
   return clamped;
 }
 
+/// The end of every integrator: x += dt v, the domain clamp (flagged in acceleration.w, so that the
+/// step reports how many were clamped), and the store of particle i's position, velocity and
+/// acceleration.
+SPHXR_HD SPHXR_INLINE void DriftAndStore(const FluidView& fluid, const Physics& ph, float dt, int i, Vec4 x, Vec4 v,
+                                         Vec4 a) {
+  x.x += dt * v.x;
+  x.y += dt * v.y;
+  x.z += dt * v.z;
+  a.w = ClampToDomain(ph, &x, &v) ? 1.0f : 0.0f;
+  fluid.acceleration[i] = a;
+  fluid.velocity[i] = v;
+  fluid.position[i] = x;
+}
+
 SPHXR_HD SPHXR_INLINE float TaitPressure(const Physics& ph, float density) {
   const float ratio = density * ph.invRestDensity;
   float power;
@@ -721,15 +735,7 @@ struct IntegrateStage {
     v.x += kick * a.x;
     v.y += kick * a.y;
     v.z += kick * a.z;
-    x.x += dt * v.x;
-    x.y += dt * v.y;
-    x.z += dt * v.z;
-    // A particle that leaves the domain is put back on its edge with the outward velocity removed,
-    // and flagged in acceleration.w so that the step reports how many were clamped.
-    a.w = ClampToDomain(ph, &x, &v) ? 1.0f : 0.0f;
-    fluid.acceleration[i] = a;
-    fluid.velocity[i] = v;
-    fluid.position[i] = x;
+    DriftAndStore(fluid, ph, dt, i, x, v, a);
   }
 };
 
