@@ -9,8 +9,9 @@
 //                   the same stage as WCSPH's; its Tait pressure is not used)            [BK17 eq. 1]
 //   2. factor       G_ij = V grad W_ij for every neighbour slot (cached: positions do not move
 //                   until the drift), the boundary terms gB_i = sum_b V_b grad W_ib and
-//                   sB_i = sum_b V_b v_b . grad W_ib, and alpha_i = 1 / (|sum_j G_ij + gB_i|^2 +
-//                   sum_j |G_ij|^2), in the density-ratio form (rho^ = rho / rho0)       [BK17 eq. 11]
+//                   sB_i = sum_b V_b v_b . grad W_ib, and alpha_i = 1 / ((sum_j G_ij + gB_i) .
+//                   (sum_j G_ij + 2 gB_i) + sum_j |G_ij|^2) (walls mirrored, below), in the
+//                   density-ratio form (rho^ = rho / rho0)                               [BK17 eq. 11]
 //   3. divergence   Jacobi iterations on D rho^_i/Dt = sum_j (v_i - v_j) . G_ij +
 //                   v_i . gB_i - sB_i until its mean over the fluid, times dt, is below
 //                   divergence_tolerance                                         [BK17 §4.2, alg. 2]
