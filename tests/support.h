@@ -2,6 +2,12 @@
 // Shared helpers for the unit tests: small scenes built in code, solver creation with a readable
 // failure, log capture, temporary directories, and per-particle lookups by id.
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <sstream>
 
 #include <chrono>
 #include <cmath>
@@ -270,5 +276,37 @@ inline double Seconds(const std::function<void()>& f) {
   f();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+/// The lines of `text`, without their newlines.
+inline std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+#ifdef SPHXR_BINARY
+/// Starts the real binary with `args` in a child whose stdout and stderr go to the two files. SIGINT,
+/// SIGTERM and SIGHUP start at their defaults, as from a terminal: a signal this test's own parent
+/// ignores (a background job, nohup, a CI runner) must not stay ignored.
+inline pid_t SpawnSphxr(const std::vector<std::string>& args, const std::string& outPath, const std::string& errPath) {
+  std::vector<char*> argv{const_cast<char*>(SPHXR_BINARY)};
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(o, 1);
+    dup2(e, 2);
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
+    ::signal(SIGHUP, SIG_DFL);
+    execv(SPHXR_BINARY, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+#endif
 
 }  // namespace sphxr::test

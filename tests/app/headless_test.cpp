@@ -222,12 +222,7 @@ Result RunBinary(const std::string& args, const test::TempDir& dir) {
   return r;
 }
 
-std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
-}
+using test::Lines;
 
 std::vector<std::string> Split(const std::string& line, char sep) {
   std::vector<std::string> out;
@@ -578,27 +573,7 @@ TEST(HeadlessTest, ScreenshotIntoAMissingDirectoryRefusedBeforeTheRun) {
                      "cannot write into", 1, "refused before the solver starts (which logs its device):\n");
 }
 
-// Starts the real binary with `args` in a child whose stdout and stderr go to the two files. SIGINT and
-// SIGTERM start at their defaults, as from a terminal: a signal this test's own parent ignores (a
-// background job) must not stay ignored.
-pid_t SpawnSphxr(const std::vector<std::string>& args, const std::string& outPath, const std::string& errPath) {
-  std::vector<char*> argv{const_cast<char*>(SPHXR_BINARY)};
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(o, 1);
-    dup2(e, 2);
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGTERM, SIG_DFL);
-    ::signal(SIGHUP, SIG_DFL);  // (under nohup or a CI runner it would be inherited as ignored)
-    execv(SPHXR_BINARY, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
+using test::SpawnSphxr;
 
 // Waits for the child until `deadline`; past it the child is killed and false returned.
 bool WaitUntil(pid_t pid, std::chrono::steady_clock::time_point deadline, int* status) {

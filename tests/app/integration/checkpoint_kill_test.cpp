@@ -21,28 +21,8 @@
 namespace sphxr::app {
 namespace {
 
-pid_t Spawn(const std::vector<std::string>& args, const std::string& outPath, const std::string& errPath) {
-  std::vector<char*> argv{const_cast<char*>(SPHXR_BINARY)};
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(o, 1);
-    dup2(e, 2);
-    execv(SPHXR_BINARY, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
-}
+using test::Lines;
+using test::SpawnSphxr;
 
 size_t Commas(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), ',')); }
 
@@ -66,7 +46,7 @@ TEST(CheckpointKill, ASigkillLeavesWholeRowsAndACheckpointThatContinues) {
   std::filesystem::copy_file(SPHXR_SCENES_DIR "/stir.json", dir.File("stir.json"));
   std::filesystem::copy_file(SPHXR_SCENES_DIR "/stir_paddle.csv", dir.File("stir_paddle.csv"));
   const std::string scene = dir.File("stir.json"), csv = dir.File("stats.csv"), state = dir.File("run.state");
-  const pid_t pid = Spawn({"--headless", "--scene", scene, "--spacing", "0.02", "--time", "1000", "--threads", "1", "--no-progress",
+  const pid_t pid = SpawnSphxr({"--headless", "--scene", scene, "--spacing", "0.02", "--time", "1000", "--threads", "1", "--no-progress",
                            "--stats", csv, "--save-state", state, "--checkpoint-every", "0.1"},
                           dir.File("out.txt"), dir.File("err.txt"));
   ASSERT_GT(pid, 0);
@@ -87,7 +67,7 @@ TEST(CheckpointKill, ASigkillLeavesWholeRowsAndACheckpointThatContinues) {
 
   // The run continues from the checkpoint: its rows replace those after the checkpoint's step.
   const double end = saved.clock.time + 0.02;
-  const pid_t again = Spawn({"--headless", "--scene", scene, "--load-state", state, "--time", std::to_string(end),
+  const pid_t again = SpawnSphxr({"--headless", "--scene", scene, "--load-state", state, "--time", std::to_string(end),
                              "--threads", "1", "--no-progress", "--stats", csv},
                             dir.File("out2.txt"), dir.File("err2.txt"));
   ASSERT_GT(again, 0);
