@@ -927,7 +927,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     if (paddles) {
       paddles->AfterStep();
       for (int k = 0; k < paddles->Count(); ++k) {
-        forceSum += sim::Length(paddles->State(k).force);
+        forceSum += Length(paddles->State(k).force);
         summary->paddlePeakHaptic = std::max(summary->paddlePeakHaptic, paddles->State(k).haptic);
       }
     }

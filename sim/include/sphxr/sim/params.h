@@ -54,10 +54,6 @@ struct ParamInfo {
 std::span<const ParamInfo> SolverParamInfos();
 const ParamInfo* FindSolverParam(const std::string& key);
 
-struct Aabb {
-  Vec3 min, max;
-};
-
 struct FluidBlock {
   Aabb box;
   Vec3 velocity;  // initial velocity, m/s
