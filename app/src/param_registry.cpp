@@ -26,43 +26,21 @@ std::vector<ParamDesc> Build() {
     out.push_back(p);
   }
   const sim::ReuseParams reuseDefaults;
-  auto reuseFloat = [&](const char* name, const char* unit, const char* help, float sim::ReuseParams::*m) {
+  for (const sim::ReuseParamInfo& info : sim::ReuseParamInfos()) {
     ParamDesc p;
-    p.name = name;
-    p.key = std::string("reuse.") + name;
+    p.name = info.key;
+    p.key = "reuse." + p.name;
     p.group = "reuse";
-    p.unit = unit;
-    p.help = help;
-    p.min = 0.0;
-    p.max = 1e9;
-    p.defaultValue = reuseDefaults.*m;
-    p.reuseFloat = m;
+    p.unit = info.unit;
+    p.help = info.help;
+    p.min = info.min;
+    p.max = info.max;
+    p.defaultValue = info.count ? reuseDefaults.*(info.count) : reuseDefaults.*(info.real);
+    p.reuseFloat = info.real;
+    p.reuseInt = info.count;
+    p.integer = info.count != nullptr;
     out.push_back(p);
-  };
-  reuseFloat("delta1", "", "weight of the pressure term delta1 P_i / P_pc in ACT_i (Huang et al. 2013, 3.3)",
-             &sim::ReuseParams::delta1);
-  reuseFloat("delta2", "", "weight of the crowding term delta2 N_CPN / N_i in ACT_i", &sim::ReuseParams::delta2);
-  reuseFloat("threshold", "", "ACT_i below this makes a particle inactive (it reuses its values)",
-             &sim::ReuseParams::threshold);
-  reuseFloat("pressure_scale", "Pa", "P_pc; 0 = the Tait pressure at 1 % compression", &sim::ReuseParams::pressureScale);
-  reuseFloat("cell_count", "", "N_CPN; 0 = the rest lattice's particles per cell", &sim::ReuseParams::cellCount);
-  const auto reuseInt = [&](const char* name, const char* unit, const char* help, int lo, int hi,
-                            int sim::ReuseParams::*m) {
-    ParamDesc p;
-    p.name = name;
-    p.key = std::string("reuse.") + name;
-    p.group = "reuse";
-    p.unit = unit;
-    p.help = help;
-    p.min = lo;
-    p.max = hi;
-    p.defaultValue = reuseDefaults.*m;
-    p.integer = true;
-    p.reuseInt = m;
-    out.push_back(p);
-  };
-  reuseInt("idle", "steps", "IDLE: consecutive steps an inactive particle reuses its density, pressure and acceleration",
-           0, 1000, &sim::ReuseParams::idle);
+  }
   return out;
 }
 

@@ -1,8 +1,7 @@
 #pragma once
 // One description of every tunable scene parameter (key, group, unit, help, range, default), read by
-// the scene loader, the command line (--set) and the desktop panel. Solver parameters come from sim's
-// own table (sim::SolverParamInfos(), which sim also validates against); the reuse parameters of the
-// scene's "reuse" section are described here.
+// the scene loader, the command line (--set) and the desktop panel, from sim's own tables
+// (sim::SolverParamInfos() and sim::ReuseParamInfos(), which sim also validates against).
 #include <span>
 #include <string>
 
