@@ -239,10 +239,13 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   std::unique_ptr<DesktopApp> app(new DesktopApp());
   Impl& m = *app->m_impl;
   m.options = options;
-  if (Status s = LoadSceneWithOptions(options, &m.scene); !s) return s;
-  m.setup = m.scene.setup;
-  // A bad state file is one line before any window opens.
-  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), m.scene.name, &m.setup, &m.start); !s) return s;
+  {
+    RunStart start;
+    if (Status s = PrepareStart(options, &start); !s) return s;
+    m.scene = std::move(start.scene);
+    m.setup = start.setup;
+    m.start = start.state;
+  }
 
   render::RendererConfig config;
   config.debug = config.debug || options.glDebug;
@@ -288,14 +291,7 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
     if (std::filesystem::equivalent(m.sceneFiles[i], options.scenePath, ec)) m.sceneIndex = static_cast<int>(i);
   }
 
-  sim::SolverConfig solverConfig;
-  solverConfig.device = options.device;
-  solverConfig.threads = options.threads;
-  if (options.threads == 0) {
-    // One core is left to the frame loop (and llvmpipe's rasteriser, on machines without a GPU).
-    solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
-    SPHXR_LOG_INFO("simulation on %d CPU threads, one core left for drawing (--threads to change)", solverConfig.threads);
-  }
+  const sim::SolverConfig solverConfig = InteractiveSolverConfig(options, true);
   if (Status s = ApplyAutoQuality(options, options.quality != 0, m.start.get(), solverConfig, &m.setup); !s) return s;
   m.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
   m.MakeSimScene();
