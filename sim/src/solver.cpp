@@ -1,3 +1,6 @@
+// Solver: creating one (device choice, sampling, the backend's set-up), the time step (CFL, force and
+// viscosity conditions) and the step with its statistics and validate hook. The rest of the class is in
+// scene_check.cpp (what Create checks), restore.cpp, settle.cpp and bodies.cpp.
 #include "sphxr/sim/solver.h"
 
 #include <algorithm>
