@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu_stages.h"
+#include "cpu/stages.h"
 #include "morton.h"
 
 namespace sphxr::sim {
