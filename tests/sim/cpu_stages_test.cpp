@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cpu/stages.h"
+#include "stages/integrate.h"
 #include "morton.h"
 
 namespace sphxr::sim {
