@@ -346,14 +346,7 @@ Status ExportSink::Surface(Simulation& simulation, int64_t step) {
 Status ExportSink::OnStart(Simulation& simulation) {
   // The start is exported when its step is one of the exports' (a fresh run's step 0): a continued
   // run then writes the files the whole run writes.
-  const int64_t step = simulation.WholeStep();
-  if (m_options.exportEvery > 0 && step % m_options.exportEvery == 0) {
-    if (Status s = Particles(simulation, step); !s) return s;
-  }
-  if (m_options.exportSurfaceEvery > 0 && step % m_options.exportSurfaceEvery == 0) {
-    if (Status s = Surface(simulation, step); !s) return s;
-  }
-  return Status::Ok();
+  return OnStep(simulation, simulation.Solver().LastStep());
 }
 
 Status ExportSink::OnStep(Simulation& simulation, const sim::StepInfo&) {

@@ -1,6 +1,7 @@
 #include "sphxr/app/param_registry.h"
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "sphxr/common/log.h"
@@ -79,6 +80,49 @@ Status SetParam(const ParamDesc& p, double value, const std::string& where, sim:
   }
   p.Set(s, value);
   return Status::Ok();
+}
+
+namespace {
+
+// A number of the reference as a scene file would write it: %g, without "+" and leading zeros in the
+// exponent (1e+10 is 1e10).
+std::string Number(double v) {
+  std::string text = Format("%g", v);
+  const size_t e = text.find('e');
+  if (e == std::string::npos) return text;
+  std::string exponent = text.substr(e + 1);
+  const bool negative = exponent[0] == '-';
+  exponent = exponent.substr(exponent[0] == '+' || exponent[0] == '-' ? 1 : 0);
+  exponent.erase(0, std::min(exponent.find_first_not_of('0'), exponent.size() - 1));
+  return text.substr(0, e) + "e" + (negative ? "-" : "") + exponent;
+}
+
+void Table(const char* group, std::string* out) {
+  *out += "| key | unit | default | range | meaning |\n|---|---|---|---|---|\n";
+  for (const ParamDesc& p : ParamRegistry()) {
+    if (p.group != group) continue;
+    *out += "| `" + p.name + "` | " + p.unit + " | " + Number(p.defaultValue) + " | " + Number(p.min) + " – " +
+            Number(p.max) + " | " + p.help + " |\n";
+    if (p.name == "fixed_dt") {  // the one solver key that is a name, not a number (sim::SolverMethod)
+      *out += Format("| `method` | | `\"%s\"` | `\"%s\"`, `\"%s\"` | the pressure solver: weakly compressible SPH (Tait) or "
+                     "divergence-free SPH (Bender & Koschier 2017), whose step follows the flow speed "
+                     "([../design/dfsph.md](../design/dfsph.md)) |\n",
+                     sim::SolverMethodName(sim::SolverMethod::kWcsph), sim::SolverMethodName(sim::SolverMethod::kWcsph),
+                     sim::SolverMethodName(sim::SolverMethod::kDfsph));
+    }
+  }
+}
+
+}  // namespace
+
+std::string SceneParameterReference() {
+  std::string out = "### `solver`\n\n";
+  Table("solver", &out);
+  out += "\n### `reuse`\n\n";
+  out += "Besides `enabled` (true or false) and `preset` (" + std::string(sim::ReusePresetNames()) +
+         ": applied first, the section's other keys override it):\n\n";
+  Table("reuse", &out);
+  return out;
 }
 
 }  // namespace sphxr::app
