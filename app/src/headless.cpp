@@ -160,6 +160,122 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
   }
 }
 
+/// The outputs' files, checked (and the CSV opened, the directories made, the GL context of the pictures
+/// made) before the solver allocates anything, so a bad path costs nothing.
+Status PrepareOutputs(const Options& options, const SceneFile& scene, RunSummary* summary,
+                      std::unique_ptr<StatsSink>* stats, std::unique_ptr<PicturesSink>* pictures) {
+  if (!options.statsPath.empty()) {
+    *stats = std::make_unique<StatsSink>(options.statsPath);
+    if (Status s = (*stats)->Open(); !s) return s;
+  }
+  // Files written after the run: check their places before it.
+  if (Status s = CheckPlaceToWrite("--screenshot", options.screenshotPath, " (.png)"); !s) return s;
+  if (Status s = CheckPlaceToWrite("--save-state", options.saveState, ""); !s) return s;
+  if (options.outDir != Options{}.outDir && options.exportEvery <= 0 && options.exportSurfaceEvery <= 0) {
+    SPHXR_LOG_WARN("--out %s: nothing is exported without --export-every or --export-surface-every",
+                   options.outDir.c_str());
+  }
+  if (options.exportEvery > 0 || options.exportSurfaceEvery > 0) {
+    if (Status s = MakeOutputDirectory("--out", options.outDir); !s) return s;
+  }
+  if (!options.screenshotPath.empty() || !options.framesDir.empty()) {
+    if (Status s = PicturesSink::Create(options, scene.surface, summary, pictures); !s) return s;
+  }
+  return Status::Ok();
+}
+
+/// The start's lines (a state file's, the particle counts) and the summary's counts.
+void LogStart(const Options& options, const SceneFile& scene, const StateFile* state, const Simulation& simulation,
+              RunSummary* summary) {
+  const sim::Solver& solver = simulation.Solver();
+  if (state) {
+    SPHXR_LOG_INFO("started from %s: t = %.6g s, step %s, %d fluid particles (saved from '%s')",
+                   options.loadState.c_str(), state->clock.time,
+                   state->step < 0 ? "unknown" : std::to_string(state->step).c_str(), state->fluidCount,
+                   state->scene.c_str());
+    if (state->step < 0) {
+      SPHXR_LOG_INFO("%s has no step count (a version-1 file, or continued from one): steps, exports and CSV rows "
+                     "are numbered from 0 again, and a state saved from this run has no count either",
+                     options.loadState.c_str());
+    }
+  }
+  // Steps count on from the state's (the whole run's numbering): the CSV's step column, the export files'
+  // numbers and the state saved at the end.
+  summary->stepsBefore = std::max<int64_t>(simulation.StepsBefore(), 0);
+  if (const interaction::PaddleSystem* paddles = simulation.Paddles()) {
+    summary->paddles = paddles->Count();
+    for (int k = 0; k < paddles->Count(); ++k) summary->paddleParticles += paddles->ParticleCount(k);
+  }
+  summary->startTime = solver.Time();
+  const float spacing = scene.setup.params.spacing;
+  summary->fluid = solver.FluidCount();
+  summary->boundary = solver.BoundaryCount();
+  SPHXR_LOG_INFO("%s: %d fluid + %d boundary particles, spacing %g m, device %s, sound speed %.3g m/s",
+                 scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str(), summary->fluid,
+                 summary->boundary, spacing, sim::DeviceName(solver.ActiveDevice()), solver.SoundSpeed());
+  if (summary->fluid == 0) {
+    SPHXR_LOG_WARN("the scene has no fluid particles (no fluid block, or every block too thin or filled by "
+                   "obstacles at spacing %g m): only the walls and paddles run", spacing);
+  }
+}
+
+/// run.settle / --settle: Solver::Settle before the first step, with its own progress bar; a signal
+/// stops it after the step in progress.
+Status SettleFirst(double settle, bool showProgress, bool progressLines, sim::Solver& solver, RunSummary* summary) {
+  if (settle <= 0.0) return Status::Ok();
+  SPHXR_LOG_INFO("settling: %g simulated s of energy minimisation (FIRE) before t = 0", settle);
+  Progress bar(showProgress, "settling ", progressLines);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto update = [&](double done) {
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const int64_t steps = solver.GetTotals().steps;
+    bar.Update(done / settle, done, steps, steps > 0 ? 1e3 * wall / static_cast<double>(steps) : 0.0);
+    return !g_interrupt;
+  };
+  if (Status s = solver.Settle(settle, &summary->settle, update); !s) return Status::Error("--settle: " + s.message());
+  bar.Finish();
+  if (summary->settle.stopped) {
+    SPHXR_LOG_WARN("settle stopped early at %.4g of %g s (%lld steps): the water is not settled", summary->settle.time,
+                   settle, static_cast<long long>(summary->settle.steps));
+  } else {
+    SPHXR_LOG_INFO("settled: %.4g s in %lld steps (%.1f s wall); largest |a| at the end %.3g m/s^2; the run starts here",
+                   summary->settle.time, static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds,
+                   summary->settle.maxAccel);
+  }
+  return Status::Ok();
+}
+
+/// The summary's figures of the run: the solver's totals, the sinks' measures, the last state's.
+void Summarise(const SceneFile& scene, const sim::Solver& solver, const SummarySink& measures, const ExportSink& exports,
+               RunSummary* summary) {
+  const sim::Totals& totals = solver.GetTotals();
+  summary->steps = totals.steps;
+  summary->simulatedTime = solver.Time();
+  summary->msPerStep = totals.steps > 0 ? 1e3 * totals.stepSeconds / totals.steps : 0.0;
+  for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) {
+    summary->stageMsPerStep[s] = totals.steps > 0 ? 1e3 * totals.stageSeconds[s] / totals.steps : 0.0;
+  }
+  summary->meanDensityError = solver.LastStep().meanDensityError;
+  summary->maxDensityError = solver.LastStep().maxDensityError;
+  summary->clampedEvents = totals.clampedEvents;
+  summary->pushedOut = totals.pushedOutEvents;
+  if (summary->paddles > 0 && totals.steps > 0) {
+    summary->paddleMeanForce = measures.ForceSum() / static_cast<double>(totals.steps * summary->paddles);
+  }
+  summary->meanActiveFraction = totals.steps > 0 ? measures.ActiveSum() / static_cast<double>(totals.steps) : 1.0;
+  sim::HostFluid host;
+  solver.Download(&host);
+  summary->lost = summary->fluid - static_cast<int64_t>(host.size());
+  if (scene.damBreak) {
+    const DamBreakMeasure m = MeasureDamBreak(*scene.damBreak, host, scene.setup.params.spacing);
+    summary->surgeFront = m.front;
+    summary->columnHeight = m.height;
+  }
+  if (summary->surfaceExports > 0) {
+    summary->surfaceMs = 1e3 * exports.SurfaceSeconds() / static_cast<double>(summary->surfaceExports);
+  }
+}
+
 }  // namespace
 
 Status RunHeadless(const Options& options, RunSummary* summary) {
@@ -196,62 +312,17 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
 
   // The outputs' files are checked before the solver allocates anything, so a bad path costs nothing.
   std::unique_ptr<StatsSink> stats;
-  if (!options.statsPath.empty()) {
-    stats = std::make_unique<StatsSink>(options.statsPath);
-    if (Status s = stats->Open(); !s) return s;
-  }
-  // Files written after the run: check their places before it.
-  if (Status s = CheckPlaceToWrite("--screenshot", options.screenshotPath, " (.png)"); !s) return s;
-  if (Status s = CheckPlaceToWrite("--save-state", options.saveState, ""); !s) return s;
-  if (options.outDir != Options{}.outDir && options.exportEvery <= 0 && options.exportSurfaceEvery <= 0) {
-    SPHXR_LOG_WARN("--out %s: nothing is exported without --export-every or --export-surface-every",
-                   options.outDir.c_str());
-  }
-  if (options.exportEvery > 0 || options.exportSurfaceEvery > 0) {
-    if (Status s = MakeOutputDirectory("--out", options.outDir); !s) return s;
-  }
   std::unique_ptr<PicturesSink> pictures;
-  if (!options.screenshotPath.empty() || !options.framesDir.empty()) {
-    if (Status s = PicturesSink::Create(options, scene.surface, summary, &pictures); !s) return s;
-  }
+  if (Status s = PrepareOutputs(options, scene, summary, &stats, &pictures); !s) return s;
 
   SimScene simScene = SimSceneFromFile(scene);
   simScene.start = state;
   std::unique_ptr<Simulation> simulation;
   if (Status s = Simulation::Create(simScene, config, &simulation); !s) return s;
   sim::Solver& solver = simulation->Solver();
-  if (state) {
-    SPHXR_LOG_INFO("started from %s: t = %.6g s, step %s, %d fluid particles (saved from '%s')",
-                   options.loadState.c_str(), state->clock.time,
-                   state->step < 0 ? "unknown" : std::to_string(state->step).c_str(), state->fluidCount,
-                   state->scene.c_str());
-    if (state->step < 0) {
-      SPHXR_LOG_INFO("%s has no step count (a version-1 file, or continued from one): steps, exports and CSV rows "
-                     "are numbered from 0 again, and a state saved from this run has no count either",
-                     options.loadState.c_str());
-    }
-  }
-  // Steps count on from the state's (the whole run's numbering): the CSV's step column, the export files'
-  // numbers and the state saved at the end.
-  summary->stepsBefore = std::max<int64_t>(simulation->StepsBefore(), 0);
-  if (const interaction::PaddleSystem* paddles = simulation->Paddles()) {
-    summary->paddles = paddles->Count();
-    for (int k = 0; k < paddles->Count(); ++k) summary->paddleParticles += paddles->ParticleCount(k);
-  }
+  LogStart(options, scene, state.get(), *simulation, summary);
   state.reset();  // the solver and the paddles have it now
   simScene.start.reset();
-
-  summary->startTime = solver.Time();
-  const float spacing = scene.setup.params.spacing;
-  summary->fluid = solver.FluidCount();
-  summary->boundary = solver.BoundaryCount();
-  SPHXR_LOG_INFO("%s: %d fluid + %d boundary particles, spacing %g m, device %s, sound speed %.3g m/s",
-                 scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str(), summary->fluid,
-                 summary->boundary, spacing, sim::DeviceName(solver.ActiveDevice()), solver.SoundSpeed());
-  if (summary->fluid == 0) {
-    SPHXR_LOG_WARN("the scene has no fluid particles (no fluid block, or every block too thin or filled by "
-                   "obstacles at spacing %g m): only the walls and paddles run", spacing);
-  }
   if (stats) {
     if (Status s = stats->WriteHeader(*simulation, scene.damBreak); !s) return s;
   }
@@ -264,27 +335,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (!options.loadState.empty() && scene.runSettle > 0.0) {
     SPHXR_LOG_INFO("run.settle (%g s) skipped: the state file is the start", scene.runSettle);
   }
-  if (settle > 0.0) {
-    SPHXR_LOG_INFO("settling: %g simulated s of energy minimisation (FIRE) before t = 0", settle);
-    Progress bar(showProgress, "settling ", progressLines);
-    const auto t0 = std::chrono::steady_clock::now();
-    auto update = [&](double done) {
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const int64_t steps = solver.GetTotals().steps;
-      bar.Update(done / settle, done, steps, steps > 0 ? 1e3 * wall / static_cast<double>(steps) : 0.0);
-      return !g_interrupt;
-    };
-    if (Status s = solver.Settle(settle, &summary->settle, update); !s) return Status::Error("--settle: " + s.message());
-    bar.Finish();
-    if (summary->settle.stopped) {
-      SPHXR_LOG_WARN("settle stopped early at %.4g of %g s (%lld steps): the water is not settled", summary->settle.time,
-                     settle, static_cast<long long>(summary->settle.steps));
-    } else {
-      SPHXR_LOG_INFO("settled: %.4g s in %lld steps (%.1f s wall); largest |a| at the end %.3g m/s^2; the run starts here",
-                     summary->settle.time, static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds,
-                     summary->settle.maxAccel);
-    }
-  }
+  if (Status s = SettleFirst(settle, showProgress, progressLines, solver, summary); !s) return s;
 
   // The outputs, in the order they act after each step: the CSV row, a checkpoint (after the rows it
   // keeps), the exports, the state at the end, pictures, progress.
@@ -327,32 +378,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   // the run), not instead of it.
   if (Status s = simulation->Finish(summary->interrupted != 0); !s) return s;
 
-  const sim::Totals& totals = solver.GetTotals();
-  summary->steps = totals.steps;
-  summary->simulatedTime = solver.Time();
-  summary->msPerStep = totals.steps > 0 ? 1e3 * totals.stepSeconds / totals.steps : 0.0;
-  for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) {
-    summary->stageMsPerStep[s] = totals.steps > 0 ? 1e3 * totals.stageSeconds[s] / totals.steps : 0.0;
-  }
-  summary->meanDensityError = solver.LastStep().meanDensityError;
-  summary->maxDensityError = solver.LastStep().maxDensityError;
-  summary->clampedEvents = totals.clampedEvents;
-  summary->pushedOut = totals.pushedOutEvents;
-  if (summary->paddles > 0 && totals.steps > 0) {
-    summary->paddleMeanForce = measures.ForceSum() / static_cast<double>(totals.steps * summary->paddles);
-  }
-  summary->meanActiveFraction = totals.steps > 0 ? measures.ActiveSum() / static_cast<double>(totals.steps) : 1.0;
-  sim::HostFluid host;
-  solver.Download(&host);
-  summary->lost = summary->fluid - static_cast<int64_t>(host.size());
-  if (scene.damBreak) {
-    const DamBreakMeasure m = MeasureDamBreak(*scene.damBreak, host, spacing);
-    summary->surgeFront = m.front;
-    summary->columnHeight = m.height;
-  }
-  if (summary->surfaceExports > 0) {
-    summary->surfaceMs = 1e3 * exports.SurfaceSeconds() / static_cast<double>(summary->surfaceExports);
-  }
+  Summarise(scene, solver, measures, exports, summary);
   PrintSummary(options, scene, *simulation, target, pictures ? pictures->Movie() : std::string(),
                pictures && !options.screenshotPath.empty(), *summary);
   return save ? save->Saved() : Status::Ok();
