@@ -55,7 +55,7 @@ TEST(XrDemo, ControllerSquareShowsTheStereoParallax) {
       << ReadText(headset.dir / "out.txt");
   ExpectNoValidationErrors(headset);
 
-  // The simulated headset's field of view (sim_runtime/src/runtime.cpp, kEyeFov): left eye
+  // The simulated headset's field of view (sim_runtime/src/spaces.cpp, kEyeFov): left eye
   // left/right/up/down = -0.80/0.75/0.80/-0.85 rad, the right eye mirrored left-right.
   auto column = [&](double x, double tanL, double tanR) { return (x / distance - tanL) / (tanR - tanL) * W; };
   const double tanUp = std::tan(0.80), tanDown = std::tan(-0.85);

@@ -207,12 +207,6 @@ bool IsSubactionOf(Action* action, XrPath subaction) {
          std::find(action->subactions.begin(), action->subactions.end(), subaction) != action->subactions.end();
 }
 
-#define SIMRT_SESSION(handle, var)                                        \
-  Session* var = Check<Session>(handle, Tag::kSession);                   \
-  if (!var) return XR_ERROR_HANDLE_INVALID;                               \
-  if (var->instance->lost) return XR_ERROR_INSTANCE_LOST;                 \
-  if (var->lost) return XR_ERROR_SESSION_LOST
-
 template <class State>
 XrResult GetState(XrSession handle, const XrActionStateGetInfo* info, XrActionType want, State* state,
                   float* valueOut) {

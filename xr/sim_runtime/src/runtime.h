@@ -128,10 +128,17 @@ struct Session {
   std::vector<std::unique_ptr<Swapchain>> swapchains;
 };
 
+inline constexpr XrSystemId kSystemId = 1;
+inline constexpr uint32_t kViewCount = 2;
+
 // Shared between the runtime's source files.
 std::mutex& Lock();
 XrTime Now();
+/// Queues an event for xrPollEvent.
+void PushEvent(Instance* inst, const void* event, size_t size);
 void PushSessionState(Session* s, XrSessionState state);
+/// Walks a running session down to STOPPING (through VISIBLE and SYNCHRONIZED).
+void Stop(Session* s);
 XrPath InternPath(Instance* inst, const std::string& path);
 const std::string* PathString(const Instance* inst, XrPath path);
 /// Seconds of the pose script at `time`.
@@ -159,7 +166,44 @@ T* Check(void* handle, Tag tag) {
   return (t && t->tag == tag) ? t : nullptr;
 }
 
-// Entry points implemented outside runtime.cpp.
+// Entry points, by file; runtime.cpp's xrGetInstanceProcAddr hands them to the loader.
+// instance.cpp
+XrResult EnumerateInstanceExtensionProperties(const char*, uint32_t, uint32_t*, XrExtensionProperties*);
+XrResult CreateInstance(const XrInstanceCreateInfo*, XrInstance*);
+XrResult DestroyInstance(XrInstance);
+XrResult GetInstanceProperties(XrInstance, XrInstanceProperties*);
+XrResult PollEvent(XrInstance, XrEventDataBuffer*);
+XrResult ResultToString(XrInstance, XrResult, char*);
+XrResult StructureTypeToString(XrInstance, XrStructureType, char*);
+XrResult GetSystem(XrInstance, const XrSystemGetInfo*, XrSystemId*);
+XrResult GetSystemProperties(XrInstance, XrSystemId, XrSystemProperties*);
+XrResult EnumerateEnvironmentBlendModes(XrInstance, XrSystemId, XrViewConfigurationType, uint32_t, uint32_t*,
+                                        XrEnvironmentBlendMode*);
+XrResult EnumerateViewConfigurations(XrInstance, XrSystemId, uint32_t, uint32_t*, XrViewConfigurationType*);
+XrResult GetViewConfigurationProperties(XrInstance, XrSystemId, XrViewConfigurationType,
+                                        XrViewConfigurationProperties*);
+XrResult EnumerateViewConfigurationViews(XrInstance, XrSystemId, XrViewConfigurationType, uint32_t, uint32_t*,
+                                         XrViewConfigurationView*);
+XrResult GetOpenGLGraphicsRequirementsKHR(XrInstance, XrSystemId, XrGraphicsRequirementsOpenGLKHR*);
+// session.cpp
+XrResult CreateSession(XrInstance, const XrSessionCreateInfo*, XrSession*);
+XrResult DestroySession(XrSession);
+XrResult BeginSession(XrSession, const XrSessionBeginInfo*);
+XrResult EndSession(XrSession);
+XrResult RequestExitSession(XrSession);
+// frame.cpp
+XrResult WaitFrame(XrSession, const XrFrameWaitInfo*, XrFrameState*);
+XrResult BeginFrame(XrSession, const XrFrameBeginInfo*);
+XrResult EndFrame(XrSession, const XrFrameEndInfo*);
+// spaces.cpp
+XrResult EnumerateReferenceSpaces(XrSession, uint32_t, uint32_t*, XrReferenceSpaceType*);
+XrResult CreateReferenceSpace(XrSession, const XrReferenceSpaceCreateInfo*, XrSpace*);
+XrResult GetReferenceSpaceBoundsRect(XrSession, XrReferenceSpaceType, XrExtent2Df*);
+XrResult CreateActionSpace(XrSession, const XrActionSpaceCreateInfo*, XrSpace*);
+XrResult DestroySpace(XrSpace);
+XrResult LocateSpace(XrSpace, XrSpace, XrTime, XrSpaceLocation*);
+XrResult LocateViews(XrSession, const XrViewLocateInfo*, XrViewState*, uint32_t, uint32_t*, XrView*);
+// actions.cpp
 XrResult StringToPath(XrInstance, const char*, XrPath*);
 XrResult PathToString(XrInstance, XrPath, uint32_t, uint32_t*, char*);
 XrResult CreateActionSet(XrInstance, const XrActionSetCreateInfo*, XrActionSet*);
@@ -180,6 +224,7 @@ XrResult GetInputSourceLocalizedName(XrSession, const XrInputSourceLocalizedName
                                      char*);
 XrResult ApplyHapticFeedback(XrSession, const XrHapticActionInfo*, const XrHapticBaseHeader*);
 XrResult StopHapticFeedback(XrSession, const XrHapticActionInfo*);
+// swapchain.cpp
 XrResult EnumerateSwapchainFormats(XrSession, uint32_t, uint32_t*, int64_t*);
 XrResult CreateSwapchain(XrSession, const XrSwapchainCreateInfo*, XrSwapchain*);
 XrResult DestroySwapchain(XrSwapchain);
@@ -198,5 +243,16 @@ XrResult TwoCall(uint32_t capacity, uint32_t* countOut, uint32_t count, F write)
   for (uint32_t i = 0; i < count; ++i) write(i);
   return XR_SUCCESS;
 }
+
+/// Entry-point preambles: the handle's object, or the error a runtime answers for a bad or lost handle.
+#define SIMRT_INSTANCE(handle, var)                        \
+  Instance* var = Check<Instance>(handle, Tag::kInstance); \
+  if (!var) return XR_ERROR_HANDLE_INVALID;                \
+  if (var->lost) return XR_ERROR_INSTANCE_LOST
+#define SIMRT_SESSION(handle, var)                        \
+  Session* var = Check<Session>(handle, Tag::kSession);   \
+  if (!var) return XR_ERROR_HANDLE_INVALID;               \
+  if (var->instance->lost) return XR_ERROR_INSTANCE_LOST; \
+  if (var->lost) return XR_ERROR_SESSION_LOST
 
 }  // namespace sphxr::xr::simrt

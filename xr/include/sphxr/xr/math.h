@@ -1,6 +1,6 @@
 #pragma once
 // What poses become at the OpenXR boundary (nothing outside xr/ sees OpenXR types): the math module's
-// Vec3, Quat and Pose (sphxr/common/math.h; session.cpp converts OpenXR's (x, y, z, w) quaternions),
+// Vec3, Quat and Pose (sphxr/common/math.h; session_impl.h converts OpenXR's (x, y, z, w) quaternions),
 // and the view and projection matrices. Conventions are OpenXR's: right-handed, +y up, -z forward,
 // metres; matrices are column-major (m[col * 4 + row]) for OpenGL.
 #include <array>
