@@ -407,6 +407,7 @@ const char* StageName(Stage stage) {
     case Stage::kBodies: return "bodies";
     case Stage::kDivergence: return "divergence";
     case Stage::kPressure: return "pressure";
+    case Stage::kProbes: return "probes";
     default: return "?";
   }
 }
@@ -619,6 +620,7 @@ Status Solver::Step() {
                                 "solver.stiffness",
                                 red.nonFinite, m_last.time));
   }
+  if (!m_probes.Empty()) ReadProbes(m_probes, m_probeDry, m_last.time, stepNumber - 1, &m_probeSample);
   m_last.time += dt;
   m_last.dt = dt;
   m_last.maxSpeed = std::sqrt(red.maxSpeed2);
@@ -654,6 +656,8 @@ Status Solver::Step() {
   m_totals.stepSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return Status::Ok();
 }
+
+void Solver::SampleProbesNow() { m_backend->SampleProbesNow(MakePhysics(m_scene)); }
 
 void Solver::Download(HostFluid* out) const { m_backend->Download(out); }
 void Solver::DownloadBoundary(HostBoundary* out) const { m_backend->DownloadBoundary(out); }

@@ -739,6 +739,18 @@ struct IntegrateStage {
   }
 };
 
+/// x += dt v and the domain clamp, for an integrator whose velocity and acceleration are already stored
+/// (DFSPH's Finish without its drift, while probes read the state before it): DriftAndStore as it would
+/// have run there, the same numbers.
+struct DriftStage {
+  FluidView fluid;
+  Physics ph;
+  float dt;
+  SPHXR_HD void operator()(int i) const {
+    DriftAndStore(fluid, ph, dt, i, fluid.position[i], fluid.velocity[i], fluid.acceleration[i]);
+  }
+};
+
 // ---- settling: FIRE (Bitzek et al. 2006) on the solver's own steps (Solver::Settle) ----------------
 /// Sums over the fluid of the step just taken: the power a.v, |v|^2 and |a|^2 (the largest |a| is the
 /// step's own StepReduction).
