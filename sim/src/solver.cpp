@@ -483,6 +483,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
   if (Status s = solver->m_backend->Init(MakeGridShape(scene), physics, fluid, boundary); !s) return s;
   if (!scene.bodies.empty()) solver->InitBodies(physics);
   WarnAboutSettings(scene, static_cast<int64_t>(positions.size()), physics.soundSpeed);
+  LogCutBlocks(scene);
   *out = std::move(solver);
   return Status::Ok();
 }
