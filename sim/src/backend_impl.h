@@ -535,8 +535,12 @@ class BackendImpl final : public Backend {
   void EvaluateProbes(const Physics& physics) {
     const int points = static_cast<int>(m_probePoints.size());
     const int items = points + static_cast<int>(m_probeLines.size());
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), items,
-                       ProbeStage{View(), Fluid(), physics, Raw(m_probePoints), points, Raw(m_probeLines), Raw(m_probeOut)});
+    const ProbeStage stage{View(), Fluid(), physics, Raw(m_probePoints), points, Raw(m_probeLines), Raw(m_probeOut)};
+    if constexpr (Traits::kSimdStages) {
+      Traits::ForEachGuided(items, 1, stage);  // the CPU: a gauge costs tens of sensors; equal slices would wait for it
+    } else {
+      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), items, stage);
+    }
   }
 
   /// Applies the sort permutation to every field of the list (one gather and one O(1) swap each).
