@@ -13,6 +13,7 @@
 #include "sphxr/common/log.h"
 #include "sphxr/common/text_file.h"
 #include "sphxr/sim/solver.h"
+#include "scene_probes.h"
 
 namespace sphxr::app {
 namespace {
@@ -186,7 +187,7 @@ class Reader {
   Status Parse(const json& root) {
     if (!root.is_object()) return Error("(root)", "a scene must be a JSON object");
     CheckKeys(root, "", {"name", "description", "solver", "gravity", "tank", "fluid", "obstacles", "run", "probe", "reuse",
-                         "paddles", "surface"});
+                         "paddles", "surface", "probes"});
     sim::SceneSetup& s = m_out->setup;
     if (root.contains("name")) {
       if (!root["name"].is_string()) return Error("name", "must be a string");
@@ -320,6 +321,12 @@ class Reader {
     }
     if (root.contains("paddles")) {
       if (Status st = Paddles(root["paddles"]); !st) return st;
+    }
+    if (root.contains("probes")) {  // after the tank and the paddles, which its probes name
+      ProbeConfig probes;
+      const auto unknown = [this](const std::string& key) { Unknown(key); };
+      if (Status st = ParseProbes(root["probes"], m_out->path, s, m_out->paddles, unknown, &probes); !st) return st;
+      m_out->probes = std::move(probes);
     }
     if (root.contains("surface")) {
       // The water surface (docs/dev/surface.md): sim::SurfaceParams; absent keys keep their defaults.
