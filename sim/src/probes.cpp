@@ -1,5 +1,5 @@
 // Probes (sphxr/sim/probes.h): checking a probe set, the dry thresholds, and turning the probe stage's
-// sums (probe_stage.h) into readings.
+// sums (stages/probes.h) into readings.
 #include "sphxr/sim/probes.h"
 
 #include <algorithm>

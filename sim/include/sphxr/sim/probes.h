@@ -2,7 +2,7 @@
 // Probes: what a user measures in a run without exporting every particle (issue 37). Pressure sensors,
 // water-level gauges, and the force and torque of the fluid on a moving body. The solver evaluates the
 // sensors and gauges on its backend in every step, one work item per probe over the neighbour grid
-// (sim/src/probe_stage.h), on the state at the start of the step: positions, densities and pressures
+// (sim/src/stages/probes.h), on the state at the start of the step: positions, densities and pressures
 // that belong together.
 #include <cstdint>
 #include <optional>

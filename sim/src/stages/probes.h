@@ -11,7 +11,7 @@
 #include <cstdint>
 
 #include "sphxr/sim/probes.h"
-#include "stages.h"
+#include "stages/views.h"
 
 namespace sphxr::sim {
 
