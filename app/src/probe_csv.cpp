@@ -45,7 +45,7 @@ Status ProbeCsv::Open(const std::string& path, const ProbeConfig& config, double
   csv->m_every = config.every;
   // The first row at or after `start`; the tiny slack keeps a start that is a multiple of `every` in
   // (k every rounds either way in binary).
-  csv->m_next = static_cast<int64_t>(std::ceil(start / config.every - 1e-9));
+  csv->StartAt(start);
   csv->m_file = std::fopen(path.c_str(), "wb");
   if (!csv->m_file) return Status::Error("--probes " + path + ": cannot open for writing: " + std::strerror(errno));
   const std::string header = ProbeCsvHeader(config.set) + "\n";
@@ -56,6 +56,8 @@ Status ProbeCsv::Open(const std::string& path, const ProbeConfig& config, double
   *out = std::move(csv);
   return Status::Ok();
 }
+
+void ProbeCsv::StartAt(double start) { m_next = static_cast<int64_t>(std::ceil(start / m_every - 1e-9)); }
 
 ProbeCsv::~ProbeCsv() {
   if (!m_file) return;
@@ -110,5 +112,26 @@ Status ProbeCsv::Flush() {
   if (!ok) return Status::Error("--probes " + m_path + ": write failed (disk full?)");
   return Status::Ok();
 }
+
+Status ProbeSink::Create(const std::string& path, const ProbeConfig& config, std::unique_ptr<ProbeSink>* out) {
+  std::unique_ptr<ProbeSink> sink(new ProbeSink());
+  sink->m_path = path;
+  sink->m_config = config;
+  if (Status s = ProbeCsv::Open(path, config, 0.0, &sink->m_csv); !s) return s;
+  *out = std::move(sink);
+  return Status::Ok();
+}
+
+Status ProbeSink::OnStart(Simulation& simulation) {
+  if (Status s = simulation.Solver().SetProbes(m_config.set); !s) return Status::Error("--probes " + m_path + ": " + s.message());
+  m_csv->StartAt(simulation.Solver().Time());
+  return Status::Ok();
+}
+
+Status ProbeSink::OnStep(Simulation& simulation, const sim::StepInfo&) {
+  return m_csv->Add(simulation.Solver().LastProbes());
+}
+
+Status ProbeSink::Finish(Simulation&, bool) { return m_csv->Flush(); }
 
 }  // namespace sphxr::app

@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 
+#include "sphxr/app/simulation.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/probes.h"
 
@@ -44,6 +45,8 @@ class ProbeCsv {
   Status Flush();
   int64_t Rows() const { return m_rows; }
   double NextTime() const { return static_cast<double>(m_next) * m_every; }
+  /// The rows start at the first multiple of `every` at or after `start` (before any Add).
+  void StartAt(double start);
 
  private:
   ProbeCsv() = default;
@@ -56,6 +59,24 @@ class ProbeCsv {
   std::optional<sim::ProbeSample> m_previous;
   std::string m_pending;
   double m_lastFlush = 0.0;  // s of wall time (steady clock)
+};
+
+/// --probes FILE.csv as a sink of the Simulation: the file made (and its header written) by Create,
+/// before the solver exists; OnStart sets the probes on the solver and starts the rows at its time;
+/// every step adds the solver's LastProbes; Finish hands the last rows to the file.
+class ProbeSink : public SimulationSink {
+ public:
+  static Status Create(const std::string& path, const ProbeConfig& config, std::unique_ptr<ProbeSink>* out);
+  Status OnStart(Simulation& simulation) override;
+  Status OnStep(Simulation& simulation, const sim::StepInfo& info) override;
+  Status Finish(Simulation& simulation, bool interrupted) override;
+  int64_t Rows() const { return m_csv ? m_csv->Rows() : 0; }
+
+ private:
+  ProbeSink() = default;
+  std::string m_path;
+  ProbeConfig m_config;
+  std::unique_ptr<ProbeCsv> m_csv;
 };
 
 }  // namespace sphxr::app
