@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "sphxr/app/probe_csv.h"
+#include "sphxr/app/probe_history.h"
+#include "sphxr/app/simulation.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/sim/solver.h"
 #include "support.h"
@@ -167,6 +169,37 @@ TEST(ProbeCsv, SolverRowsOneMillisecondApart) {
     EXPECT_GT(rows[k][5], 0.1) << "the gauge in the column sees its water";
   }
   std::filesystem::remove(path);
+}
+
+// The panels' plots: a trace per probe, a point every span / kPoints simulated seconds, the last
+// kPoints kept; and a Simulation built from a scene with probes reads them in every step.
+TEST(ProbeHistory, KeepsTheLastSecondsOfEveryProbe) {
+  SceneFile scene;
+  ASSERT_TRUE(ParseScene(Scene(kProbes), "test.json", &scene).ok());
+  const SimScene simScene = SimSceneFromFile(scene);
+  ASSERT_EQ(simScene.probes.pressure.size(), 3u);
+  std::unique_ptr<Simulation> simulation;
+  SimulationConfig config;
+  config.solver = ::sphxr::test::TestConfig();
+  ASSERT_TRUE(Simulation::Create(simScene, config, &simulation).ok());
+  const double span = 0.01;  // s: a point every span / kPoints
+  ProbeHistory history(simScene.probes, span);
+  ASSERT_EQ(history.Traces().size(), 5u);
+  EXPECT_EQ(history.Traces()[0].label, "P1 (Pa)");
+  EXPECT_EQ(history.Traces()[3].label, "G1 (m)");
+  int steps = 0;
+  while (simulation->Solver().Time() < 0.02) {
+    ASSERT_TRUE(simulation->Step().ok());
+    history.Add(simulation->Solver().LastProbes());
+    ++steps;
+  }
+  for (const ProbeTrace& t : history.Traces()) {
+    // More steps than points: the points are thinned to the span's, and only the last kPoints kept.
+    EXPECT_LE(t.values.size(), static_cast<size_t>(ProbeHistory::kPoints)) << t.label;
+    EXPECT_GT(t.values.size(), 0u) << t.label;
+    EXPECT_LE(t.values.size(), static_cast<size_t>(steps)) << t.label;
+  }
+  EXPECT_EQ(history.Traces()[3].values.back(), simulation->Solver().LastProbes().level[0]);
 }
 
 }  // namespace
