@@ -68,7 +68,7 @@ float KernelFractionInside(float offset, float supportRadius);
 /// A pressure probe is dry when its Shepard sum is below half of KernelFractionInside at its offset:
 /// half of what the water gives it next to a flooded wall, which is what it has when the free surface
 /// of still water passes through the probe's point (half of its kernel in the air). A lone drop of one
-/// particle on the probe gives 1/pi ~ 0.32 against a threshold of 0.5 (away from walls) or 0.39 (half a
+/// particle on the probe gives 1/pi ~ 0.32 against a threshold of 0.5 (away from walls) or 0.41 (half a
 /// spacing from a wall at the default support): spray that touches a sensor does not make it wet.
 inline constexpr float kDryFraction = 0.5f;
 float ProbeDryThreshold(float offset, float supportRadius);
