@@ -109,7 +109,9 @@ std::string UsageText() {
          "                    ffmpeg is on the PATH\n"
          "  --image-size WxH  size of the pictures (default 1280x720)\n"
          "  --render MODE     water (default) or particles (coloured by speed)\n"
-         "  --gl-debug        OpenGL debug output on (as in debug builds): any GL error aborts, naming the call\n";
+         "  --gl-debug        OpenGL debug output on (as in debug builds): any GL error aborts, naming the call\n"
+         "  --print-scene-reference  the scene parameters' reference (markdown, from the parameter registry;\n"
+         "                    docs/user/scenes.md holds it)\n";
 }
 
 Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
@@ -139,6 +141,8 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     const char* v = nullptr;
     if (arg == "--help" || arg == "-h") {
       out->help = true;
+    } else if (arg == "--print-scene-reference") {
+      out->printSceneReference = true;
     } else if (arg == "--headless") {
       out->mode = Mode::kHeadless;
     } else if (arg == "--desktop") {

@@ -83,7 +83,7 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
       const PaddlePose& p = snap.paddles[k];
       const char* who = p.hand == 0 ? "left hand" : p.hand == 1 ? "right hand" : "script";
       ImGui::Text("%s%s: %s, fluid force %.3f N", who, p.hand == hand.index ? " (mouse)" : "",
-                  interaction::PaddleModeName(p.mode), sim::Length(p.force));
+                  interaction::PaddleModeName(p.mode), Length(p.force));
     }
     panelHaptic = snap.haptic[hand.index];
     ImGui::ProgressBar(panelHaptic, ImVec2(180, 0), Format("%.2f", panelHaptic).c_str());

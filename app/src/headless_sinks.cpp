@@ -141,7 +141,7 @@ Status MakeOutputDirectory(const std::string& flag, const std::string& dir) {
 Status SummarySink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
   if (const interaction::PaddleSystem* paddles = simulation.Paddles()) {
     for (int k = 0; k < paddles->Count(); ++k) {
-      m_forceSum += sim::Length(paddles->State(k).force);
+      m_forceSum += Length(paddles->State(k).force);
       m_summary->paddlePeakHaptic = std::max(m_summary->paddlePeakHaptic, paddles->State(k).haptic);
     }
   }

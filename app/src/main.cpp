@@ -11,6 +11,7 @@
 
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/headless.h"
+#include "sphxr/app/param_registry.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/xr_mode.h"
 #include "sphxr/common/log.h"
@@ -26,6 +27,10 @@ int Main(int argc, char** argv) {
   }
   if (options.help) {
     std::fputs(sphxr::app::UsageText().c_str(), stdout);
+    return 0;
+  }
+  if (options.printSceneReference) {
+    std::fputs(sphxr::app::SceneParameterReference().c_str(), stdout);
     return 0;
   }
   // A bad scene is one error, whatever the mode (a window failing on it is not "unavailable").

@@ -25,7 +25,7 @@ void ProbeHistory::Add(const sim::ProbeSample& sample) {
   };
   for (float p : sample.pressure) push(p);
   for (float l : sample.level) push(l);
-  for (const sim::BodyLoad& load : sample.load) push(sim::Length(load.force));
+  for (const sim::BodyLoad& load : sample.load) push(Length(load.force));
 }
 
 void DrawProbePlots(const std::vector<ProbeTrace>& traces, float width) {

@@ -74,7 +74,7 @@ class ProbeReader {
     if (!InTank(out->at)) return Error(key + ".at", Str(out->at) + " is outside " + Tank());
     if (p.contains("normal")) {
       if (Status s = Vec(p["normal"], key + ".normal", &out->normal); !s) return s;
-      const float length = sim::Length(out->normal);
+      const float length = Length(out->normal);
       if (!(length > 0.0f)) return Error(key + ".normal", "must not be zero (leave it out for a point in the water)");
       out->normal = out->normal * (1.0f / length);
     }
@@ -84,7 +84,7 @@ class ProbeReader {
       if (offset < 0.0f) return Error(key + ".offset", Format("%g: must be 0 or more (m into the water)", offset));
       out->offset = offset;
     }
-    const float offset = out->offset.value_or(sim::Length(out->normal) > 0.0f ? 0.5f * m_setup.params.spacing : 0.0f);
+    const float offset = out->offset.value_or(Length(out->normal) > 0.0f ? 0.5f * m_setup.params.spacing : 0.0f);
     const sim::Vec3 x = out->at - out->normal * offset;
     if (!InTank(x)) return Error(key + ".offset", Format("%g m along -normal puts the point at ", offset) + Str(x) + ", outside " + Tank());
     return Status::Ok();

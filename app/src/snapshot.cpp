@@ -39,7 +39,7 @@ Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* pad
     for (int k = 0; k < paddles->Count(); ++k) {
       const interaction::PaddleDesc& d = paddles->Desc(k);
       const interaction::PaddleState& st = paddles->State(k);
-      const sim::RigidPose pose = solver.BodyPose(paddles->BodyIndex(k));
+      const sim::Pose pose = solver.BodyPose(paddles->BodyIndex(k));
       PaddlePose p;
       p.shapes = d.shapes;
       p.pose.position = pose.position;

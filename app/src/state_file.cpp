@@ -23,8 +23,7 @@ constexpr char kMagic[8] = {'S', 'P', 'H', 'X', 'R', 'S', 'T', '1'};
 constexpr uint32_t kByteOrder = 0x01020304u;
 constexpr uint32_t kVersion = 3;  // 2: the step count after the clock; 3: the solver method after the scene name
 constexpr uint32_t kOldestVersion = 1;
-static_assert(sizeof(sim::Vec3) == 12 && sizeof(sim::Quat) == 16 && sizeof(sim::RigidPose) == 28 &&
-                  sizeof(interaction::Pose) == 28,
+static_assert(sizeof(sim::Vec3) == 12 && sizeof(sim::Quat) == 16 && sizeof(sim::Pose) == 28,
               "state files write these structs as their bytes: they must have no padding");
 
 class Writer {
@@ -50,9 +49,7 @@ class Writer {
 // Solver::SetBodyMotion does): a NaN here would become the paddle's target pose, or the controller's
 // buzz amplitude.
 bool Sound(const interaction::PaddleRestart& p) {
-  using sim::Finite;
-  const interaction::Quat& q = p.state.commanded.orientation;
-  return Finite(p.state.commanded.position) && Finite(sim::Quat{q.w, q.x, q.y, q.z}) && Finite(p.state.force) &&
+  return Finite(p.state.commanded.position) && Finite(p.state.commanded.orientation) && Finite(p.state.force) &&
          Finite(p.state.torque) && Finite(p.state.rawForce) &&
          p.state.haptic >= 0.0f && p.state.haptic <= 1.0f && p.state.teleports >= 0 && std::isfinite(p.lostSince) &&
          std::isfinite(p.lastFrame);
@@ -118,7 +115,7 @@ Status CheckAgainstScene(const StateFile& state, const sim::SceneSetup& scene) {
     return Status::Error(Format("particle id %u appears twice: damaged", *twin));
   }
   // Bodies (paddles) may be withdrawn above the water, not far away: within the tank's diagonal of it.
-  const double reach = sim::Length(t.max - t.min);
+  const double reach = Length(t.max - t.min);
   auto near = [&](const sim::Vec3& x) {
     const double dx = std::max({double(t.min.x) - x.x, 0.0, double(x.x) - t.max.x});
     const double dy = std::max({double(t.min.y) - x.y, 0.0, double(x.y) - t.max.y});
@@ -127,14 +124,14 @@ Status CheckAgainstScene(const StateFile& state, const sim::SceneSetup& scene) {
   };
   for (size_t k = 0; k < state.bodies.size(); ++k) {
     const sim::BodyMotionState& m = state.bodies[k];
-    for (const sim::RigidPose* pose : {&m.pose, &m.from, &m.to}) {
-      if (!sim::Finite(pose->position) || !near(pose->position)) {
+    for (const sim::Pose* pose : {&m.pose, &m.from, &m.to}) {
+      if (!Finite(pose->position) || !near(pose->position)) {
         return Status::Error(Format("body %zu's pose [%g %g %g] is more than the tank's diagonal (%g m) from the tank: "
                                     "damaged",
                                     k, pose->position.x, pose->position.y, pose->position.z, reach));
       }
     }
-    const double speed = sim::Finite(m.velocity) ? double(sim::Length(m.velocity)) : HUGE_VAL;
+    const double speed = Finite(m.velocity) ? double(Length(m.velocity)) : HUGE_VAL;
     if (!(speed <= kMaxFluidSpeed)) {
       return Status::Error(Format("body %zu moves at %g m/s; at most %g m/s is supported: damaged", k, speed, kMaxFluidSpeed));
     }
@@ -190,7 +187,7 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     w.Put(static_cast<uint32_t>(solver.BodyCount()));
     for (int k = 0; k < solver.BodyCount(); ++k) {
       const sim::BodyMotionState m = solver.BodyMotionOf(k);
-      for (const sim::RigidPose& p : {m.pose, m.from, m.to}) w.Put(p);
+      for (const sim::Pose& p : {m.pose, m.from, m.to}) w.Put(p);
       w.Put(m.fromTime);
       w.Put(m.toTime);
       w.Put(m.velocity);

@@ -42,7 +42,7 @@ glm::mat4 ToGlm(const xr::Mat4& m) { return glm::make_mat4(m.m.data()); }
 
 /// A paddle hangs from the hand along its body -y (paddle.h: blade below the grip); a controller's
 /// grip points along its -z. Body -> grip: +90 degrees about x (body -y becomes grip -z).
-constexpr xr::Quat kGripFromPaddle{0.70710678f, 0.0f, 0.0f, 0.70710678f};
+constexpr Quat kGripFromPaddle{0.70710678f, 0.70710678f, 0.0f, 0.0f};
 
 /// Where a hand's paddle may go: over the tank (5 cm beyond its sides) from its floor to 0.5 m above its
 /// top. A hand elsewhere (resting at the user's side, reaching past the tank) does not drag its paddle
@@ -59,8 +59,7 @@ interaction::HandInput ToHandInput(const xr::HandState& h, const sim::Vec3& offs
   interaction::HandInput in;
   in.pose.position = {h.grip.position.x - offset.x, h.grip.position.y - offset.y, h.grip.position.z - offset.z};
   in.tracked = h.poseValid && h.tracked && InReach(in.pose.position, tank);
-  const xr::Quat q = h.grip.orientation * kGripFromPaddle;
-  in.pose.orientation = {q.w, q.x, q.y, q.z};
+  in.pose.orientation = Mul(h.grip.orientation, kGripFromPaddle);
   in.hasVelocity = h.velocityValid;
   in.linearVelocity = {h.linearVelocity.x, h.linearVelocity.y, h.linearVelocity.z};
   in.angularVelocity = {h.angularVelocity.x, h.angularVelocity.y, h.angularVelocity.z};

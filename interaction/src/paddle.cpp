@@ -39,12 +39,12 @@ void SampleBox(const ShapePrimitive& s, float dx, std::vector<Vec3>* out) {
 // One sheet on the capsule shrunk by half a spacing: rings along the cylinder, latitude rings on the caps.
 void SampleCapsule(const ShapePrimitive& s, float dx, std::vector<Vec3>* out) {
   const Vec3 ab = s.b - s.a;
-  const float length = sim::Length(ab);
+  const float length = Length(ab);
   const Vec3 axis = length > 0.0f ? ab * (1.0f / length) : Vec3{0.0f, 1.0f, 0.0f};
   const Vec3 c = std::fabs(axis.x) < 0.9f ? Vec3{1.0f, 0.0f, 0.0f} : Vec3{0.0f, 1.0f, 0.0f};
-  Vec3 u = sim::Cross(axis, c);
-  u = u * (1.0f / sim::Length(u));
-  const Vec3 w = sim::Cross(axis, u);
+  Vec3 u = Cross(axis, c);
+  u = u * (1.0f / Length(u));
+  const Vec3 w = Cross(axis, u);
   const float r = s.radius - 0.5f * dx;
   const int m = std::max(1, static_cast<int>(std::lround(length / dx)));
   if (r < 0.25f * dx) {  // thinner than a spacing: a row of points on the axis
@@ -169,7 +169,7 @@ Status PaddleSystem::Create(std::vector<PaddleDesc> paddles, const sim::SceneSet
     // Sized from closed forms before anything is sampled (a capsule of radius 100 m asked for 8.9 GB of
     // boundary particles before sim's ValidateBodies saw it): the reach ValidateBodies allows, and a
     // particle count a sheet over the shapes' surfaces cannot exceed by much.
-    const float tankSize = sim::Length(scene.tank.max - scene.tank.min);
+    const float tankSize = Length(scene.tank.max - scene.tank.min);
     double reach = 0.0, area = 0.0;
     for (const ShapePrimitive& s : d.shapes) {
       if (s.kind == ShapePrimitive::Kind::kBox) {
@@ -177,8 +177,8 @@ Status PaddleSystem::Create(std::vector<PaddleDesc> paddles, const sim::SceneSet
         reach = std::max(reach, std::sqrt(x * x + y * y + z * z));
         area += 8.0 * (double(s.b.x) * s.b.y + double(s.b.y) * s.b.z + double(s.b.x) * s.b.z);
       } else {
-        const double length = sim::Length(s.b - s.a);
-        reach = std::max(reach, std::max<double>(sim::Length(s.a), sim::Length(s.b)) + s.radius);
+        const double length = Length(s.b - s.a);
+        reach = std::max(reach, std::max<double>(Length(s.a), Length(s.b)) + s.radius);
         area += 2.0 * kPi * s.radius * length + 4.0 * kPi * double(s.radius) * s.radius;
       }
     }
@@ -206,11 +206,11 @@ Status PaddleSystem::Create(std::vector<PaddleDesc> paddles, const sim::SceneSet
 
 Pose PaddleSystem::Withdrawn(const Paddle& p, const Pose& from) const {
   float radius = 0.0f;
-  for (const Vec3& x : p.points) radius = std::max(radius, sim::Length(x));
+  for (const Vec3& x : p.points) radius = std::max(radius, Length(x));
   for (const ShapePrimitive& s : p.desc.shapes) {
     radius = std::max(radius, s.kind == ShapePrimitive::Kind::kBox
-                                  ? sim::Length(s.a) + sim::Length(s.b)
-                                  : std::max(sim::Length(s.a), sim::Length(s.b)) + s.radius);
+                                  ? Length(s.a) + Length(s.b)
+                                  : std::max(Length(s.a), Length(s.b)) + s.radius);
   }
   Pose out = from;
   out.position.y = m_scene.tank.max.y + p.desc.limits.withdrawClearance + radius;
@@ -238,7 +238,7 @@ void PaddleSystem::AddBodies(sim::SceneSetup* scene) {
     body.shapes = p.desc.shapes;
     body.points = p.points;
     body.viscosity = p.desc.viscosity;
-    body.pose = ToSim(start);
+    body.pose = start;
     scene->bodies.push_back(std::move(body));
   }
 }
@@ -255,7 +255,7 @@ Status PaddleSystem::Attach(sim::Solver* solver) {
   for (int k = 0; k < Count(); ++k) {
     Paddle& p = m_paddles[k];
     p.lastFrame = solver->Time();
-    p.state.commanded = ToPose(solver->BodyPose(m_firstBody + k));
+    p.state.commanded = solver->BodyPose(m_firstBody + k);
   }
   return Status::Ok();
 }
@@ -273,9 +273,9 @@ Status PaddleSystem::Drive(Paddle& p, int body, const HandInput& hand, double di
   if (hand.tracked) {
     p.lost = false;
     target = hand.pose;
-    const float jump = sim::Length(target.position - cmd.position);
+    const float jump = Length(target.position - cmd.position);
     const float allowance =
-        l.teleportDistance + (hand.hasVelocity ? sim::Length(hand.linearVelocity) * static_cast<float>(frame) : 0.0f);
+        l.teleportDistance + (hand.hasVelocity ? Length(hand.linearVelocity) * static_cast<float>(frame) : 0.0f);
     // Re-tracking after a withdrawal is a teleport whatever the distance: the paddle re-enters gently.
     const bool returning = st.mode == PaddleMode::kWithdrawing;
     if (st.mode != PaddleMode::kReentering && (jump > allowance || returning)) {
@@ -305,7 +305,7 @@ Status PaddleSystem::Drive(Paddle& p, int body, const HandInput& hand, double di
   // Move towards the target within the speed limits.
   Pose next = target;
   const Vec3 delta = target.position - cmd.position;
-  const float dist = sim::Length(delta);
+  const float dist = Length(delta);
   // The solver may already be past the previous frame (its steps do not end on frame times): the motion
   // spans from its time to this frame's, so the limit applies to that span.
   const double span = std::min(frame, displayTime - m_solver->Time());
@@ -319,7 +319,7 @@ Status PaddleSystem::Drive(Paddle& p, int body, const HandInput& hand, double di
   st.commanded = next;
   double when = displayTime;
   if (when <= m_solver->Time()) when = m_solver->Time() + frame;  // never a relocation: always a motion
-  return m_solver->SetBodyTarget(body, ToSim(next), when);
+  return m_solver->SetBodyTarget(body, next, when);
 }
 
 Status PaddleSystem::BeginFrame(double displayTime, const std::vector<HandInput>& hands) {
@@ -350,7 +350,7 @@ void PaddleSystem::AfterStep() {
     st.rawForce = load.force;
     st.force += (load.force - st.force) * a;
     st.torque += (load.torque - st.torque) * a;
-    st.haptic = std::min(1.0f, sim::Length(st.force) / p.desc.haptics.fullScaleForce);
+    st.haptic = std::min(1.0f, Length(st.force) / p.desc.haptics.fullScaleForce);
   }
 }
 

@@ -53,7 +53,7 @@ Status Trajectory::FromKeys(std::vector<TrajectoryKey> keys, Trajectory* out) {
       return Status::Error(Format("trajectory: key %zu: time %g is not after the previous key's %g", k, keys[k].time,
                                   keys[k - 1].time));
     }
-    keys[k].pose.orientation = ToQuat(sim::Normalized(ToSim(keys[k].pose.orientation)));
+    keys[k].pose.orientation = Normalized(keys[k].pose.orientation);
     keys[k].trigger = std::fmin(std::fmax(keys[k].trigger, 0.0f), 1.0f);
     keys[k].grip = std::fmin(std::fmax(keys[k].grip, 0.0f), 1.0f);
   }

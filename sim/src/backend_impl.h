@@ -22,6 +22,7 @@
 #include "backend.h"
 #include "backend_guard.h"
 #include "dfsph_solver.h"
+#include "reuse_lists.h"
 #include "surface_impl.h"
 
 namespace sphxr::sim {
@@ -150,35 +151,13 @@ class BackendImpl final : public Backend {
       if (Status s = lap(Stage::kBodies); !s) return s;
     }
 
-    // 3b. activity (reuse): classify, then compact the particles that compute this step
+    // 3b. activity (reuse): classify, then compact the particles that compute this step (reuse_lists.h)
     const FluidView fv = Fluid();
     int computing = n;
-    // The particles whose density is computed: those that compute (the compute list).
-    int densityCount = n;
-    const uint32_t* densityList = nullptr;  // set once the lists are sized: a resize moves their storage
-    const ComputesThisStep densityOf{Raw(m_fluid.idle), physics.reuseIdle};
+    const uint32_t* computeList = nullptr;  // set once the list is sized: a resize moves its storage
     if (physics.reuseEnabled) {
-      const int cells = static_cast<int>(m_fluidStart.size());
-      m_cellCount.resize(cells);
-      m_cellCrowd.resize(cells);
-      const GridView grid = View();
-      const int rows = grid.ny * grid.nz;
-      uint32_t* count = Raw(m_cellCount);
-      uint32_t* crowd = Raw(m_cellCrowd);
-      if (physics.reuseSyncStep) {  // the impulse hold classifies on its schedule only
-        thrust::for_each_n(policy, first, cells, CellCountStage{grid, count});
-        // The 27-cell sums in three passes (x, y, z), the two buffers in turn; the crowding ends in m_cellCrowd.
-        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 0});
-        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, crowd, count, 1});
-        thrust::for_each_n(policy, first, rows, CellBoxSumStage{grid, count, crowd, 2});
-      }
-      thrust::for_each_n(policy, first, n, ActivityStage{grid, fv, physics, crowd});
-      m_computeList.resize(n);
-      auto end = thrust::copy_if(policy, first, first + n, m_computeList.begin(),
-                                 ComputesThisStep{Raw(m_fluid.idle), physics.reuseIdle});
-      computing = static_cast<int>(end - m_computeList.begin());
-      densityCount = computing;
-      densityList = Raw(m_computeList);
+      computing = m_reuse.Classify(View(), fv, physics, static_cast<int>(m_fluidStart.size()));
+      computeList = m_reuse.List();
       if (Status s = lap(Stage::kActivity); !s) return s;
     }
 
@@ -197,7 +176,7 @@ class BackendImpl final : public Backend {
     auto overComputing = [&](int chunk, const auto& stage) {
       using S = std::decay_t<decltype(stage)>;
       if (computing < n) {
-        loop(computing, chunk, OverList<S>{Raw(m_computeList), stage});
+        loop(computing, chunk, OverList<S>{computeList, stage});
       } else {
         loop(n, chunk, stage);
       }
@@ -221,25 +200,19 @@ class BackendImpl final : public Backend {
       // particles that reuse take no lane (cpu/blocks.h BlockSet). The pairs-only layout (benchmarks)
       // keeps the layout before both: every particle, the lanes that reuse masked.
       typename Traits::BlockSet set{Raw(m_keys), n};
-      const bool compacted = densityCount < n && !m_pairBlocks;
-      if (compacted) {
-        m_computeKeys.resize(densityCount);
-        thrust::gather(policy, densityList, densityList + densityCount, m_keys.begin(), m_computeKeys.begin());
-        m_computeRank.resize(n + 1);
-        const auto flags = thrust::make_transform_iterator(first, ComputeFlag{densityOf, n});
-        thrust::exclusive_scan(policy, flags, flags + (n + 1), m_computeRank.begin(), 0u, thrust::plus<uint32_t>());
-        set = typename Traits::BlockSet{Raw(m_computeKeys), densityCount, densityList, Raw(m_computeRank)};
+      if (computing < n && !m_pairBlocks) {
+        set = m_reuse.template CompactedBlocks<typename Traits::BlockSet>(m_keys, fv, physics, computing);
       }
       m_blockStart.resize(set.count);
       auto end = thrust::copy_if(policy, first, first + set.count, m_blockStart.begin(),
                                  typename Traits::DensityBlockStart{View(), set, m_pairBlocks});
       const int blocks = static_cast<int>(end - m_blockStart.begin());
-      const bool masked = densityCount < n && m_pairBlocks;  // the pairs-only layout's masked lanes
+      const bool masked = computing < n && m_pairBlocks;  // the pairs-only layout's masked lanes
       loop(blocks, 8,
            typename Traits::DensityBlockStage{density, set, Raw(m_blockStart), masked ? Raw(m_fluid.idle) : nullptr,
                                               physics.reuseIdle, m_pairBlocks});
-    } else if (densityCount < n) {
-      loop(densityCount, 32, OverList<DensityStage>{densityList, density});
+    } else if (computing < n) {
+      loop(computing, 32, OverList<DensityStage>{computeList, density});
     } else {
       loop(n, 32, density);
     }
@@ -535,7 +508,10 @@ class BackendImpl final : public Backend {
     const int items = points + static_cast<int>(m_probeLines.size());
     const ProbeStage stage{View(), Fluid(), physics, Raw(m_probePoints), points, Raw(m_probeLines), Raw(m_probeOut)};
     if constexpr (Traits::kSimdStages) {
-      Traits::ForEachGuided(items, 1, stage);  // the CPU: a gauge costs tens of sensors; equal slices would wait for it
+      // The CPU: on the calling thread. A few dozen probes are tens of microseconds of work; a parallel
+      // region for them cost more than that on a loaded machine (sphxr_bench_probes: the probes stage
+      // took 5 % of a 2-thread step, 0.5 % of a 1-thread one).
+      for (int k = 0; k < items; ++k) stage(k);
     } else {
       thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), items, stage);
     }
@@ -608,12 +584,8 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_fluidStart, m_fluidEnd, m_boundaryStart, m_boundaryEnd;
   Vector<uint8_t> m_boundaryNear;  // per cell: a boundary particle in its 27 cells
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
-  Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
-  Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell; scratch of the 27-cell sums
-  Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each cell
+  ReuseLists<Traits> m_reuse;      // reuse: the crowding, the compacted list of the particles that compute
   Vector<uint32_t> m_blockStart;   // CPU density blocks: first entry of each (cpu/blocks.h)
-  Vector<uint32_t> m_computeKeys;  // CPU density blocks with reuse: the compacted list's Morton keys
-  Vector<uint32_t> m_computeRank;  // and the computing particles before each particle (n + 1)
   bool m_pairBlocks = false;       // CPU density blocks from pairs of cells only (UsePairDensityBlocks)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;

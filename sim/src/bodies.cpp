@@ -11,7 +11,7 @@
 
 namespace sphxr::sim {
 
-void Solver::HoldBody(BodyMotion* b, const RigidPose& pose, double time) {
+void Solver::HoldBody(BodyMotion* b, const Pose& pose, double time) {
   b->pose = b->from = b->to = pose;
   b->fromTime = b->toTime = time;
   b->velocity = b->angular = Vec3{};
@@ -55,7 +55,7 @@ void Solver::InitBodies(const Physics& physics) {
       shapes.push_back(p);
     }
     BodyMotion m;
-    m.pose = RigidPose{setup.pose.position, Normalized(setup.pose.orientation)};
+    m.pose = Pose{setup.pose.position, Normalized(setup.pose.orientation)};
     m.from = m.to = m.pose;
     m.boundRadius = radius;
     m.shapes = setup.shapes;
@@ -65,10 +65,10 @@ void Solver::InitBodies(const Physics& physics) {
   m_backend->InitBodies(local, bodyOf, alpha, shapes);
 }
 
-RigidPose Solver::BodyPoseAt(const BodyMotion& body, double time) const {
+Pose Solver::BodyPoseAt(const BodyMotion& body, double time) const {
   if (time >= body.toTime || body.toTime <= body.fromTime) return body.to;
   const float u = static_cast<float>(std::max(0.0, (time - body.fromTime) / (body.toTime - body.fromTime)));
-  return RigidPose{body.from.position + (body.to.position - body.from.position) * u,
+  return Pose{body.from.position + (body.to.position - body.from.position) * u,
                    Slerp(body.from.orientation, body.to.orientation, u)};
 }
 
@@ -110,7 +110,7 @@ Status Solver::SetBodyMotion(int body, const BodyMotionState& m) {
   }
   // (Only those visibly off: the solver's own, saved, must come back bit for bit for a continued run.)
   BodyMotionState unit = m;
-  for (RigidPose* p : {&unit.pose, &unit.from, &unit.to}) {
+  for (Pose* p : {&unit.pose, &unit.from, &unit.to}) {
     const Quat q = p->orientation;
     if (std::abs(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z - 1.0f) > 1e-4f) p->orientation = Normalized(q);
   }
@@ -118,13 +118,13 @@ Status Solver::SetBodyMotion(int body, const BodyMotionState& m) {
   return Status::Ok();
 }
 
-Status Solver::SetBodyTarget(int body, const RigidPose& target, double targetTime) {
+Status Solver::SetBodyTarget(int body, const Pose& target, double targetTime) {
   if (body < 0 || body >= BodyCount()) return Status::Error(Format("SetBodyTarget: no body %d (%d bodies)", body, BodyCount()));
   if (!Finite(target.position) || !Finite(target.orientation) || !std::isfinite(targetTime)) {
     return Status::Error(Format("SetBodyTarget: non-finite target for body %d", body));
   }
   BodyMotion& b = m_bodies[body];
-  const RigidPose to{target.position, Normalized(target.orientation)};
+  const Pose to{target.position, Normalized(target.orientation)};
   if (targetTime <= m_last.time) {  // relocate now, at rest
     HoldBody(&b, to, m_last.time);
     return Status::Ok();

@@ -5,7 +5,7 @@
 //        = sigma * 2(1 - q)^3           for 1/2 < q < 1
 // Normalisation, gradient antisymmetry, zero gradient sum and compact support are tested in
 // tests/sim/kernel_test.cpp.
-#include "sphxr/sim/hd.h"
+#include "sphxr/common/hd.h"
 #include "sphxr/sim/vec.h"
 
 namespace sphxr::sim {

@@ -3,7 +3,7 @@
 // sorted by the Z-order of their cell, so that neighbouring cells lie close in memory).
 #include <cstdint>
 
-#include "sphxr/sim/hd.h"
+#include "sphxr/common/hd.h"
 
 namespace sphxr::sim {
 

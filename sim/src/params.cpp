@@ -34,9 +34,22 @@ const std::array<ParamInfo, 15> kParams = {{
      10000.0, &SolverParams::maxDivergenceIterations, true},
 }};
 
+const std::array<ReuseParamInfo, 6> kReuseParams = {{
+    {"delta1", "", "weight of the pressure term delta1 P_i / P_pc in ACT_i (Huang et al. 2013, 3.3)", 0.0, 1e9,
+     &ReuseParams::delta1},
+    {"delta2", "", "weight of the crowding term delta2 N_CPN / N_i in ACT_i", 0.0, 1e9, &ReuseParams::delta2},
+    {"threshold", "", "ACT_i below this makes a particle inactive (it reuses its values)", 0.0, 1e9,
+     &ReuseParams::threshold},
+    {"pressure_scale", "Pa", "P_pc; 0 = the Tait pressure at 1 % compression", 0.0, 1e9, &ReuseParams::pressureScale},
+    {"cell_count", "", "N_CPN; 0 = the rest lattice's particles per cell", 0.0, 1e9, &ReuseParams::cellCount},
+    {"idle", "steps", "IDLE: consecutive steps an inactive particle reuses its density, pressure and acceleration", 0.0,
+     1000.0, nullptr, &ReuseParams::idle},
+}};
+
 }  // namespace
 
 std::span<const ParamInfo> SolverParamInfos() { return kParams; }
+std::span<const ReuseParamInfo> ReuseParamInfos() { return kReuseParams; }
 
 const char* SolverMethodName(SolverMethod method) {
   return method == SolverMethod::kDfsph ? "dfsph" : "wcsph";

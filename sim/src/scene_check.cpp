@@ -74,15 +74,19 @@ Status ValidateBodies(const SceneSetup& scene) {
 }  // namespace
 
 Status ValidateReuse(const ReuseParams& r) {
-  const float values[] = {r.delta1, r.delta2, r.threshold, r.pressureScale, r.cellCount};
-  const char* names[] = {"delta1", "delta2", "threshold", "pressure_scale", "cell_count"};
-  for (int k = 0; k < 5; ++k) {
-    if (!std::isfinite(values[k]) || values[k] < 0.0f || values[k] > 1e9f) {
-      return Status::Error(Format("reuse.%s = %g is invalid: must be a number from 0 to 1e9", names[k], values[k]));
+  for (const ReuseParamInfo& p : ReuseParamInfos()) {
+    if (p.count) {
+      const int v = r.*p.count;
+      if (v < p.min || v > p.max) {
+        return Status::Error(Format("reuse.%s = %d is invalid: must be %g to %g %s", p.key, v, p.min, p.max, p.unit));
+      }
+      continue;
     }
-  }
-  if (r.idle < 0 || r.idle > 1000) {
-    return Status::Error(Format("reuse.idle = %d is invalid: must be 0 to 1000 steps", r.idle));
+    const float v = r.*p.real;
+    // Compared as floats, as the solver parameters are (ValidateScene).
+    if (!std::isfinite(v) || v < static_cast<float>(p.min) || v > static_cast<float>(p.max)) {
+      return Status::Error(Format("reuse.%s = %g is invalid: must be a number from %g to %g", p.key, v, p.min, p.max));
+    }
   }
   return Status::Ok();
 }

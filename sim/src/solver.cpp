@@ -276,7 +276,7 @@ Status Solver::Step() {
     const double end = m_last.time + dt;
     size_t firstShape = 0;
     for (BodyMotion& b : m_bodies) {
-      const RigidPose to = BodyPoseAt(b, end);
+      const Pose to = BodyPoseAt(b, end);
       BodyState st{};
       st.position = b.pose.position;
       st.orientation = b.pose.orientation;
@@ -296,7 +296,7 @@ Status Solver::Step() {
   if (!m_bodies.empty()) {
     m_backend->BodyLoads(&m_bodyLoads);
     for (size_t k = 0; k < m_bodies.size(); ++k) {
-      m_bodies[k].pose = RigidPose{states[k].endPosition, states[k].endOrientation};
+      m_bodies[k].pose = Pose{states[k].endPosition, states[k].endOrientation};
       m_bodies[k].velocity = states[k].velocity;
       m_bodies[k].angular = states[k].angular;
     }

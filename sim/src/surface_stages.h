@@ -21,7 +21,7 @@
 
 #include "kernel.h"
 #include "mc_tables.h"
-#include "sphxr/sim/hd.h"
+#include "sphxr/common/hd.h"
 #include "sphxr/sim/surface.h"
 #include "sphxr/sim/vec.h"
 #include "stages.h"

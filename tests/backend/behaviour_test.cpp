@@ -193,7 +193,7 @@ TEST_P(Behaviour, AMovingBodyFeelsTheWaterAndPushesItAside) {
   scene.bodies.push_back(body);
   auto solver = test::CreateOrFail(scene, Config());
   ASSERT_TRUE(solver);
-  RigidPose target = solver->BodyPose(0);
+  Pose target = solver->BodyPose(0);
   target.position.x = 0.15f;
   ASSERT_TRUE(solver->SetBodyTarget(0, target, 0.1).ok());
   while (solver->Time() < 0.1) ASSERT_TRUE(test::StepN(*solver, 1));

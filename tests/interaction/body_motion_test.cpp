@@ -58,7 +58,7 @@ TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
   const Vec3 from = scene.bodies[0].pose.position, to = from + Vec3{0.05f, 0.0f, 0.0f};
   const float half = 0.25f * 3.14159265f;
   const Quat q1{std::cos(half), 0.0f, std::sin(half), 0.0f};
-  ASSERT_TRUE(solver->SetBodyTarget(0, RigidPose{to, q1}, duration).ok());
+  ASSERT_TRUE(solver->SetBodyTarget(0, Pose{to, q1}, duration).ok());
   std::vector<Vec4> pos, vel;
   int steps = 0;
   while (solver->Time() < duration - 1e-9) {
@@ -66,7 +66,7 @@ TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
     ++steps;
     const double t = solver->Time();
     const float u = static_cast<float>(std::min(1.0, t / duration));
-    const RigidPose p = solver->BodyPose(0);
+    const Pose p = solver->BodyPose(0);
     EXPECT_NEAR(p.position.x, from.x + 0.05f * u, 2e-6f) << "t = " << t;
     // slerp from identity: a rotation by u * 90 degrees about y
     EXPECT_NEAR(p.orientation.w, std::cos(half * u), 2e-5f);
@@ -93,10 +93,10 @@ TEST(BodyMotion, FollowsTheSegmentWithTheRigidVelocity) {
   EXPECT_EQ(solver->BodyPose(0).position.x, to.x);
   EXPECT_EQ(Length(solver->BodyVelocity(0)), 0.0f);
   // A target time not after now relocates at once, at rest.
-  ASSERT_TRUE(solver->SetBodyTarget(0, RigidPose{from, Quat{}}, solver->Time()).ok());
+  ASSERT_TRUE(solver->SetBodyTarget(0, Pose{from, Quat{}}, solver->Time()).ok());
   EXPECT_EQ(solver->BodyPose(0).position.x, from.x);
-  EXPECT_FALSE(solver->SetBodyTarget(1, RigidPose{}, 1.0).ok());
-  EXPECT_FALSE(solver->SetBodyTarget(0, RigidPose{Vec3{NAN, 0, 0}, Quat{}}, 1.0).ok());
+  EXPECT_FALSE(solver->SetBodyTarget(1, Pose{}, 1.0).ok());
+  EXPECT_FALSE(solver->SetBodyTarget(0, Pose{Vec3{NAN, 0, 0}, Quat{}}, 1.0).ok());
 }
 
 // A restart (state files): a body's whole motion read mid-segment and set on a fresh solver of the same
@@ -105,7 +105,7 @@ TEST(BodyMotion, ARestartContinuesTheMotionExactly) {
   const SceneSetup scene = PaddleScene(0.08f);  // the paddle in the water
   auto through = test::CreateOrFail(scene);
   ASSERT_TRUE(through);
-  ASSERT_TRUE(through->SetBodyTarget(0, RigidPose{Vec3{0.2f, 0.08f, 0.1f}, scene.bodies[0].pose.orientation}, 0.1).ok());
+  ASSERT_TRUE(through->SetBodyTarget(0, Pose{Vec3{0.2f, 0.08f, 0.1f}, scene.bodies[0].pose.orientation}, 0.1).ok());
   for (int k = 0; k < 15; ++k) ASSERT_TRUE(through->Step().ok());
   const BodyMotionState motion = through->BodyMotionOf(0);
   EXPECT_GT(Length(motion.velocity), 0.5f) << "saved while moving along its segment (1 m/s)";
@@ -122,7 +122,7 @@ TEST(BodyMotion, ARestartContinuesTheMotionExactly) {
     ASSERT_TRUE(restored->Step().ok());
     ASSERT_EQ(through->LastStep().dt, restored->LastStep().dt) << "step " << k;
   }
-  const RigidPose a = through->BodyPose(0), b = restored->BodyPose(0);
+  const Pose a = through->BodyPose(0), b = restored->BodyPose(0);
   EXPECT_EQ(a.position.x, b.position.x);
   EXPECT_EQ(a.orientation.w, b.orientation.w);
   HostFluid fa, fb;

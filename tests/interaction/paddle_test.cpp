@@ -124,7 +124,7 @@ TEST(PaddleSampling, SheetHalfASpacingInsideTheSurfaceAndNoGaps) {
     for (float y = -blade.b.y; y <= blade.b.y; y += 0.003f) {
       const Vec3 q = blade.a + Vec3{x, y, blade.b.z};
       float nearest = 1e9f;
-      for (const Vec3& p : pts) nearest = std::min(nearest, sim::Length(p - q));
+      for (const Vec3& p : pts) nearest = std::min(nearest, Length(p - q));
       EXPECT_LT(nearest, dx) << "hole in the sampling near " << q.x << ", " << q.y << ", " << q.z;
     }
   }
@@ -220,7 +220,7 @@ void SwingAtFiveMetresPerSecond(const sim::SceneSetup& scene) {
     while (rig.solver->Time() < t - 1e-9) {
       ASSERT_TRUE(test::StepN(*rig.solver, 1));
       rig.paddles->AfterStep();
-      bodySpeed = std::max(bodySpeed, sim::Length(rig.solver->BodyVelocity(0)));
+      bodySpeed = std::max(bodySpeed, Length(rig.solver->BodyVelocity(0)));
       maxDt = std::max(maxDt, rig.solver->LastStep().dt);
       worst = std::max(worst, ParticlesInside(*rig.solver, test::DownloadFluid(*rig.solver)));
     }
@@ -275,7 +275,7 @@ TEST(PaddleFluid, OneMetreTeleportIsNotAHugeVelocity) {
       hand.pose.position = p;
       hand.time = t;
       ASSERT_TRUE(rig.paddles->Advance(t, {HandInput{}, hand}).ok());
-      bodySpeed = std::max(bodySpeed, sim::Length(rig.solver->BodyVelocity(0)));
+      bodySpeed = std::max(bodySpeed, Length(rig.solver->BodyVelocity(0)));
       const sim::HostFluid f = test::DownloadFluid(*rig.solver);
       ASSERT_EQ(test::FirstNonFinite(f), "") << "at t = " << t;
       fluidSpeed = std::max(fluidSpeed, MaxSpeed(f));
@@ -285,13 +285,13 @@ TEST(PaddleFluid, OneMetreTeleportIsNotAHugeVelocity) {
   run(inWater, 0.4);
   EXPECT_EQ(rig.paddles->State(0).teleports, 1);
   EXPECT_EQ(rig.paddles->State(0).mode, PaddleMode::kFollowing);
-  EXPECT_NEAR(sim::Length(rig.solver->BodyPose(0).position - inWater), 0.0f, 1e-4f);
+  EXPECT_NEAR(Length(rig.solver->BodyPose(0).position - inWater), 0.0f, 1e-4f);
   run(away, 0.1);  // the jump: a teleport, the paddle glides towards it
   EXPECT_EQ(rig.paddles->State(0).teleports, 2);
   EXPECT_EQ(rig.paddles->State(0).mode, PaddleMode::kReentering);
   run(inWater, 0.3);  // and back (still gliding, so not a new teleport), then following again
   EXPECT_EQ(rig.paddles->State(0).mode, PaddleMode::kFollowing);
-  EXPECT_NEAR(sim::Length(rig.solver->BodyPose(0).position - inWater), 0.0f, 1e-4f);
+  EXPECT_NEAR(Length(rig.solver->BodyPose(0).position - inWater), 0.0f, 1e-4f);
   // The paddle never moved faster than the re-entry speed (1 m/s; a 1 m jump in one 90 Hz frame would be
   // 90 m/s), and the water stays below what a wall moving at that speed can give it: twice the wall's
   // speed (a particle reflected off it) plus the free-fall speed of the water's depth, sqrt(2 g 0.1 m) =
@@ -435,7 +435,7 @@ TEST(PaddleFluid, HeldStillInWaterFeelsArchimedesBuoyancy) {
   EXPECT_LT(std::abs(sum[2] / samples), 0.05 * buoyancy);
   // The haptic amplitude is the filtered force over the full-scale force.
   const PaddleState& st = rig.paddles->State(0);
-  EXPECT_NEAR(st.haptic, std::min(1.0f, sim::Length(st.force) / d.haptics.fullScaleForce), 1e-6f);
+  EXPECT_NEAR(st.haptic, std::min(1.0f, Length(st.force) / d.haptics.fullScaleForce), 1e-6f);
 }
 
 }  // namespace
@@ -465,7 +465,7 @@ TEST(PaddleFluid, ParticlesNearAPaddleStayActiveUnderReuse) {
     rig.solver->DownloadBodies(&body, &vel);
     for (size_t i = 0; i < f.size(); ++i) {
       float nearest = 1e9f;
-      for (const Vec4& x : body) nearest = std::min(nearest, sim::Length(Xyz(x) - Xyz(f.position[i])));
+      for (const Vec4& x : body) nearest = std::min(nearest, Length(Xyz(x) - Xyz(f.position[i])));
       if (nearest < reach) {
         ++checked;
         // Active is IC < 0: -1, or below -1 when the force stage's acceleration guard flagged it (docs/design/impulse_hold.md).

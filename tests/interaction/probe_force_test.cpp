@@ -26,7 +26,7 @@ TEST(ProbeForce, ReadsTheBodysLoadOfTheStep) {
   set.pressure.push_back({"floor", {0.15f, 0.0f, 0.1f}, {0.0f, -1.0f, 0.0f}, {}});
   ASSERT_TRUE(solver->SetProbes(set).ok());
   // The body moves through the water, so its load is not zero.
-  ASSERT_TRUE(solver->SetBodyTarget(0, RigidPose{{0.2f, 0.03f, 0.1f}, {}}, 0.05).ok());
+  ASSERT_TRUE(solver->SetBodyTarget(0, Pose{{0.2f, 0.03f, 0.1f}, Quat{}}, 0.05).ok());
   for (int i = 0; i < 10; ++i) {
     const double before = solver->Time();
     ASSERT_TRUE(solver->Step().ok());

@@ -566,7 +566,7 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
               " haptic at rest %.2f, peak %.2f; force at the end %.3f N; %.2f ms per step, surface %.2f ms, %.3f simulated s"
               " in %.1f s\n",
               glm::length(target1 - target0), alongPeak, alongBefore, sidePeak, sideBefore, nearShift, near, farShift, far,
-              hapticInWater, hapticPeak, sim::Length(after->paddles[0].force), after->stepMs, after->surfaceMs,
+              hapticInWater, hapticPeak, Length(after->paddles[0].force), after->stepMs, after->surfaceMs,
               after->last.time, wall());
   // The plunge into the water left it sloshing: the stroke must add momentum along the drag to that.
   EXPECT_GT(alongPeak - alongBefore, 0.015) << "the water did not move along the drag";

@@ -1,4 +1,4 @@
-// The CPU backend's SIMD stages (sim/src/cpu_stages.h) against the per-particle stages of stages.h (the
+// The CPU backend's SIMD stages (sim/src/cpu/) against the per-particle stages of stages.h (the
 // CUDA backend's) and against brute-force O(n^2) sums in double. Density blocks: the same neighbour
 // lists in the same order, the same densities to float rounding, on random, clustered, cell-border and
 // over-full sets (more than kLanes particles in a cell, more neighbours than list slots), with and without
@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "cpu/stages.h"
-#include "stages/integrate.h"  // StepReduction
+#include "stages/integrate.h"
 #include "morton.h"
 
 namespace sphxr::sim {
@@ -183,7 +183,7 @@ struct Setup {
     return BlockStarts(BlockSet{keys.data(), static_cast<int>(keys.size())}, pairsOnly);
   }
 
-  /// The backend's set with reuse (cpu_stages.h BlockSet): the particles that compute this step, their
+  /// The backend's set with reuse (cpu/blocks.h BlockSet): the particles that compute this step, their
   /// keys, and each particle's rank among them (n + 1 values), held in `compactList`, `compactKeys` and
   /// `compactRank`.
   BlockSet ComputingSet(const std::vector<uint32_t>& keys, int idleSteps) {

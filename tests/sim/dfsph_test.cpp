@@ -46,20 +46,20 @@ struct BruteForce {
   double Rate(const std::vector<Vec4>& x, const std::vector<Vec4>& v, size_t i, int* neighbours) const {
     double rate = 0.0;
     *neighbours = 0;
-    const Vec3 xi = sim::Xyz(x[i]), vi = sim::Xyz(v[i]);
+    const Vec3 xi = Xyz(x[i]), vi = Xyz(v[i]);
     for (size_t j = 0; j < x.size(); ++j) {
-      const Vec3 d = xi - sim::Xyz(x[j]);
-      const float r = sim::Length(d);
+      const Vec3 d = xi - Xyz(x[j]);
+      const float r = Length(d);
       if (j == i || r >= k.H) continue;
       ++*neighbours;
-      rate += volume * sim::Dot(vi - sim::Xyz(v[j]), d * k.GradFactor(r));
+      rate += volume * Dot(vi - Xyz(v[j]), d * k.GradFactor(r));
     }
     for (const Vec4& b : boundary) {
-      const Vec3 d = xi - sim::Xyz(b);
-      const float r = sim::Length(d);
+      const Vec3 d = xi - Xyz(b);
+      const float r = Length(d);
       if (r >= k.H) continue;
       ++*neighbours;
-      rate += b.w / scene.params.restDensity * sim::Dot(vi, d * k.GradFactor(r));
+      rate += b.w / scene.params.restDensity * Dot(vi, d * k.GradFactor(r));
     }
     return rate;
   }

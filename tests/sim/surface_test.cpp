@@ -132,7 +132,7 @@ double Area(const SurfaceMesh& m) {
   double a = 0.0;
   for (int64_t t = 0; t < m.TriangleCount(); ++t) {
     const Vec3 p0 = P(m.positions, 3 * t), p1 = P(m.positions, 3 * t + 1), p2 = P(m.positions, 3 * t + 2);
-    a += 0.5 * static_cast<double>(sim::Length(sim::Cross(p1 - p0, p2 - p0)));
+    a += 0.5 * static_cast<double>(Length(Cross(p1 - p0, p2 - p0)));
   }
   return a;
 }
@@ -142,7 +142,7 @@ double Volume(const SurfaceMesh& m) {
   double v = 0.0;
   for (int64_t t = 0; t < m.TriangleCount(); ++t) {
     const Vec3 p0 = P(m.positions, 3 * t), p1 = P(m.positions, 3 * t + 1), p2 = P(m.positions, 3 * t + 2);
-    v += static_cast<double>(sim::Dot(p0, sim::Cross(p1, p2))) / 6.0;
+    v += static_cast<double>(Dot(p0, Cross(p1, p2))) / 6.0;
   }
   return v;
 }
@@ -228,7 +228,7 @@ void ExpectSameTriangles(const SurfaceMesh& hpmc, const ReferenceMesh& ref, floa
       if (id[c] < 0) ++unmatched;
       if (id[c] >= 0 && !ref.normals.empty()) {
         const Vec3 d = P(hpmc.normals, static_cast<size_t>(3 * t + c)) - refNormal[static_cast<size_t>(id[c])];
-        normalsOff += sim::Length(d) > 1e-4f ? 1 : 0;
+        normalsOff += Length(d) > 1e-4f ? 1 : 0;
       }
     }
     hpmcTriangles.push_back(canonical(id[0], id[1], id[2]));
@@ -246,16 +246,16 @@ void ExpectOutwardUnitNormals(const SurfaceMesh& m, double minAgreeing = 0.99) {
   int64_t agreeing = 0, nonUnit = 0, counted = 0;
   for (int64_t t = 0; t < m.TriangleCount(); ++t) {
     const Vec3 p0 = P(m.positions, 3 * t), p1 = P(m.positions, 3 * t + 1), p2 = P(m.positions, 3 * t + 2);
-    const Vec3 g = sim::Cross(p1 - p0, p2 - p0);
-    if (sim::Length(g) == 0.0f) continue;
+    const Vec3 g = Cross(p1 - p0, p2 - p0);
+    if (Length(g) == 0.0f) continue;
     Vec3 n{0, 0, 0};
     for (int c = 0; c < 3; ++c) {
       const Vec3 nc = P(m.normals, 3 * t + c);
-      if (std::fabs(sim::Length(nc) - 1.0f) > 1e-4f) ++nonUnit;
+      if (std::fabs(Length(nc) - 1.0f) > 1e-4f) ++nonUnit;
       n += nc;
     }
     ++counted;
-    agreeing += sim::Dot(n, g) > 0.0f ? 1 : 0;
+    agreeing += Dot(n, g) > 0.0f ? 1 : 0;
   }
   EXPECT_EQ(nonUnit, 0);
   EXPECT_GE(static_cast<double>(agreeing), minAgreeing * static_cast<double>(counted));
@@ -360,7 +360,7 @@ TEST(Surface, SphereMatchesReferenceAndAnalyticAreaAndVolume) {
   double worst = 1.0;
   for (int64_t v = 0; v < m.VertexCount(); ++v) {
     const Vec3 p = P(m.positions, static_cast<size_t>(v)), n = P(m.normals, static_cast<size_t>(v));
-    worst = std::min(worst, static_cast<double>(sim::Dot(n, p * (1.0f / sim::Length(p)))));
+    worst = std::min(worst, static_cast<double>(Dot(n, p * (1.0f / Length(p)))));
   }
   EXPECT_GT(worst, std::cos(5.0 * kPi / 180.0));
   // Pyramid memory: every level above the base is 1/8 of the one below (rounded up).
@@ -626,8 +626,8 @@ TEST(SurfaceParticles, SingleParticleIsASphereOfTheKernelsIsoRadius) {
   double worst = 0.0;
   for (int64_t v = 0; v < mesh.VertexCount(); ++v) {
     const Vec3 d = P(mesh.positions, static_cast<size_t>(v)) - c;
-    worst = std::max(worst, std::fabs(static_cast<double>(sim::Length(d)) - rStar));
-    EXPECT_GT(sim::Dot(P(mesh.normals, static_cast<size_t>(v)), d), 0.0f) << "normal points into the particle";
+    worst = std::max(worst, std::fabs(static_cast<double>(Length(d)) - rStar));
+    EXPECT_GT(Dot(P(mesh.normals, static_cast<size_t>(v)), d), 0.0f) << "normal points into the particle";
   }
   // Linear interpolation of a field that is not linear along the edges: within a tenth of a cell.
   EXPECT_LT(worst, 0.1 * p.cellSize) << "r* = " << rStar;
@@ -754,7 +754,7 @@ void CompareFieldWithBruteForce(const SurfaceGrid& g, const std::vector<float>& 
         double sum = 0.0;
         for (const Vec4& q : positions) {
           const Vec3 d = x - Xyz(q);
-          if (sim::Dot(d, d) < w.H2) sum += volume * w.W(sim::Length(d));
+          if (Dot(d, d) < w.H2) sum += volume * w.W(Length(d));
         }
         const float got = field[static_cast<size_t>(i + g.nx * (j + g.ny * kz))];
         ASSERT_TRUE(std::isfinite(got)) << "sample " << i << ", " << j << ", " << kz << " not written";

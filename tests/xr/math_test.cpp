@@ -33,14 +33,14 @@ TEST(XrMath, RotationFollowsRightHandRule) {
   Quat q = AxisAngle({0, 1, 0}, kPi / 2);
   ExpectNear(Rotate(q, {0, 0, -1}), {-1, 0, 0});
   ExpectNear(Rotate(q, {1, 0, 0}), {0, 0, -1});
-  // Composition: rotating by a then b equals rotating by b * a.
+  // Composition: rotating by a then b equals rotating by Mul(b, a).
   Quat a = AxisAngle({1, 0, 0}, 0.3f), b = AxisAngle({0, 0, 1}, -1.1f);
   Vec3 v{0.2f, -0.7f, 1.3f};
-  ExpectNear(Rotate(b * a, v), Rotate(b, Rotate(a, v)));
+  ExpectNear(Rotate(Mul(b, a), v), Rotate(b, Rotate(a, v)));
 }
 
 TEST(XrMath, PoseInverseAndComposition) {
-  Pose p{Normalize({0.1f, 0.7f, -0.2f, 0.6f}), {1, 2, 3}};
+  Pose p{{1, 2, 3}, Normalized({0.6f, 0.1f, 0.7f, -0.2f})};
   Pose id = p * Inverse(p);
   ExpectNear(id.position, {0, 0, 0});
   EXPECT_NEAR(std::fabs(id.orientation.w), 1.0f, 1e-5f);
@@ -52,7 +52,7 @@ TEST(XrMath, PoseInverseAndComposition) {
 }
 
 TEST(XrMath, ViewMatrixPutsTheEyeAtTheOrigin) {
-  Pose eye{AxisAngle({0, 1, 0}, 0.4f), {0.3f, 1.6f, -0.2f}};
+  Pose eye{{0.3f, 1.6f, -0.2f}, AxisAngle({0, 1, 0}, 0.4f)};
   auto o = Apply(ViewMatrix(eye), eye.position);
   ExpectNear({o[0], o[1], o[2]}, {0, 0, 0});
   // A point one metre ahead of the eye lands on the view axis at z = -1.

@@ -362,7 +362,7 @@ TEST(XrSession, RecentreAndResetButtons) {
   // Head at (0.5, 1.7, 0.2) facing -x (yaw 90 degrees about +y), pitched down 20 degrees about its
   // own x axis; left menu pressed from 0.05 s, right menu from 0.1 s (simple controller).
   Quat yaw = AxisAngle({0, 1, 0}, kPi / 2), pitch = AxisAngle({1, 0, 0}, -0.35f);
-  Quat head = yaw * pitch;
+  Quat head = Mul(yaw, pitch);
   std::string script = Format("0 head 0.5 1.7 0.2  %.8f %.8f %.8f %.8f\n"
                               "0 left -0.2 1 0 0 0 0 1\n0.05 left -0.2 1 0 0 0 0 1 menu=1\n"
                               "0 right 0.2 1 0 0 0 0 1\n0.10 right 0.2 1 0 0 0 0 1 menu=1\n",

@@ -95,8 +95,8 @@ SessionState FromXr(XrSessionState s) {
 }
 
 Pose FromXr(const XrPosef& p) {
-  return {{p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w},
-          {p.position.x, p.position.y, p.position.z}};
+  return {{p.position.x, p.position.y, p.position.z},
+          {p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z}};
 }
 XrPosef ToXr(const Pose& p) {
   return {{p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w},
@@ -543,7 +543,7 @@ Status Session::Impl::RecentreAt(XrTime time) {
   Pose head = FromXr(loc.pose);
   Vec3 forward = Rotate(head.orientation, {0, 0, -1});
   float yaw = std::atan2(-forward.x, -forward.z);  // rotation about +y taking -z to the head's heading
-  si.poseInReferenceSpace = ToXr(Pose{AxisAngle({0, 1, 0}, yaw), {head.position.x, 0, head.position.z}});
+  si.poseInReferenceSpace = ToXr(Pose{{head.position.x, 0, head.position.z}, AxisAngle({0, 1, 0}, yaw)});
   XrSpace recentred = XR_NULL_HANDLE;
   SPHXR_XR_CHECK(xrCreateReferenceSpace(session, &si, &recentred));
   xrDestroySpace(playSpace);

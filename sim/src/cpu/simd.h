@@ -11,7 +11,7 @@
 #endif
 
 #include "kernel.h"
-#include "sphxr/sim/hd.h"
+#include "sphxr/common/hd.h"
 
 // Each instruction-set tier gets its own inline namespace: a translation unit built for another tier
 // (a test without -march=native) then cannot lend its copies of these inline functions to the backend's.

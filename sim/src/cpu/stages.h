@@ -29,6 +29,7 @@
 // brute force.
 //
 // One header per stage, beside the stage it implements (stages/):
+#include "../stages.h"    // the stages these implement (sim/src/stages.h, not this file)
 #include "cpu/simd.h"     // Lanes, kLanes, the tier's intrinsics
 #include "cpu/blocks.h"   // the density blocks' layout and kernel sums
 #include "cpu/density.h"  // DensityBlockStage

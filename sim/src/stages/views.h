@@ -8,7 +8,7 @@
 #include "kernel.h"
 #include "sphxr/common/assert.h"
 #include "sphxr/sim/fields.h"
-#include "sphxr/sim/hd.h"
+#include "sphxr/common/hd.h"
 #include "sphxr/sim/vec.h"
 
 namespace sphxr::sim {

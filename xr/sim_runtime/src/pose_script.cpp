@@ -78,7 +78,7 @@ bool PoseScript::Parse(const std::string& text, PoseScript* out, std::string* er
     float qn = std::sqrt(p.orientation.x * p.orientation.x + p.orientation.y * p.orientation.y +
                          p.orientation.z * p.orientation.z + p.orientation.w * p.orientation.w);
     if (std::fabs(qn - 1.0f) > 1e-3f) return fail("orientation is not a unit quaternion");
-    p.orientation = Normalize(p.orientation);
+    p.orientation = Normalized(p.orientation);
     std::string kv;
     while (ls >> kv) {
       auto eq = kv.find('=');

@@ -591,7 +591,7 @@ XRAPI_ATTR XrResult XRAPI_CALL LocateSpace(XrSpace spaceHandle, XrSpace baseHand
         SpaceWorldPose(base, time - kH, &b0) && SpaceWorldPose(base, time + kH, &b1)) {
       Pose r0 = Inverse(b0) * p0, r1 = Inverse(b1) * p1;
       Vec3 v = (r1.position - r0.position) * float(1e9 / (2.0 * kH));
-      Quat dq = r1.orientation * Conjugate(r0.orientation);  // rotation over 2h, in the base frame
+      Quat dq = Mul(r1.orientation, Conjugate(r0.orientation));  // rotation over 2h, in the base frame
       if (dq.w < 0) dq = {-dq.x, -dq.y, -dq.z, -dq.w};
       float sinHalf = std::sqrt(dq.x * dq.x + dq.y * dq.y + dq.z * dq.z);
       float angle = 2.0f * std::atan2(sinHalf, dq.w);
@@ -622,7 +622,7 @@ XRAPI_ATTR XrResult XRAPI_CALL LocateViews(XrSession handle, const XrViewLocateI
                                 : 0;
   float half = s->instance->config.ipdMetres * 0.5f;
   return TwoCall(capacity, count, kViewCount, [&](uint32_t i) {
-    Pose eye = head.pose * Pose{{}, {i == 0 ? -half : half, 0, 0}};
+    Pose eye = head.pose * Pose{{i == 0 ? -half : half, 0, 0}, {}};
     views[i].pose = ToXr(valid ? Inverse(base) * eye : Pose{});
     // The right eye mirrors the left eye's field of view.
     views[i].fov = i == 0 ? XrFovf{kEyeFov.angleLeft, kEyeFov.angleRight, kEyeFov.angleUp, kEyeFov.angleDown}

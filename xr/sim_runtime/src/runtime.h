@@ -149,8 +149,8 @@ inline XrPosef ToXr(const Pose& p) {
           {p.position.x, p.position.y, p.position.z}};
 }
 inline Pose FromXr(const XrPosef& p) {
-  return {{p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w},
-          {p.position.x, p.position.y, p.position.z}};
+  return {{p.position.x, p.position.y, p.position.z},
+          {p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z}};
 }
 
 template <class T>

@@ -57,6 +57,7 @@ struct Options {
   bool glDebug = false;         // --gl-debug: GL debug callback on in a release build (any GL error aborts)
   int quality = -1;             // --quality: -1 = auto in the desktop window, scene headless; 0 = scene; 1 = auto
   bool help = false;
+  bool printSceneReference = false;  // --print-scene-reference: print SceneParameterReference() and exit
 };
 
 /// Parses argv. Values are checked here (a bad number is a one-line error naming the flag).

@@ -1,19 +1,15 @@
 #pragma once
 // The neutral hand input: what the XR layer (a controller's grip pose), the desktop mouse and scripted
 // trajectories (trajectory.h) all fill, and what a paddle follows (paddle.h). No OpenXR or GL types.
+#include "sphxr/common/math.h"
 #include "sphxr/sim/vec.h"
 
 namespace sphxr::interaction {
 
-/// Unit quaternion w + xi + yj + zk, body (hand) frame -> world frame.
-struct Quat {
-  float w = 1, x = 0, y = 0, z = 0;
-};
-
-struct Pose {
-  sim::Vec3 position;  // m, world (the simulation's frame)
-  Quat orientation;
-};
+// Poses are the math module's (sphxr/common/math.h): position in the world (the simulation's frame),
+// orientation hand frame -> world frame.
+using sphxr::Pose;
+using sphxr::Quat;
 
 struct HandInput {
   bool tracked = false;       // false: the pose is stale (the paddle holds, then withdraws)

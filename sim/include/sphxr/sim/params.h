@@ -54,10 +54,6 @@ struct ParamInfo {
 std::span<const ParamInfo> SolverParamInfos();
 const ParamInfo* FindSolverParam(const std::string& key);
 
-struct Aabb {
-  Vec3 min, max;
-};
-
 struct FluidBlock {
   Aabb box;
   Vec3 velocity;  // initial velocity, m/s
@@ -84,6 +80,19 @@ struct ReuseParams {
   float pressureScale = 0.0f;    // P_pc, Pa; 0 = the Tait pressure at 1 % compression
   float cellCount = 0.0f;        // N_CPN; 0 = (cell size / spacing)^3, the rest lattice's count
 };
+
+/// One parameter of the scene's "reuse" section, described once like SolverParamInfos(): the scene
+/// file, --set, the panel and validation read it. Exactly one of `real` and `count` is set.
+struct ReuseParamInfo {
+  const char* key;   // inside the section: "threshold" (the scene's "reuse.threshold")
+  const char* unit;
+  const char* help;
+  double min, max;   // inclusive valid range
+  float ReuseParams::*real = nullptr;
+  int ReuseParams::*count = nullptr;  // a whole number
+};
+/// The table of reuse parameters (the scene reference's order; `enabled` is the section's presence).
+std::span<const ReuseParamInfo> ReuseParamInfos();
 
 /// The presets chosen from the measured trade (docs/design/impulse_hold.md): "accurate", "balanced", "fast".
 /// Each sets delta1, delta2, threshold and idle and turns reuse on; the derived constants

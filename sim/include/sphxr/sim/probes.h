@@ -73,10 +73,11 @@ float KernelFractionInside(float offset, float supportRadius);
 inline constexpr float kDryFraction = 0.5f;
 float ProbeDryThreshold(float offset, float supportRadius);
 
-/// The level gauges' sampling: the line is walked upward in steps of kLevelCoarse spacings; the step in
-/// which phi falls below 1/2 is sampled again at kLevelFine spacings, and the crossing found by linear
-/// interpolation between the two samples around it.
-inline constexpr float kLevelCoarse = 0.5f;
+/// The level gauges' sampling: the line is walked upward in steps of kLevelCoarse spacings (the fraction
+/// falls from 1 to 0 over a kernel support, two spacings, so no surface is stepped over; an air gap
+/// thinner than a spacing may be); the step in which phi falls below 1/2 is sampled again at kLevelFine
+/// spacings, and the crossing found by linear interpolation between the two samples around it.
+inline constexpr float kLevelCoarse = 1.0f;
 inline constexpr float kLevelFine = 0.125f;
 inline constexpr float kLevelFraction = 0.5f;
 

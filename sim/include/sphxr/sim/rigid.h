@@ -5,62 +5,10 @@
 // solver after Akinci et al. 2012). Everything here is plain data and host+device math.
 #include <vector>
 
-#include "sphxr/sim/hd.h"
+#include "sphxr/common/hd.h"
 #include "sphxr/sim/vec.h"
 
 namespace sphxr::sim {
-
-/// Unit quaternion, w + xi + yj + zk; rotates body-frame vectors into the world frame.
-struct Quat {
-  float w = 1, x = 0, y = 0, z = 0;
-};
-
-SPHXR_HD SPHXR_INLINE bool Finite(Quat q) { return IsFinite(q.w) && IsFinite(q.x) && IsFinite(q.y) && IsFinite(q.z); }
-SPHXR_HD SPHXR_INLINE Quat Mul(Quat a, Quat b) {
-  return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
-          a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
-}
-SPHXR_HD SPHXR_INLINE Quat Conjugate(Quat q) { return {q.w, -q.x, -q.y, -q.z}; }
-SPHXR_HD SPHXR_INLINE Quat Normalized(Quat q) {
-  const float n = sqrtf(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  if (!(n > 0.0f)) return Quat{};
-  return {q.w / n, q.x / n, q.y / n, q.z / n};
-}
-/// R(q) v.
-SPHXR_HD SPHXR_INLINE Vec3 Rotate(Quat q, Vec3 v) {
-  const Vec3 u{q.x, q.y, q.z};
-  const Vec3 t = Cross(u, v) * 2.0f;
-  return v + t * q.w + Cross(u, t);
-}
-/// Spherical linear interpolation along the shorter arc; nlerp when the arc is tiny.
-SPHXR_HD SPHXR_INLINE Quat Slerp(Quat a, Quat b, float u) {
-  float d = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
-  if (d < 0.0f) {
-    b = {-b.w, -b.x, -b.y, -b.z};
-    d = -d;
-  }
-  float wa = 1.0f - u, wb = u;
-  if (d < 0.9995f) {
-    const float theta = acosf(d);
-    const float s = sinf(theta);
-    wa = sinf(wa * theta) / s;
-    wb = sinf(wb * theta) / s;
-  }
-  return Normalized(Quat{wa * a.w + wb * b.w, wa * a.x + wb * b.x, wa * a.y + wb * b.y, wa * a.z + wb * b.z});
-}
-/// The rotation vector (axis * angle, radians, angle in [0, pi]) of the unit quaternion q.
-SPHXR_HD SPHXR_INLINE Vec3 RotationVector(Quat q) {
-  if (q.w < 0.0f) q = {-q.w, -q.x, -q.y, -q.z};
-  const float s = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z);
-  if (s < 1e-7f) return Vec3{2.0f * q.x, 2.0f * q.y, 2.0f * q.z};
-  const float angle = 2.0f * atan2f(s, q.w);
-  return Vec3{q.x, q.y, q.z} * (angle / s);
-}
-
-struct RigidPose {
-  Vec3 position;     // m, world position of the body origin
-  Quat orientation;  // body frame -> world frame
-};
 
 /// A solid primitive in the body frame. Box: centre `a`, half extents `b` (axis-aligned in the body
 /// frame). Capsule: the segment from `a` to `b`, radius `radius`.
@@ -127,7 +75,7 @@ struct RigidBodySetup {
   std::vector<ShapePrimitive> shapes;
   std::vector<Vec3> points;   // boundary particles (body frame), e.g. interaction::SamplePaddle
   float viscosity = -1.0f;    // artificial viscosity alpha fluid-body; < 0: solver.boundary_viscosity
-  RigidPose pose;             // pose at time 0
+  Pose pose;                  // pose at time 0
 };
 
 /// Force and torque of the fluid on a body during the last step (sum of the boundary particles'

@@ -94,7 +94,7 @@ struct SolverClock {
 /// A moving body's motion, for a restart: where it is, the target segment it is on, and the velocities
 /// of its last step (which the next step's time step depends on).
 struct BodyMotionState {
-  RigidPose pose, from, to;
+  Pose pose, from, to;
   double fromTime = 0.0, toTime = 0.0;
   Vec3 velocity, angular;
 };
@@ -171,8 +171,8 @@ class Solver {
   /// slerp, evaluated at every step's end; it holds `target` after that time. Each step its boundary
   /// particles carry the rigid velocity that takes them there. A target time not after Time() relocates
   /// the body at once, at rest (no velocity from the jump). Errors: bad index, non-finite values.
-  Status SetBodyTarget(int body, const RigidPose& target, double targetTime);
-  RigidPose BodyPose(int body) const {
+  Status SetBodyTarget(int body, const Pose& target, double targetTime);
+  Pose BodyPose(int body) const {
     SPHXR_ASSERT(body >= 0 && body < BodyCount());
     return m_bodies[body].pose;
   }
@@ -244,12 +244,12 @@ class Solver {
     std::vector<ShapePrimitive> shapes;
   };
   /// Puts `b` at `pose`, at rest, on a segment that ends at `time` (a relocation; Settle; Restore).
-  static void HoldBody(BodyMotion* b, const RigidPose& pose, double time);
+  static void HoldBody(BodyMotion* b, const Pose& pose, double time);
   /// Every field of `fluid` has FluidCount() entries; else an error naming the first that does not.
   Status CheckFluidSizes(const HostFluid& fluid, const char* who) const;
   std::vector<BodyMotion> m_bodies;
   std::vector<BodyLoad> m_bodyLoads;
-  RigidPose BodyPoseAt(const BodyMotion& body, double time) const;
+  Pose BodyPoseAt(const BodyMotion& body, double time) const;
   float MaxBodySpeed() const;
   void InitBodies(const Physics& physics);
   ProbeSet m_probes;

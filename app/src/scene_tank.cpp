@@ -1,0 +1,75 @@
+#include "scene_reader.h"
+
+namespace sphxr::app::scene {
+
+Status Reader::Tank(const json& root) {
+  sim::SceneSetup& s = m_out->setup;
+  if (!root.contains("tank")) return Error("tank", "missing: every scene needs a tank (its interior is the domain)");
+  const json& tank = root["tank"];
+  if (!tank.is_object()) return Error("tank", "must be an object");
+  CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity", "wall_pressure"});
+  if (Status st = Box(tank, "tank", &s.tank); !st) return st;
+  if (tank.contains("open_top")) {
+    if (!tank["open_top"].is_boolean()) return Error("tank.open_top", "must be true or false");
+    s.openTop = tank["open_top"].get<bool>();
+  }
+  if (tank.contains("floor_viscosity")) {
+    double v;
+    if (Status st = Number(tank["floor_viscosity"], "tank.floor_viscosity", &v); !st) return st;
+    if (v < 0 || v > 10) return Error("tank.floor_viscosity", "must be from 0 to 10 (artificial viscosity alpha)");
+    s.floorViscosity = static_cast<float>(v);
+  }
+  if (tank.contains("wall_pressure")) {
+    const json& w = tank["wall_pressure"];
+    const std::string v = w.is_string() ? w.get<std::string>() : "";
+    if (v == "mirrored") s.wallPressure = sim::SceneSetup::WallPressure::kMirrored;
+    else if (v == "wall_density") s.wallPressure = sim::SceneSetup::WallPressure::kWallDensity;
+    else return Error("tank.wall_pressure", "must be \"mirrored\" or \"wall_density\"");
+  }
+  if (tank.contains("boundary_layers")) {
+    if (!tank["boundary_layers"].is_number_integer()) return Error("tank.boundary_layers", "must be an integer");
+    const int64_t layers = tank["boundary_layers"].get<int64_t>();
+    if (layers < 1 || layers > 4) return Error("tank.boundary_layers", "must be 1 to 4");
+    s.boundaryLayers = static_cast<int>(layers);
+  }
+  return Status::Ok();
+}
+
+Status Reader::Fluid(const json& root) {
+  sim::SceneSetup& s = m_out->setup;
+  const json& fluid = root["fluid"];
+  if (!fluid.is_array()) return Error("fluid", "must be an array of blocks");
+  for (size_t i = 0; i < fluid.size(); ++i) {
+    const std::string key = "fluid[" + std::to_string(i) + "]";
+    if (!fluid[i].is_object()) return Error(key, "must be an object with min and max");
+    CheckKeys(fluid[i], key, {"min", "max", "velocity", "hydrostatic"});
+    sim::FluidBlock block;
+    if (Status st = Box(fluid[i], key, &block.box); !st) return st;
+    if (fluid[i].contains("velocity")) {
+      if (Status st = Vec(fluid[i]["velocity"], key + ".velocity", &block.velocity); !st) return st;
+    }
+    if (fluid[i].contains("hydrostatic")) {
+      if (!fluid[i]["hydrostatic"].is_boolean()) return Error(key + ".hydrostatic", "must be true or false");
+      block.hydrostatic = fluid[i]["hydrostatic"].get<bool>();
+    }
+    s.fluid.push_back(block);
+  }
+  return Status::Ok();
+}
+
+Status Reader::Obstacles(const json& root) {
+  sim::SceneSetup& s = m_out->setup;
+  const json& obstacles = root["obstacles"];
+  if (!obstacles.is_array()) return Error("obstacles", "must be an array of boxes");
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    const std::string key = "obstacles[" + std::to_string(i) + "]";
+    if (!obstacles[i].is_object()) return Error(key, "must be an object with min and max");
+    CheckKeys(obstacles[i], key, {"min", "max"});
+    sim::Aabb box;
+    if (Status st = Box(obstacles[i], key, &box); !st) return st;
+    s.obstacles.push_back(box);
+  }
+  return Status::Ok();
+}
+
+}  // namespace sphxr::app::scene
