@@ -49,6 +49,7 @@ std::string UsageText() {
   return "usage: sphxr [--xr | --desktop | --headless] [--scene FILE] [--time S | --steps N] [--settle S]\n"
          "             [--load-state FILE] [--save-state FILE [--checkpoint-every S [--checkpoint-keep N]]]\n"
          "             [--device auto|cpu|cuda|cpu-reference] [--threads T] [--spacing H] [--set KEY=VALUE]... [--export-every K --out DIR]\n"
+         "             [--export-interval S] [--export-surface-interval S] [--probes FILE.csv]\n"
          "             [--export-format ply|vtk] [--stats FILE.csv] [--validate] [--reuse on|off|PRESET]\n"
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
          "             [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
@@ -89,6 +90,11 @@ std::string UsageText() {
          "  --export-surface-every K  write the water surface (HPMC mesh, the scene's \"surface\" section) every K\n"
          "                    steps to DIR as surface_NNNNNN.ply (binary, with normals) or .obj (--surface-format)\n"
          "  --stats FILE.csv  one CSV row per step (time, dt, speeds, density errors, probes)\n"
+         "  --export-interval S, --export-surface-interval S  the particles, the surface every S simulated\n"
+         "                    seconds (the first step at or after each multiple of S) instead of every K steps;\n"
+         "                    every export names its step and time (PLY comment, VTK field data, OBJ comment)\n"
+         "  --probes FILE.csv the scene's \"probes\" section (pressure sensors, level gauges, paddle forces): a\n"
+         "                    row every probes.every simulated seconds, interpolated between steps\n"
          "  --progress, --no-progress  a progress bar with the time left, or none (default: the bar on a\n"
          "                    terminal, a progress line a minute when stderr is a log file)\n"
          "  --validate        check every stage for non-finite values; stop at the first, naming it\n"
@@ -267,6 +273,14 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       int64_t n = 0;
       if (Status s = ParseInt(arg, v, 1, 100, &n); !s) return s;
       out->checkpointKeep = static_cast<int>(n);
+    } else if (arg == "--export-interval" || arg == "--export-surface-interval") {
+      if (Status s = value(&v); !s) return s;
+      double* target = arg == "--export-interval" ? &out->exportInterval : &out->exportSurfaceInterval;
+      if (Status s = ParseDouble(arg, v, 1e-9, 1e6, target); !s) return s;
+    } else if (arg == "--probes") {
+      if (Status s = value(&v); !s) return s;
+      if (v[0] == '\0') return Status::Error("--probes: needs a file name");
+      out->probesPath = v;
     } else if (arg == "--stats") {
       if (Status s = value(&v); !s) return s;
       if (v[0] == '\0') return Status::Error("--stats: needs a file name");
@@ -276,6 +290,12 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     }
   }
   if (out->time > 0.0 && out->steps > 0) return Status::Error("--time and --steps: give one, not both");
+  if (out->exportEvery > 0 && out->exportInterval > 0.0) {
+    return Status::Error("--export-every and --export-interval: give one, not both");
+  }
+  if (out->exportSurfaceEvery > 0 && out->exportSurfaceInterval > 0.0) {
+    return Status::Error("--export-surface-every and --export-surface-interval: give one, not both");
+  }
   for (const std::string& set : out->sets) {
     if (out->spacing > 0.0f && set.rfind("spacing=", 0) == 0) {
       return Status::Error("--spacing and --set " + set.substr(0, 40) + ": give one of them");
@@ -319,7 +339,8 @@ Status CheckOutputsAreNotInputs(const Options& options, const SceneFile& scene) 
   if (!options.loadState.empty()) inputs.push_back({"--load-state", options.loadState});
   for (const std::string& t : scene.inputs) inputs.push_back({"the trajectory", t});
   const std::pair<const char*, std::string> outputs[] = {
-      {"--stats", options.statsPath}, {"--save-state", options.saveState}, {"--screenshot", options.screenshotPath}};
+      {"--stats", options.statsPath}, {"--save-state", options.saveState}, {"--screenshot", options.screenshotPath},
+      {"--probes", options.probesPath}};
   for (size_t k = 0; k < std::size(outputs); ++k) {
     const auto& [flag, path] = outputs[k];
     if (path.empty()) continue;
@@ -363,6 +384,9 @@ std::string HeadlessOnlyOptions(const Options& options) {
   add(!options.statsPath.empty(), "--stats");
   add(options.exportEvery > 0, "--export-every");
   add(options.exportSurfaceEvery > 0, "--export-surface-every");
+  add(options.exportInterval > 0.0, "--export-interval");
+  add(options.exportSurfaceInterval > 0.0, "--export-surface-interval");
+  add(!options.probesPath.empty(), "--probes");
   add(options.time > 0.0, "--time");
   add(options.steps > 0, "--steps");
   add(options.settle >= 0.0, "--settle");

@@ -72,6 +72,11 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     }
   }
 
+  // The scene's probes over the last seconds (its "probes" section).
+  if (!snap.probes.empty() && ImGui::CollapsingHeader("probes (last 5 s)", ImGuiTreeNodeFlags_DefaultOpen)) {
+    DrawProbePlots(snap.probes, 180.0f);
+  }
+
   // Paddles: where they are, what the water does to them, what a hand would feel.
   if (ImGui::CollapsingHeader("paddles", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (size_t k = 0; k < snap.paddles.size(); ++k) {

@@ -1,5 +1,7 @@
 #include "sphxr/app/export.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <cstring>
@@ -59,6 +61,11 @@ void PutBigEndian(FILE* f, const T& value) {
       u = ToBigEndian(u);
       std::fwrite(&u, 4, 1, f);
     }
+  } else if constexpr (sizeof(T) == 8) {  // the stamp's time (double)
+    uint64_t u;
+    std::memcpy(&u, &value, 8);
+    u = __builtin_bswap64(u);
+    std::fwrite(&u, 8, 1, f);
   } else {
     uint32_t u;
     static_assert(sizeof(T) == 4, "export supports 4-byte scalar fields");
@@ -85,13 +92,19 @@ Status OpenForWrite(const std::string& path, File* out) {
   return Status::Ok();
 }
 
+void PlyStamp(std::FILE* f, const ExportStamp& stamp) {
+  if (stamp.step >= 0) std::fprintf(f, "comment step %lld time %.17g\n", static_cast<long long>(stamp.step), stamp.time);
+}
+
 }  // namespace
 
-Status WritePly(const std::string& path, const sim::HostFluid& fluid) {
+Status WritePly(const std::string& path, const sim::HostFluid& fluid, const ExportStamp& stamp) {
   File f;
   if (Status s = OpenForWrite(path, &f); !s) return s;
   const size_t n = fluid.size();
-  std::fprintf(f.get(), "ply\nformat binary_little_endian 1.0\ncomment sphxr fluid particles\nelement vertex %zu\n", n);
+  std::fprintf(f.get(), "ply\nformat binary_little_endian 1.0\ncomment sphxr fluid particles\n");
+  PlyStamp(f.get(), stamp);
+  std::fprintf(f.get(), "element vertex %zu\n", n);
   // position first, named x y z so that every reader finds the points.
 #define SPHXR_PLY_HEADER(type, name)                                                                  \
   if (std::strcmp(#name, "position") == 0) {                                                         \
@@ -112,11 +125,18 @@ Status WritePly(const std::string& path, const sim::HostFluid& fluid) {
   return Close(&f, path);
 }
 
-Status WriteVtk(const std::string& path, const sim::HostFluid& fluid) {
+Status WriteVtk(const std::string& path, const sim::HostFluid& fluid, const ExportStamp& stamp) {
   File f;
   if (Status s = OpenForWrite(path, &f); !s) return s;
   const size_t n = fluid.size();
   std::fprintf(f.get(), "# vtk DataFile Version 3.0\nsphxr fluid particles\nBINARY\nDATASET POLYDATA\n");
+  if (stamp.step >= 0) {
+    std::fprintf(f.get(), "FIELD FieldData 2\nTIME 1 1 double\n");
+    PutBigEndian(f.get(), stamp.time);
+    std::fprintf(f.get(), "\nCYCLE 1 1 int\n");
+    PutBigEndian(f.get(), static_cast<int32_t>(std::min<int64_t>(stamp.step, INT32_MAX)));
+    std::fprintf(f.get(), "\n");
+  }
   std::fprintf(f.get(), "POINTS %zu float\n", n);
   for (size_t i = 0; i < n; ++i) PutBigEndian(f.get(), fluid.position[i]);
   std::fprintf(f.get(), "\nVERTICES %zu %zu\n", n, 2 * n);
@@ -137,13 +157,15 @@ Status WriteVtk(const std::string& path, const sim::HostFluid& fluid) {
   return Close(&f, path);
 }
 
-Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh) {
+Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh, const ExportStamp& stamp) {
   File f;
   if (Status s = OpenForWrite(path, &f); !s) return s;
   const int64_t n = mesh.VertexCount();
   std::fprintf(f.get(),
-               "ply\nformat binary_little_endian 1.0\ncomment sphxr water surface (triangle soup)\nelement vertex %lld\n"
-               "property float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+               "ply\nformat binary_little_endian 1.0\ncomment sphxr water surface (triangle soup)\n");
+  PlyStamp(f.get(), stamp);
+  std::fprintf(f.get(),
+               "element vertex %lld\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\n"
                "property float nz\nelement face %lld\nproperty list uchar uint vertex_indices\nend_header\n",
                static_cast<long long>(n), static_cast<long long>(n / 3));
   for (int64_t v = 0; v < n; ++v) {
@@ -160,11 +182,12 @@ Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh) {
   return Close(&f, path);
 }
 
-Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh) {
+Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh, const ExportStamp& stamp) {
   File f;
   if (Status s = OpenForWrite(path, &f); !s) return s;
   const int64_t n = mesh.VertexCount();
   std::fprintf(f.get(), "# sphxr water surface: %lld triangles\n", static_cast<long long>(n / 3));
+  if (stamp.step >= 0) std::fprintf(f.get(), "# step %lld time %.17g\n", static_cast<long long>(stamp.step), stamp.time);
   for (int64_t v = 0; v < n; ++v) {
     const float* p = &mesh.positions[static_cast<size_t>(3 * v)];
     std::fprintf(f.get(), "v %.7g %.7g %.7g\n", p[0], p[1], p[2]);

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "headless_sinks.h"
+#include "sphxr/app/probe_csv.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/simulation.h"
 #include "sphxr/app/state_file.h"
@@ -171,11 +172,13 @@ Status PrepareOutputs(const Options& options, const SceneFile& scene, RunSummary
   // Files written after the run: check their places before it.
   if (Status s = CheckPlaceToWrite("--screenshot", options.screenshotPath, " (.png)"); !s) return s;
   if (Status s = CheckPlaceToWrite("--save-state", options.saveState, ""); !s) return s;
-  if (options.outDir != Options{}.outDir && options.exportEvery <= 0 && options.exportSurfaceEvery <= 0) {
-    SPHXR_LOG_WARN("--out %s: nothing is exported without --export-every or --export-surface-every",
+  const bool exporting = options.exportEvery > 0 || options.exportSurfaceEvery > 0 || options.exportInterval > 0.0 ||
+                         options.exportSurfaceInterval > 0.0;
+  if (options.outDir != Options{}.outDir && !exporting) {
+    SPHXR_LOG_WARN("--out %s: nothing is exported without --export-every, --export-interval or their surface forms",
                    options.outDir.c_str());
   }
-  if (options.exportEvery > 0 || options.exportSurfaceEvery > 0) {
+  if (exporting) {
     if (Status s = MakeOutputDirectory("--out", options.outDir); !s) return s;
   }
   if (!options.screenshotPath.empty() || !options.framesDir.empty()) {
@@ -312,6 +315,14 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
 
   // The outputs' files are checked before the solver allocates anything, so a bad path costs nothing.
   std::unique_ptr<StatsSink> stats;
+  std::unique_ptr<ProbeSink> probes;
+  if (!options.probesPath.empty()) {
+    if (!scene.probes) {
+      return Status::Error("--probes " + options.probesPath + ": " + options.scenePath +
+                           " has no \"probes\" section (docs/user/scenes.md#probes)");
+    }
+    if (Status s = ProbeSink::Create(options.probesPath, *scene.probes, &probes); !s) return s;
+  }
   std::unique_ptr<PicturesSink> pictures;
   if (Status s = PrepareOutputs(options, scene, summary, &stats, &pictures); !s) return s;
 
@@ -342,6 +353,7 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   SummarySink measures(summary);
   simulation->AddSink(&measures);
   if (stats) simulation->AddSink(stats.get());
+  if (probes) simulation->AddSink(probes.get());
   std::unique_ptr<CheckpointSink> checkpoints;
   if (options.checkpointEvery > 0.0) {
     checkpoints = std::make_unique<CheckpointSink>(options, scene.name, stats.get(), summary);

@@ -131,7 +131,9 @@ class SaveStateSink : public SimulationSink {
 
 /// --export-every K and --export-surface-every K: particles (PLY, VTK) and the surface mesh (PLY, OBJ)
 /// into --out DIR, at the start when its step is one of theirs, every K steps, and once more at the
-/// step a signal stopped the run.
+/// step a signal stopped the run. --export-interval S and --export-surface-interval S instead: at the
+/// first step at or after each multiple of S simulated seconds (the start when it is one). Every file
+/// names its step and time (export.h ExportStamp).
 class ExportSink : public SimulationSink {
  public:
   ExportSink(const Options& options, std::optional<sim::SurfaceParams> surface, RunSummary* summary)
@@ -145,6 +147,10 @@ class ExportSink : public SimulationSink {
  private:
   Status Particles(Simulation& simulation, int64_t step);
   Status Surface(Simulation& simulation, int64_t step);
+  /// The exports due now, by step count or by simulated time.
+  Status Due(Simulation& simulation);
+  /// By time: the multiple `*next` of `interval` is reached at `time`; moves `*next` past it.
+  static bool Reached(double interval, double time, int64_t* next);
 
   const Options& m_options;
   std::optional<sim::SurfaceParams> m_surface;
@@ -152,6 +158,8 @@ class ExportSink : public SimulationSink {
   sim::HostFluid m_host;
   sim::SurfaceMesh m_mesh;
   double m_surfaceSeconds = 0.0;
+  int64_t m_nextParticles = 0, m_nextSurface = 0;      // by time: the next multiple of the interval
+  int64_t m_particlesStep = -1, m_surfaceStep = -1;    // the step of the last file written
 };
 
 /// --frames DIR (a PNG every 1/fps simulated s, then DIR/movie.mp4 when ffmpeg is on the PATH) and

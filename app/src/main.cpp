@@ -49,9 +49,11 @@ int Main(int argc, char** argv) {
     }
   }
   // Files only a headless run writes: asked for without a mode, they pick it.
-  if (options.mode == Mode::kAuto && (!options.statsPath.empty() || options.exportEvery > 0 ||
-                                      options.exportSurfaceEvery > 0 || !options.saveState.empty())) {
-    SPHXR_LOG_INFO("--stats/--export-every/--save-state asked for without a mode: running headless");
+  if (options.mode == Mode::kAuto &&
+      (!options.statsPath.empty() || options.exportEvery > 0 || options.exportSurfaceEvery > 0 ||
+       options.exportInterval > 0.0 || options.exportSurfaceInterval > 0.0 || !options.probesPath.empty() ||
+       !options.saveState.empty())) {
+    SPHXR_LOG_INFO("--stats/--export-every/--export-interval/--probes/--save-state asked for without a mode: running headless");
     options.mode = Mode::kHeadless;
   }
   // The default: the headset when a runtime answers (asked without creating a session).

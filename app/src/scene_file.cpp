@@ -8,6 +8,7 @@
 #include "sphxr/common/log.h"
 #include "sphxr/common/text_file.h"
 #include "sphxr/sim/solver.h"
+#include "scene_probes.h"
 
 namespace sphxr::app {
 namespace scene {
@@ -15,7 +16,7 @@ namespace scene {
 Status Reader::Parse(const json& root) {
   if (!root.is_object()) return Error("(root)", "a scene must be a JSON object");
   CheckKeys(root, "", {"name", "description", "solver", "gravity", "tank", "fluid", "obstacles", "run", "probe", "reuse",
-                       "paddles", "surface"});
+                       "paddles", "surface", "probes"});
   if (root.contains("name")) {
     if (!root["name"].is_string()) return Error("name", "must be a string");
     m_out->name = root["name"].get<std::string>();
@@ -42,6 +43,12 @@ Status Reader::Parse(const json& root) {
   }
   if (root.contains("paddles")) {
     if (Status st = Paddles(root["paddles"]); !st) return st;
+  }
+  if (root.contains("probes")) {  // after the tank and the paddles, which its probes name
+    ProbeConfig probes;
+    const auto unknown = [this](const std::string& key) { Unknown(key); };
+    if (Status st = ParseProbes(root["probes"], m_out->path, m_out->setup, m_out->paddles, unknown, &probes); !st) return st;
+    m_out->probes = std::move(probes);
   }
   if (root.contains("surface")) {
     if (Status st = Surface(root); !st) return st;

@@ -33,6 +33,7 @@ Status SimWorker::Build(const SimScene& scene, bool strict, std::unique_ptr<Simu
 
 Status SimWorker::Start(const SimScene& scene) {
   if (Status s = Build(scene, true, &m_sim); !s) return s;
+  m_probes = ProbeHistory(scene.probes, kProbePlotSeconds);
   m_path = ChooseSurfacePath(m_sim->Solver().ActiveDevice());
   if (m_path.load() == SurfacePath::kInterop) {
     LogOnce("surface-path", LogLevel::kInfo,
@@ -161,6 +162,7 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
     m_lastSurface = now;
   }
   snap->setup = m_scene.setup;
+  snap->probes = m_probes.Traces();
   for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) snap->stageMs[s] = stageMs[s];
   snap->stepMs = stepMs;
   snap->stepsPerSecond = m_rateSteps;
@@ -221,6 +223,7 @@ void SimWorker::Run() {
       } else {
         std::unique_lock solverLock = LockSolver();
         m_sim = std::move(fresh);
+        m_probes = ProbeHistory(reset->probes, kProbePlotSeconds);
         m_builtBuild = 0;  // the new solver has built no surface yet
         solverLock.unlock();
         {
@@ -264,7 +267,9 @@ void SimWorker::Run() {
         std::lock_guard lock(m_mutex);
         hands = m_hands;
       }
-      if (Status s = m_sim->Step(hands); !s) {
+      const Status stepped = m_sim->Step(hands);
+      if (stepped) m_probes.Add(m_sim->Solver().LastProbes());
+      if (Status s = stepped; !s) {
         std::lock_guard lock(m_mutex);
         m_error = std::isfinite(m_sim->Solver().LastStep().maxSpeed)
                       ? s.message()

@@ -102,6 +102,7 @@ class SimWorker {
 
   sim::SolverConfig m_config;
   std::unique_ptr<Simulation> m_sim;
+  ProbeHistory m_probes;  // the worker's thread only: the probes' plots, copied into each snapshot
   SimScene m_scene;
   std::thread m_thread;
   mutable std::mutex m_mutex;

@@ -16,6 +16,7 @@ SimScene SimSceneFromFile(const SceneFile& scene, std::initializer_list<int> han
   out.paddles = scene.paddles;
   out.paddleFrameRate = scene.paddleFrameRate;
   out.surface.params = scene.surface.value_or(sim::SurfaceParams{});
+  if (scene.probes) out.probes = scene.probes->set;
   for (int hand : hands) {
     const interaction::Holder holder = hand == 0 ? interaction::Holder::kLeftHand : interaction::Holder::kRightHand;
     bool held = false;
@@ -56,6 +57,9 @@ Status Simulation::Create(const SimScene& scene, const SimulationConfig& config,
   }
   if (Status s = sim::Solver::Create(run->m_setup, config.solver, &run->m_solver); !s) {
     return Status::Error(config.errorPrefix + s.message());
+  }
+  if (!scene.probes.Empty()) {
+    if (Status s = run->m_solver->SetProbes(scene.probes); !s) return Status::Error(config.errorPrefix + s.message());
   }
   if (scene.start) {
     // Not strict (a reset after the panel changed the spacing): a mismatch falls back to the scene's own

@@ -147,6 +147,9 @@ struct XrApp {
       surface.enabled = mode == render::RenderMode::kWater;  // no surface extraction for particles
       worker->SetSurface(surface);
     }
+    if (!snap.probes.empty() && ImGui::CollapsingHeader("probes (last 5 s)", ImGuiTreeNodeFlags_DefaultOpen)) {
+      DrawProbePlots(snap.probes, 160.0f);
+    }
     const std::string error = worker->LastError();
     if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
     ImGui::End();

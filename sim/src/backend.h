@@ -9,6 +9,7 @@
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/solver.h"
 #include "stages/bodies.h"
+#include "stages/probes.h"
 #include "stages.h"
 #include "surface_extractor.h"
 
@@ -55,6 +56,14 @@ class Backend {
   virtual void BodyLoads(std::vector<BodyLoad>* out) const = 0;
   /// World positions (w = Psi_b) and velocities (w = alpha) of the body particles in the last step.
   virtual void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const = 0;
+  // Probes (stages/probes.h). Without SetProbes (or with empty lists) a step has no probe work at all.
+  /// The pressure sensors' points and the level gauges' lines, evaluated in every following step.
+  virtual void SetProbes(const std::vector<Vec4>& points, const std::vector<ProbeLine>& lines) = 0;
+  /// The probes' sums (stages/probes.h's layout) of the last evaluation: the last step's, or SampleProbesNow's.
+  virtual void ProbeValues(std::vector<float>* out) const = 0;
+  /// Re-grids the particles (their order changes, nothing else: the next step's stable sort finds them in
+  /// order) and evaluates the probes on the current state.
+  virtual void SampleProbesNow(const Physics& physics) = 0;
   /// The HPMC stages on this backend's system (surface_impl.h); building from the particles re-grids them.
   virtual SurfaceExtractor* Surface() = 0;
   /// The CPU backend's density blocks from pairs of cells only, drawn from every particle with the lanes

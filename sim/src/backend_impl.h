@@ -248,7 +248,7 @@ class BackendImpl final : public Backend {
       out->densityIterations = density.iterations;
       out->densityError = density.error;
       if (Status s = lap(Stage::kPressure); !s) return s;
-      m_dfsph.Finish(fv, physics, dt, bodies ? Raw(m_bodyPressureTerm) : nullptr);
+      m_dfsph.Finish(fv, physics, dt, bodies ? Raw(m_bodyPressureTerm) : nullptr, /*drift=*/m_probeOut.empty());
     }
 
     // 5b. the fluid's force on each body particle (the reaction). DFSPH's term is the solves' own
@@ -262,8 +262,18 @@ class BackendImpl final : public Backend {
       if (Status s = lap(Stage::kBodies); !s) return s;
     }
 
-    // 6. integrate (DFSPH drifted in its Finish), then the statistics the next time step needs
+    // 5c. probes, on the state at the start of the step (positions, grid, densities and pressures of one
+    // state; DFSPH's Finish stored its pressure and leaves the drift to the stage below while probes run)
+    const bool probes = !m_probeOut.empty();
+    if (probes) {
+      EvaluateProbes(physics);
+      if (Status s = lap(Stage::kProbes); !s) return s;
+    }
+
+    // 6. integrate (DFSPH drifted in its Finish, or after the probes), then the statistics the next time
+    // step needs
     if (!physics.dfsph) thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
+    if (physics.dfsph && probes) thrust::for_each_n(policy, first, n, DriftStage{fv, physics, dt});
     // 6b. push fluid out of the bodies at their end-of-step pose
     if (bodies) {
       if (Status s = lap(Stage::kIntegrate); !s) return s;
@@ -336,6 +346,26 @@ class BackendImpl final : public Backend {
 
   void FireMix(float keep, float mix) override {
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), FluidCount(), FireMixStage{Fluid(), keep, mix});
+  }
+
+  void SetProbes(const std::vector<Vec4>& points, const std::vector<ProbeLine>& lines) override {
+    m_probePoints.assign(points.begin(), points.end());
+    m_probeLines.assign(lines.begin(), lines.end());
+    m_probeOut.resize(2 * (points.size() + lines.size()));
+    thrust::fill(m_probeOut.begin(), m_probeOut.end(), 0.0f);
+  }
+
+  void ProbeValues(std::vector<float>* out) const override {
+    out->resize(m_probeOut.size());
+    if (!out->empty()) thrust::copy(m_probeOut.begin(), m_probeOut.end(), out->begin());
+  }
+
+  void SampleProbesNow(const Physics& physics) override {
+    if (m_probeOut.empty()) return;
+    CellCodes();
+    SortAndReorder();
+    CellRanges();
+    EvaluateProbes(physics);
   }
 
   int FluidCount() const override { return static_cast<int>(m_fluid.position.size()); }
@@ -472,6 +502,21 @@ class BackendImpl final : public Backend {
     }
   }
 
+  /// One work item per probe (stages/probes.h) over the current grid.
+  void EvaluateProbes(const Physics& physics) {
+    const int points = static_cast<int>(m_probePoints.size());
+    const int items = points + static_cast<int>(m_probeLines.size());
+    const ProbeStage stage{View(), Fluid(), physics, Raw(m_probePoints), points, Raw(m_probeLines), Raw(m_probeOut)};
+    if constexpr (Traits::kSimdStages) {
+      // The CPU: on the calling thread. A few dozen probes are tens of microseconds of work; a parallel
+      // region for them cost more than that on a loaded machine (sphxr_bench_probes: the probes stage
+      // took 5 % of a 2-thread step, 0.5 % of a 1-thread one).
+      for (int k = 0; k < items; ++k) stage(k);
+    } else {
+      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), items, stage);
+    }
+  }
+
   /// Applies the sort permutation to every field of the list (one gather and one O(1) swap each).
   void Reorder() {
     auto policy = Traits::Policy();
@@ -559,6 +604,9 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_bodyStart, m_bodyEnd;
   Vector<uint8_t> m_movingNear;
   Vector<float> m_bodyPressureTerm;  // per fluid particle (ForceStage or DFSPH's Finish -> BodyReactionStage)
+  Vector<Vec4> m_probePoints;        // pressure sensors (stages/probes.h); all three empty: no probes
+  Vector<ProbeLine> m_probeLines;    // level gauges
+  Vector<float> m_probeOut;          // two floats per probe, the last evaluation
   DfsphSolver<Traits> m_dfsph;       // DFSPH's arrays (sized at its first step)
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the

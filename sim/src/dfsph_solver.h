@@ -260,6 +260,7 @@ struct DfsphFinishStage {
   DfsphView view;
   float dt;
   float* bodyPressureTerm;  // per particle, for BodyReactionStage (nullptr without bodies)
+  bool drift;  // false: store v and a only; the probes read this state and DriftStage drifts after them
   SPHXR_HD void operator()(int i) const {
     // The physical stiffnesses of this step: kappa / dt^2 and kappa^v / dt. Their velocity change is the
     // one a pressure p_i = rho_i^2 kappa_i / rho0 gives in the WCSPH momentum equation (m p_i / rho_i^2 =
@@ -277,7 +278,11 @@ struct DfsphFinishStage {
     a.x += (v.x - v0.x) * inv;
     a.y += (v.y - v0.y) * inv;
     a.z += (v.z - v0.z) * inv;
-    DriftAndStore(fluid, ph, dt, i, fluid.position[i], v, a);
+    if (drift) {
+      DriftAndStore(fluid, ph, dt, i, fluid.position[i], v, a);
+    } else {
+      fluid.acceleration[i] = a;
+    }
   }
 };
 
@@ -326,9 +331,9 @@ class DfsphSolver {
     return Solve(grid, fluid, list, ph, dt, true, ph.minIterations, ph.maxIterations, ph.densityTolerance);
   }
 
-  /// Pressure, acceleration and drift.
-  void Finish(const FluidView& fluid, const Physics& ph, float dt, float* bodyPressureTerm) {
-    ForEach(fluid.count, DfsphFinishStage{fluid, ph, View(), dt, bodyPressureTerm});
+  /// Pressure, acceleration and (with `drift`) the drift; without it DriftStage drifts later.
+  void Finish(const FluidView& fluid, const Physics& ph, float dt, float* bodyPressureTerm, bool drift) {
+    ForEach(fluid.count, DfsphFinishStage{fluid, ph, View(), dt, bodyPressureTerm, drift});
   }
 
   void ZeroPressure(const FluidView& fluid) { ForEach(fluid.count, DfsphZeroPressureStage{fluid}); }

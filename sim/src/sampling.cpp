@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sphxr/common/log.h"
+
 namespace sphxr::sim {
 namespace {
 
@@ -74,6 +76,27 @@ bool InsideBody(const RigidBodySetup& body, Vec3 p, float margin) {
 }
 
 }  // namespace
+
+int LogCutBlocks(const SceneSetup& scene) {
+  const float dx = scene.params.spacing;
+  int cut = 0;
+  for (size_t b = 0; b < scene.fluid.size(); ++b) {
+    const Aabb& box = scene.fluid[b].box;
+    const float asked[3] = {box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z};
+    float filled[3];
+    bool whole = true;
+    for (int a = 0; a < 3; ++a) {
+      filled[a] = static_cast<float>(FitCount(asked[a], dx)) * dx;
+      // FitCount's own slack: an extent meant to be a whole number of spacings is one.
+      whole = whole && static_cast<double>(asked[a]) - filled[a] <= 1e-6 * static_cast<double>(asked[a]) + 1e-7 * dx;
+    }
+    if (whole) continue;
+    ++cut;
+    SPHXR_LOG_INFO("fluid[%zu]: filled %g x %g x %g m of the %g x %g x %g m asked for (whole layers of the spacing %g m)",
+                   b, filled[0], filled[1], filled[2], asked[0], asked[1], asked[2], dx);
+  }
+  return cut;
+}
 
 int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
   const float dx = scene.params.spacing;

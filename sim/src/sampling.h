@@ -14,6 +14,11 @@ namespace sphxr::sim {
 /// corner; points inside or within half a spacing of an obstacle are skipped. `out` may be null (count only).
 int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out);
 
+/// Logs one info line for each fluid block that does not hold a whole number of layers on every axis:
+/// the size the lattice fills (whole spacings, as SampleFluid fills it) and the size asked for.
+/// Returns the number of such blocks.
+int LogCutBlocks(const SceneSetup& scene);
+
 /// Boundary particles on the tank faces (layers outward) and the obstacle surfaces (layers inward),
 /// spaced as close to the rest spacing as fits each face exactly. w is left 0 (volumes come later).
 /// `viscosity` (may be null) receives each particle's wall friction alpha (floor or walls).

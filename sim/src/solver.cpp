@@ -100,6 +100,7 @@ const char* StageName(Stage stage) {
     case Stage::kBodies: return "bodies";
     case Stage::kDivergence: return "divergence";
     case Stage::kPressure: return "pressure";
+    case Stage::kProbes: return "probes";
     default: return "?";
   }
 }
@@ -175,6 +176,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
   if (Status s = solver->m_backend->Init(MakeGridShape(scene), physics, fluid, boundary); !s) return s;
   if (!scene.bodies.empty()) solver->InitBodies(physics);
   WarnAboutSettings(scene, static_cast<int64_t>(positions.size()), physics.soundSpeed);
+  LogCutBlocks(scene);
   *out = std::move(solver);
   return Status::Ok();
 }
@@ -312,6 +314,7 @@ Status Solver::Step() {
                                 "solver.stiffness",
                                 red.nonFinite, m_last.time));
   }
+  if (!m_probes.Empty()) ReadProbes(m_probes, m_probeDry, m_last.time, stepNumber - 1, &m_probeSample);
   m_last.time += dt;
   m_last.dt = dt;
   m_last.maxSpeed = std::sqrt(red.maxSpeed2);
@@ -352,5 +355,7 @@ Solver::GridInfo Solver::Grid() const {
   const GridShape g = MakeGridShape(m_scene);
   return GridInfo{g.origin, g.cellSize, {g.nx, g.ny, g.nz}};
 }
+
+void Solver::SampleProbesNow() { m_backend->SampleProbesNow(MakePhysics(m_scene)); }
 
 }  // namespace sphxr::sim

@@ -70,6 +70,17 @@ struct IntegrateStage {
   }
 };
 
+/// x += dt v and the domain clamp, for an integrator whose velocity and acceleration are already stored
+/// (DFSPH's Finish without its drift, while probes read the state before it): DriftAndStore as it would
+/// have run there, the same numbers.
+struct DriftStage {
+  FluidView fluid;
+  Physics ph;
+  float dt;
+  SPHXR_HD void operator()(int i) const {
+    DriftAndStore(fluid, ph, dt, i, fluid.position[i], fluid.velocity[i], fluid.acceleration[i]);
+  }
+};
 
 // ---- step statistics (a reduction over particles) ------------------------------------------------
 struct StepReduction {

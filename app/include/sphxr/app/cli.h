@@ -36,6 +36,9 @@ struct Options {
   int64_t exportSurfaceEvery = 0;    // steps between surface exports (0 = none), into outDir
   std::string surfaceFormat = "ply"; // ply | obj
   std::string statsPath;    // per-step CSV
+  std::string probesPath;   // --probes: the scene's probes, a row every probes.every s (probe_csv.h)
+  double exportInterval = 0.0;         // --export-interval: simulated s between particle exports (0 = none)
+  double exportSurfaceInterval = 0.0;  // --export-surface-interval: the same for the surface
   bool validate = false;
   int reuse = -1;           // -1 = as the scene says, 0 = off, 1 = on (the scene's or default parameters)
   std::string reusePreset;  // --reuse accurate|balanced|fast: that preset (turns reuse on)

@@ -2,6 +2,7 @@
 // Particle export that ParaView and Blender read: binary little-endian PLY (vertices with properties)
 // and legacy VTK polydata. Fields come from the one field list (sim/fields.h), so a new field is
 // exported without touching this file.
+#include <cstdint>
 #include <string>
 
 #include "sphxr/common/status.h"
@@ -10,10 +11,18 @@
 
 namespace sphxr::app {
 
-Status WritePly(const std::string& path, const sim::HostFluid& fluid);
-Status WriteVtk(const std::string& path, const sim::HostFluid& fluid);
+/// The step and simulated time a file holds, so that files can be lined up without the CSV: a PLY
+/// comment `comment step N time T`, VTK field data (TIME, double; CYCLE, int: ParaView's names), an OBJ
+/// comment `# step N time T`. A negative step writes none of them.
+struct ExportStamp {
+  int64_t step = -1;
+  double time = 0.0;  // s
+};
+
+Status WritePly(const std::string& path, const sim::HostFluid& fluid, const ExportStamp& stamp = {});
+Status WriteVtk(const std::string& path, const sim::HostFluid& fluid, const ExportStamp& stamp = {});
 /// The surface mesh (a triangle soup, sim/surface.h): binary PLY with per-vertex normals, or OBJ.
-Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh);
-Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh);
+Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh, const ExportStamp& stamp = {});
+Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh, const ExportStamp& stamp = {});
 
 }  // namespace sphxr::app

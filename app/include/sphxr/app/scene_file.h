@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "sphxr/app/probe_csv.h"
 #include "sphxr/common/status.h"
 #include "sphxr/interaction/paddle.h"
 #include "sphxr/sim/params.h"
@@ -40,6 +41,7 @@ struct SceneFile {
   /// "paddles" section (absent: none). Scripted paddles carry their loaded trajectory.
   std::vector<interaction::PaddleDesc> paddles;
   double paddleFrameRate = 90.0;  // Hz: display frames at which the paddles get new targets
+  std::optional<ProbeConfig> probes;  // "probes" section (docs/user/scenes.md#probes); absent: none
   std::optional<sim::SurfaceParams> surface;  // "surface" section (cell_size, iso_level, margin); absent: defaults
   std::vector<std::string> warnings;  // unknown keys, already logged
   std::vector<std::string> inputs;    // the other files it read (paddle trajectories)

@@ -34,6 +34,8 @@ struct SimScene {
   std::vector<interaction::PaddleDesc> paddles;
   double paddleFrameRate = 90.0;  // Hz (simulated): the paddles get new targets this often
   SurfaceRequest surface;
+  /// The scene's probes (the "probes" section), read in every step; force probes name paddles by index.
+  sim::ProbeSet probes;
   /// --load-state: the fluid and clock to start from instead of the scene's (every reset of the window
   /// returns there); null: the scene's own start.
   std::shared_ptr<const StateFile> start;

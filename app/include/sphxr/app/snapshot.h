@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "sphxr/app/probe_history.h"
 #include "sphxr/common/status.h"
 #include "sphxr/interaction/paddle.h"
 #include "sphxr/sim/params.h"
@@ -52,6 +53,8 @@ struct SimSnapshot {
   /// (index 0 left, 1 right; PaddleSystem::HapticAmplitude).
   std::vector<PaddlePose> paddles;
   float haptic[2] = {0.0f, 0.0f};
+  /// The scene's probes over the last seconds (probe_history.h), for the panels' plots.
+  std::vector<ProbeTrace> probes;
 };
 
 /// The body-frame point a mouse places: the centre of the paddle's lowest primitive (the blade).

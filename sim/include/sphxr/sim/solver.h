@@ -12,6 +12,7 @@
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/params.h"
+#include "sphxr/sim/probes.h"
 #include "sphxr/sim/rigid.h"
 #include "sphxr/sim/surface.h"
 
@@ -38,8 +39,9 @@ struct SolverConfig {
 /// kBodies: the moving boundaries' own work (placing and sorting their particles, the reaction on them,
 /// the push-out); their terms inside the density and force loops count to those stages.
 /// kDivergence, kPressure: DFSPH's two solves (its factor counts to kDensity); WCSPH leaves them 0.
+/// kProbes: the pressure sensors and level gauges (Solver::SetProbes); 0 without probes.
 enum class Stage : int {
-  kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kDivergence, kPressure, kCount
+  kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kDivergence, kPressure, kProbes, kCount
 };
 const char* StageName(Stage stage);
 
@@ -196,6 +198,21 @@ class Solver {
   /// Signed distance of a world point to body `body`'s solid at its current pose (negative inside).
   float BodyDistance(int body, Vec3 point) const;
 
+  // ---- probes (sphxr/sim/probes.h) -------------------------------------------------------------------
+  /// Evaluates `probes` in every following step, on the state at the start of the step, the one whose
+  /// positions, densities and pressures belong together (LastProbes). An empty set turns them off: the
+  /// step then does no probe work. Errors name the probe: a point outside the tank, a gauge's line outside
+  /// it, a body that does not exist.
+  Status SetProbes(const ProbeSet& probes);
+  const ProbeSet& Probes() const { return m_probes; }
+  /// The readings of the last step, of the state at its start (time Time() - LastStep().dt; the force
+  /// probes: the step's LastBodyLoad). Empty vectors before the first step with probes.
+  const ProbeSample& LastProbes() const { return m_probeSample; }
+  /// Evaluates `probes` on the current state (tests, tools). Re-grids the particles first, as the surface
+  /// does: their order changes, no value does, and the next step is the same. Force probes read the last
+  /// step's loads. Errors as SetProbes.
+  Status SampleProbes(const ProbeSet& probes, ProbeSample* out);
+
   /// The water surface by histogram-pyramid marching cubes (docs/dev/surface.md), from the current particles.
   /// Into the solver's own mesh buffer (grown when needed, reported in stats and the log); the view is
   /// valid until the next extraction.
@@ -235,6 +252,15 @@ class Solver {
   Pose BodyPoseAt(const BodyMotion& body, double time) const;
   float MaxBodySpeed() const;
   void InitBodies(const Physics& physics);
+  ProbeSet m_probes;
+  ProbeSample m_probeSample;
+  std::vector<float> m_probeDry;  // per pressure probe: the Shepard sum below which it reads dry
+  /// Checks `probes` and uploads its points and lines to the backend; `dry` gets the thresholds.
+  Status UploadProbes(const ProbeSet& probes, std::vector<float>* dry);
+  /// The backend's probe sums and the bodies' loads into `out`, as the state at `time` after `steps`.
+  void ReadProbes(const ProbeSet& probes, const std::vector<float>& dry, double time, int64_t steps,
+                  ProbeSample* out) const;
+  void SampleProbesNow();  // the backend's re-grid and evaluation (solver.cpp: it has the step's physics)
   bool m_dtClampLogged = false;
   double m_iterationWarnTime = -1.0;  // simulated time of the last "iteration cap reached" warning
 };

@@ -1,0 +1,190 @@
+// The headless runner's probes and timed exports end to end (the sphxr binary): `--probes FILE.csv`
+// gives rows exactly probes.every apart whatever the adaptive step, `--export-interval S` and
+// `--export-surface-interval S` export at the first step at or after each multiple of S, and every
+// export names its step and time (PLY comment, VTK field data, OBJ comment).
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <algorithm>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support.h"
+
+namespace sphxr::app {
+namespace {
+
+// A small dam break (0.1 x 0.15 m column, 900 particles): its adaptive step shrinks as the water speeds up.
+constexpr const char* kScene = R"({
+  "name": "probe_e2e",
+  "solver": { "spacing": 0.01, "max_dt": 0.001 },
+  "tank": { "min": [0, 0, 0], "max": [0.3, 0.2, 0.06] },
+  "fluid": [ { "min": [0, 0, 0], "max": [0.1, 0.15, 0.06] } ],
+  "probes": { "every": 0.001,
+    "pressure": [ { "name": "far", "at": [0.3, 0.02, 0.03], "normal": [1, 0, 0] },
+                  { "name": "back", "at": [0.0, 0.02, 0.03], "normal": [-1, 0, 0] } ],
+    "level": [ { "name": "column", "x": 0.05, "z": 0.03 } ] }
+})";
+
+struct SphxrRun {
+  int code = -1;
+  std::string out, err;
+};
+
+SphxrRun Sphxr(const test::TempDir& dir, const std::vector<std::string>& args) {
+  SphxrRun r;
+  const std::string out = dir.File("stdout.txt"), err = dir.File("stderr.txt");
+  const pid_t pid = test::SpawnSphxr(args, out, err);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = test::ReadFile(out);
+  r.err = test::ReadFile(err);
+  return r;
+}
+
+std::vector<std::string> Cells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.push_back("");
+  return cells;
+}
+
+TEST(HeadlessTest, ProbeRowsOneMillisecondApartWhateverTheStep) {
+  test::TempDir dir("probes");
+  const std::string scene = dir.Write("scene.json", kScene);
+  const std::string csv = dir.File("probes.csv"), stats = dir.File("stats.csv");
+  const SphxrRun r = Sphxr(dir, {"--headless", "--scene", scene, "--time", "0.04", "--probes", csv, "--stats", stats,
+                            "--threads", "1", "--no-progress"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The steps differ (the adaptive step), and none is a divisor of 1 ms that the rows could ride on.
+  std::map<std::string, int> dts;
+  const std::vector<std::string> statRows = test::Lines(test::ReadFile(stats));
+  for (size_t i = 1; i < statRows.size(); ++i) ++dts[Cells(statRows[i])[2]];
+  EXPECT_GT(dts.size(), 3u) << "expected the adaptive step to change";
+
+  const std::vector<std::string> lines = test::Lines(test::ReadFile(csv));
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "time,step,far_p,back_p,column_level");
+  // Rows at 0, 1, ..., 39 ms: the last reading is of the last step's start, before 40 ms.
+  ASSERT_GE(lines.size(), 1u + 39u);
+  for (size_t k = 1; k < lines.size(); ++k) {
+    const std::vector<std::string> cells = Cells(lines[k]);
+    ASSERT_EQ(cells.size(), 5u) << lines[k];
+    EXPECT_NEAR(std::stod(cells[0]), 0.001 * static_cast<double>(k - 1), 1e-12) << lines[k];
+    EXPECT_FALSE(cells[3].empty()) << "the back wall under the column is wet: " << lines[k];
+    EXPECT_FALSE(cells[4].empty()) << "the gauge in the column sees water: " << lines[k];
+  }
+  // The far wall is dry at the start: the water has not arrived.
+  EXPECT_TRUE(Cells(lines[1])[2].empty()) << lines[1];
+}
+
+TEST(HeadlessTest, ProbesWithoutASectionAreRefused) {
+  test::TempDir dir("probes_none");
+  const std::string scene = dir.Write("scene.json", test::kSmallTankScene);
+  const SphxrRun r = Sphxr(dir, {"--headless", "--scene", scene, "--steps", "2", "--probes", dir.File("p.csv"), "--no-progress"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("--probes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no \"probes\" section"), std::string::npos) << r.err;
+}
+
+/// The step and time a PLY header's comment names (-1 when it has none).
+std::pair<int64_t, double> PlyStamp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::regex stamp(R"(comment step (\d+) time ([0-9.eE+-]+))");
+  for (std::string line; std::getline(in, line) && line != "end_header";) {
+    std::smatch m;
+    if (std::regex_match(line, m, stamp)) return {std::stoll(m[1]), std::stod(m[2])};
+  }
+  return {-1, 0.0};
+}
+
+/// The TIME (big-endian double) and CYCLE (big-endian int) of a legacy VTK file's field data.
+std::pair<int64_t, double> VtkStamp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::pair<int64_t, double> out{-1, 0.0};
+  const size_t field = bytes.find("FIELD FieldData 2\nTIME 1 1 double\n");
+  if (field == std::string::npos) return out;
+  size_t at = field + std::strlen("FIELD FieldData 2\nTIME 1 1 double\n");
+  uint64_t t;
+  std::memcpy(&t, bytes.data() + at, 8);
+  t = __builtin_bswap64(t);
+  std::memcpy(&out.second, &t, 8);
+  at += 8;
+  const std::string cycle = "\nCYCLE 1 1 int\n";
+  if (bytes.compare(at, cycle.size(), cycle) != 0) return out;
+  uint32_t c;
+  std::memcpy(&c, bytes.data() + at + cycle.size(), 4);
+  out.first = static_cast<int32_t>(__builtin_bswap32(c));
+  return out;
+}
+
+// --export-interval: a file at the first step at or after each multiple of the interval, named by its
+// step, whose stamp gives that step and its time (checked against the stats CSV's row of that step).
+TEST(HeadlessTest, ExportIntervalStampsStepAndTime) {
+  for (const std::string format : {"ply", "vtk"}) {
+    SCOPED_TRACE(format);
+    test::TempDir dir("export_interval");
+    const std::string scene = dir.Write("scene.json", kScene);
+    const std::string out = dir.File("out"), stats = dir.File("stats.csv");
+    const SphxrRun r = Sphxr(dir, {"--headless", "--scene", scene, "--time", "0.03", "--export-interval", "0.01",
+                              "--export-format", format, "--export-surface-interval", "0.015", "--surface-format", "obj",
+                              "--out", out, "--stats", stats, "--threads", "1", "--no-progress"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::map<int64_t, double> timeOfStep{{0, 0.0}};
+    const std::vector<std::string> rows = test::Lines(test::ReadFile(stats));
+    for (size_t i = 1; i < rows.size(); ++i) {
+      const std::vector<std::string> c = Cells(rows[i]);
+      timeOfStep[std::stoll(c[0])] = std::stod(c[1]);
+    }
+    std::vector<std::pair<int64_t, double>> particles, surfaces;
+    for (const auto& entry : std::filesystem::directory_iterator(out)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("particles_", 0) == 0) {
+        particles.push_back(format == "ply" ? PlyStamp(entry.path().string()) : VtkStamp(entry.path().string()));
+        EXPECT_EQ(std::stoll(name.substr(10, 6)), particles.back().first) << name << " names another step than its stamp";
+      } else if (name.rfind("surface_", 0) == 0) {
+        std::ifstream in(entry.path());
+        std::string first, second;
+        std::getline(in, first);
+        std::getline(in, second);
+        std::smatch m;
+        ASSERT_TRUE(std::regex_match(second, m, std::regex(R"(# step (\d+) time ([0-9.eE+-]+))"))) << second;
+        surfaces.push_back({std::stoll(m[1]), std::stod(m[2])});
+      }
+    }
+    std::sort(particles.begin(), particles.end());
+    std::sort(surfaces.begin(), surfaces.end());
+    // Particles at 0, 10, 20, 30 ms (the run ends at the first step at or after 30 ms); the surface at
+    // 0, 15, 30 ms.
+    auto check = [&](const std::vector<std::pair<int64_t, double>>& files, double interval, size_t count) {
+      ASSERT_EQ(files.size(), count);
+      for (size_t k = 0; k < files.size(); ++k) {
+        const auto [step, time] = files[k];
+        ASSERT_TRUE(timeOfStep.count(step)) << "step " << step;
+        EXPECT_NEAR(time, timeOfStep[step], 1e-6 * (1.0 + time)) << "the stamp's time is the step's";
+        const double due = interval * static_cast<double>(k);
+        EXPECT_GE(time, due - 1e-12) << "file " << k << " before its time";
+        if (step > 0) EXPECT_LT(timeOfStep[step - 1], due) << "file " << k << ": the step before had reached it";
+      }
+    };
+    check(particles, 0.01, 4);
+    check(surfaces, 0.015, 3);
+  }
+}
+
+}  // namespace
+}  // namespace sphxr::app
