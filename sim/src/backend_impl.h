@@ -22,6 +22,7 @@
 #include "backend.h"
 #include "backend_guard.h"
 #include "dfsph_solver.h"
+#include "stages/density_diffusion.h"
 #include "surface_impl.h"
 
 namespace sphxr::sim {
@@ -247,6 +248,11 @@ class BackendImpl final : public Backend {
     } else {
       loop(n, 32, density);
     }
+    // 4b. delta_sph: the density's rate of change (stages/density_diffusion.h), of the step's start
+    if (physics.continuityDensity) {
+      m_densityRate.resize(n);
+      loop(n, 32, DensityRateStage{View(), fv, Neighbours(physics), physics, Raw(m_densityRate)});
+    }
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // DFSPH (dfsph_solver.h): the factor and kernel-gradient cache, the divergence-free solve, then the
@@ -295,6 +301,7 @@ class BackendImpl final : public Backend {
 
     // 6. integrate (DFSPH drifted in its Finish), then the statistics the next time step needs
     if (!physics.dfsph) thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
+    if (physics.continuityDensity) thrust::for_each_n(policy, first, n, DensityIntegrateStage{fv, Raw(m_densityRate), dt});
     // 6b. push fluid out of the bodies at their end-of-step pose
     if (bodies) {
       if (Status s = lap(Stage::kIntegrate); !s) return s;
@@ -304,7 +311,7 @@ class BackendImpl final : public Backend {
       if (Status s = lap(Stage::kBodies); !s) return s;
     }
     const StepReduction solves = *out;
-    *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics.invRestDensity},
+    *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics},
                                     StepReduction{}, StepReductionCombine{});
     out->computed = computing;
     out->densityIterations = solves.densityIterations;
@@ -592,6 +599,7 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_bodyStart, m_bodyEnd;
   Vector<uint8_t> m_movingNear;
   Vector<float> m_bodyPressureTerm;  // per fluid particle (ForceStage or DFSPH's Finish -> BodyReactionStage)
+  Vector<float> m_densityRate;       // per fluid particle, solver.density delta_sph (DensityRateStage)
   DfsphSolver<Traits> m_dfsph;       // DFSPH's arrays (sized at its first step)
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the

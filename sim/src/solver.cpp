@@ -187,6 +187,11 @@ Status ValidateScene(const SceneSetup& scene) {
       }
     }
   }
+  if (scene.obstacles.size() > static_cast<size_t>(kMaxObstacles)) {
+    return Status::Error(Format("obstacles: %zu boxes given, at most %d are supported (each is checked for fluid "
+                                "inside it every step): merge touching boxes",
+                                scene.obstacles.size(), kMaxObstacles));
+  }
   for (size_t i = 0; i < scene.obstacles.size(); ++i) {
     const std::string key = Format("obstacles[%zu]", i);
     if (Status s = ValidateBox(scene.obstacles[i], key); !s) return s;
@@ -294,7 +299,14 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
                    "errors above 1%% (WCSPH wants 10x); solver.stiffness >= %.3g Pa would give that",
                    soundSpeed, soundSpeed / vRef, vRef, needB);
   }
-  if (wcsph) {
+  const bool deltaSph = scene.density == DensityModel::kDeltaSph;
+  if (!wcsph && deltaSph) {
+    SPHXR_LOG_WARN("solver.density delta_sph is a WCSPH model; DFSPH sums the density (the setting is ignored)");
+  }
+  if (wcsph && deltaSph && scene.reuse.enabled) {
+    SPHXR_LOG_WARN("reuse is off under solver.density delta_sph: an integrated density cannot skip steps (use "
+                   "\"summation\" for reuse)");
+  } else if (wcsph) {
     WarnAboutReuse(scene.reuse);
   } else if (scene.reuse.enabled) {
     SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method dfsph (docs/design/dfsph.md)");
@@ -336,7 +348,10 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.bodyGradScale = WallGradientCorrection(ph.kernel, p.spacing, 1) / WallDensityCorrection(ph.kernel, p.spacing, 1);
   ph.bodyClearance = 0.25f * p.spacing;
   const ReuseParams& r = scene.reuse;
-  ph.reuseEnabled = r.enabled && !ph.dfsph;  // reuse is WCSPH's (docs/design/dfsph.md)
+  ph.continuityDensity = scene.density == DensityModel::kDeltaSph && !ph.dfsph;
+  // Reuse is WCSPH's (docs/design/dfsph.md), and holds a summation density: an integrated density
+  // cannot skip steps.
+  ph.reuseEnabled = r.enabled && !ph.dfsph && !ph.continuityDensity;
   ph.reuseDelta1 = r.delta1;
   ph.reuseDelta2 = r.delta2;
   ph.reuseThreshold = r.threshold;
@@ -357,6 +372,15 @@ Physics MakePhysics(const SceneSetup& scene) {
   const float inset = 0.25f * p.spacing;
   ph.domainMin = Vec3{scene.tank.min.x + inset, scene.tank.min.y + inset, scene.tank.min.z + inset};
   ph.domainMax = Vec3{scene.tank.max.x - inset, scene.tank.max.y - inset, scene.tank.max.z - inset};
+  // Obstacles are sampled like the tank (a sheet half a spacing inside each face, fluid seeded half a
+  // spacing outside): the same quarter-spacing inset, outward.
+  ph.obstacleCount = static_cast<int>(std::min<size_t>(scene.obstacles.size(), kMaxObstacles));
+  for (int k = 0; k < kMaxObstacles; ++k) {
+    const bool used = k < ph.obstacleCount;
+    const Aabb o = used ? scene.obstacles[k] : Aabb{};
+    ph.obstacleMin[k] = used ? Vec3{o.min.x - inset, o.min.y - inset, o.min.z - inset} : Vec3{};
+    ph.obstacleMax[k] = used ? Vec3{o.max.x + inset, o.max.y + inset, o.max.z + inset} : Vec3{};
+  }
   ph.volume = ph.mass / p.restDensity;
   ph.densityTolerance = 0.01f * p.densityTolerance;  // % to a fraction
   ph.divergenceTolerance = 0.01f * p.divergenceTolerance;
@@ -394,6 +418,32 @@ bool ParseDevice(const std::string& text, Device* out) {
 
 bool CudaBackendCompiled() { return CudaCompiled(); }
 int CudaDeviceCount() { return CudaDevices(); }
+
+std::string ClampSiteName(int site) {
+  static const char* const kFaces[kTankFaces] = {"x- wall", "x+ wall", "floor", "top", "z- wall", "z+ wall"};
+  SPHXR_ASSERT(site >= 0 && site < kClampSites);
+  return site < kTankFaces ? kFaces[site] : Format("obstacles[%d]", site - kTankFaces);
+}
+
+void Solver::WarnIfWallsLeak() {
+  // Judged once the run has had a thousand particle-steps per particle's worth of chances (a few steps of
+  // a large scene, some hundred of a small one), then at most once per run.
+  if (m_leakWarned || m_totals.particleSteps < 100000) return;
+  const double rate = static_cast<double>(m_totals.clampedEvents) / static_cast<double>(m_totals.particleSteps);
+  if (rate <= kLeakingClampRate) return;
+  m_leakWarned = true;
+  int worst = 0;
+  for (int k = 1; k < kClampSites; ++k) {
+    if (m_totals.clampedAt[k] > m_totals.clampedAt[worst]) worst = k;
+  }
+  const double share = m_totals.clampedEvents > 0 ? static_cast<double>(m_totals.clampedAt[worst]) /
+                                                        static_cast<double>(m_totals.clampedEvents)
+                                                  : 0.0;
+  SPHXR_LOG_WARN("the walls leak: %.3g clamps per 1,000 particle-steps by t = %.3g s (a clamp is a safety net at "
+                 "under %.2g), %.0f %% of them at the %s; more boundary layers (tank.boundary_layers) or a larger "
+                 "sound speed hold the water (logged once)",
+                 1000.0 * rate, m_last.time, 1000.0 * kLeakingClampRate, 100.0 * share, ClampSiteName(worst).c_str());
+}
 
 const char* StageName(Stage stage) {
   switch (stage) {
@@ -465,11 +515,23 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
       SceneSetup one = scene;
       one.fluid = {block};
       const int64_t n = SampleFluid(one, nullptr);
+      // delta_sph integrates the density from here: a hydrostatic block starts at the Tait density of
+      // each particle's depth below the block's top layer (plus half a spacing), as its lattice is
+      // compressed; everything else at rho0.
+      const bool hydrostatic = block.hydrostatic && scene.density == DensityModel::kDeltaSph;
+      float top = -std::numeric_limits<float>::infinity();
+      for (int64_t k = 0; k < n; ++k) top = std::max(top, positions[i + k].y);
+      top += 0.5f * scene.params.spacing;
+      const SolverParams& p = scene.params;
       for (int64_t k = 0; k < n; ++k, ++i) {
         fluid.position[i] = positions[i];
         fluid.velocity[i] = MakeVec4(block.velocity);
         fluid.id[i] = static_cast<uint32_t>(i);
-        fluid.density[i] = scene.params.restDensity;
+        fluid.density[i] = p.restDensity;
+        if (hydrostatic) {
+          const float head = p.restDensity * Length(scene.gravity) * (top - positions[i].y) / p.stiffness;
+          fluid.density[i] = p.restDensity * std::pow(1.0f + head, 1.0f / p.exponent);
+        }
         fluid.idle[i] = -1;  // every particle computes its first step
       }
     }
@@ -630,6 +692,9 @@ Status Solver::Step() {
   m_last.activeFraction = n > 0 ? static_cast<float>(red.computed) / static_cast<float>(n) : 1.0f;
   m_totals.steps += 1;
   m_totals.clampedEvents += red.clamped;
+  for (int k = 0; k < kClampSites; ++k) m_totals.clampedAt[k] += red.clampedAt[k];
+  m_totals.particleSteps += n;
+  WarnIfWallsLeak();
   m_last.pushedOut = red.pushed;
   m_totals.pushedOutEvents += red.pushed;
   m_last.densityIterations = red.densityIterations;
@@ -757,6 +822,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
     }
   } restoreReuse{this, reuse};
   SettleReport r;
+  m_leakWarned = true;  // the settle's steps are not the run's: it clamps what it relaxes
   double alpha = 0.1;
   int downhill = 0;
   while (m_last.time < seconds) {
@@ -790,6 +856,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
   for (BodyMotion& b : m_bodies) HoldBody(&b, b.pose, 0.0);  // where it is, at rest, on the restarted clock
   m_last = StepInfo{};
   m_totals = Totals{};
+  m_leakWarned = false;
   m_maxAccel = 0.0f;
   if (reuse.enabled) {
     if (Status s = SetReuse(reuse); !s) return s;

@@ -24,6 +24,7 @@
 #include "sphxr/common/assert.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/hd.h"
+#include "sphxr/sim/params.h"
 #include "sphxr/sim/vec.h"
 
 namespace sphxr::sim {
@@ -171,6 +172,7 @@ struct Physics {
   float reuseInvPressureScale;  // 1 / P_pc
   float reuseCellCount;         // N_CPN
   bool reuseSyncStep;           // this step's number is a multiple of IDLE + 1 (the impulse hold's schedule)
+  bool continuityDensity;       // solver.density delta_sph: density is state (stages/density_diffusion.h)
   bool wallDensity;             // walls with their own density (WallPressureStage), else mirrored pressure
   float bodyGradScale;          // as boundaryGradScale, for the one-sheet shells of moving bodies
   float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle
@@ -182,6 +184,11 @@ struct Physics {
   Vec3 gravity;
   Vec3 domainMin;       // clamp box for fluid particles
   Vec3 domainMax;
+  // Obstacles (static boxes), each grown by the same inset as the clamp box: a fluid particle inside
+  // one is put back on its nearest face (ClampOutOfObstacles).
+  int obstacleCount;
+  Vec3 obstacleMin[kMaxObstacles];
+  Vec3 obstacleMax[kMaxObstacles];
   // DFSPH (dfsph_solver.h); unused by WCSPH.
   bool dfsph;                   // SolverMethod::kDfsph
   float volume;                 // m / rho0, each fluid particle's rest volume
@@ -205,15 +212,61 @@ SPHXR_HD SPHXR_INLINE bool ClampToDomain(const Physics& ph, Vec4* x, Vec4* v) {
   return clamped;
 }
 
-/// The end of every integrator: x += dt v, the domain clamp (flagged in acceleration.w, so that the
-/// step reports how many were clamped), and the store of particle i's position, velocity and
-/// acceleration.
+/// Puts a particle inside an obstacle (grown by the clamp inset) on the obstacle's nearest face, with the
+/// velocity into the obstacle removed; true when it did. The obstacle's boundary particles should hold
+/// the water; this is the safety net, as the domain clamp is for the tank.
+SPHXR_HD SPHXR_INLINE bool ClampOutOfObstacles(const Physics& ph, Vec4* x, Vec4* v) {
+  bool clamped = false;
+  for (int k = 0; k < ph.obstacleCount; ++k) {
+    const Vec3 lo = ph.obstacleMin[k], hi = ph.obstacleMax[k];
+    if (!(x->x > lo.x && x->x < hi.x && x->y > lo.y && x->y < hi.y && x->z > lo.z && x->z < hi.z)) continue;
+    // The face the particle is nearest: axis a, side (lo or hi).
+    const float depth[6] = {x->x - lo.x, hi.x - x->x, x->y - lo.y, hi.y - x->y, x->z - lo.z, hi.z - x->z};
+    int face = 0;
+    for (int f = 1; f < 6; ++f) {
+      if (depth[f] < depth[face]) face = f;
+    }
+    float* xs[3] = {&x->x, &x->y, &x->z};
+    float* vs[3] = {&v->x, &v->y, &v->z};
+    const float bound[6] = {lo.x, hi.x, lo.y, hi.y, lo.z, hi.z};
+    const int axis = face / 2;
+    *xs[axis] = bound[face];
+    // Low face: the outward direction is -axis, so velocity along +axis goes into the box.
+    if ((face % 2 == 0) ? (*vs[axis] > 0.0f) : (*vs[axis] < 0.0f)) *vs[axis] = 0.0f;
+    clamped = true;
+  }
+  return clamped;
+}
+
+/// The clamp site (params.h kClampSites) that put particle x where it is after a clamp: the tank face
+/// it sits on, else the obstacle on whose grown face it sits; -1 when none (a moving body pushed it on).
+SPHXR_HD SPHXR_INLINE int ClampSiteOf(const Physics& ph, Vec3 x) {
+  if (x.x == ph.domainMin.x) return 0;
+  if (x.x == ph.domainMax.x) return 1;
+  if (x.y == ph.domainMin.y) return 2;
+  if (x.y == ph.domainMax.y) return 3;
+  if (x.z == ph.domainMin.z) return 4;
+  if (x.z == ph.domainMax.z) return 5;
+  for (int k = 0; k < ph.obstacleCount; ++k) {
+    const Vec3 lo = ph.obstacleMin[k], hi = ph.obstacleMax[k];
+    const bool inside = x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y && x.z >= lo.z && x.z <= hi.z;
+    const bool onFace = x.x == lo.x || x.x == hi.x || x.y == lo.y || x.y == hi.y || x.z == lo.z || x.z == hi.z;
+    if (inside && onFace) return kTankFaces + k;
+  }
+  return -1;
+}
+
+/// The end of every integrator: x += dt v, the domain and obstacle clamps (flagged in acceleration.w, so
+/// that the step reports how many were clamped, and where), and the store of particle i's position,
+/// velocity and acceleration.
 SPHXR_HD SPHXR_INLINE void DriftAndStore(const FluidView& fluid, const Physics& ph, float dt, int i, Vec4 x, Vec4 v,
                                          Vec4 a) {
   x.x += dt * v.x;
   x.y += dt * v.y;
   x.z += dt * v.z;
-  a.w = ClampToDomain(ph, &x, &v) ? 1.0f : 0.0f;
+  bool clamped = ph.obstacleCount > 0 && ClampOutOfObstacles(ph, &x, &v);
+  clamped = ClampToDomain(ph, &x, &v) || clamped;
+  a.w = clamped ? 1.0f : 0.0f;
   fluid.acceleration[i] = a;
   fluid.velocity[i] = v;
   fluid.position[i] = x;
@@ -542,7 +595,9 @@ struct DensityStage {
         if (r2 < k.H2) sumBoundary += grid.body[j].w * k.W(sqrtf(r2));
       });
     }
-    const float rho = ph.mass * sumFluid + sumBoundary;
+    // delta_sph: the density is integrated state (stages/density_diffusion.h); the sums above still give
+    // the neighbour list and the wall flag.
+    const float rho = ph.continuityDensity ? fluid.density[i] : ph.mass * sumFluid + sumBoundary;
     fluid.density[i] = rho;
     const float pressure = TaitPressure(ph, rho);
     fluid.pressure[i] = pressure;
@@ -792,6 +847,7 @@ struct StepReduction {
   float maxDensityError = 0.0f;
   double sumCompression = 0.0;
   int32_t clamped = 0;
+  int32_t clampedAt[kClampSites] = {};  // the same per tank face and obstacle (ClampSiteOf)
   int32_t computed = 0;  // particles that computed density and forces this step (set by the backend)
   int32_t pushed = 0;    // fluid particles pushed out of a moving body this step (body_stages.h)
   int32_t nonFinite = 0; // fluid particles with a NaN or infinite position, velocity, acceleration or density
@@ -804,8 +860,9 @@ struct StepReduction {
 
 struct StepReductionOp {
   FluidView fluid;
-  float invRestDensity;
+  Physics ph;
   SPHXR_HD StepReduction operator()(int i) const {
+    const float invRestDensity = ph.invRestDensity;
     StepReduction r;
     const Vec4 v = fluid.velocity[i];
     const Vec4 a = fluid.acceleration[i];
@@ -819,6 +876,10 @@ struct StepReductionOp {
     r.maxDensityError = fabsf(err);
     r.sumCompression = err > 0.0f ? err : 0.0f;
     r.clamped = WasClamped(a.w) ? 1 : 0;
+    if (r.clamped) {
+      const int site = ClampSiteOf(ph, Xyz(x));
+      if (site >= 0) r.clampedAt[site] = 1;
+    }
     r.pushed = WasPushed(a.w) ? 1 : 0;
     return r;
   }
@@ -832,6 +893,7 @@ struct StepReductionCombine {
     r.maxDensityError = MaxDroppingNaN(a.maxDensityError, b.maxDensityError);
     r.sumCompression = a.sumCompression + b.sumCompression;
     r.clamped = a.clamped + b.clamped;
+    for (int s = 0; s < kClampSites; ++s) r.clampedAt[s] = a.clampedAt[s] + b.clampedAt[s];
     r.pushed = a.pushed + b.pushed;
     r.nonFinite = a.nonFinite + b.nonFinite;
     return r;
