@@ -1,6 +1,6 @@
 // sphxr_bench_blocks: the CPU density blocks fitted to the particles (Morton boxes of up to 4 x 4 x 4
-// cells where the water is sparse, crowded pairs cut per cell; cpu_stages.h BlockBoxOf) against the
-// layout before them (every block from a pair of cells along x; SolverConfig::pairDensityBlocks).
+// cells where the water is sparse, crowded pairs cut per cell; cpu/blocks.h BlockBoxOf) against the
+// layout before them (every block from a pair of cells along x; sim/src/backend.h UsePairDensityBlocks).
 //
 // Two solvers of one scene, one per layout, stepped in lock-step: one step of each in turn, the first
 // of each step alternating, so that both see the same machine (this VM's speed swings 1.5-3x between
@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "backend.h"  // sim/src: UsePairDensityBlocks
 #include "bench_util.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/sim/fields.h"
@@ -147,11 +148,11 @@ int Main(int argc, char** argv) {
     sim::SolverConfig config;
     config.device = sim::Device::kCpu;
     config.threads = args.threads;
-    config.pairDensityBlocks = k == 1 && !args.control;
     if (Status s = sim::Solver::Create(scene.setup, config, &solver[k]); !s) {
       std::fprintf(stderr, "sphxr_bench_blocks: %s\n", s.message().c_str());
       return 1;
     }
+    if (k == 1 && !args.control) solver[k]->BackendForTests()->UsePairDensityBlocks();
   }
   std::printf("sphxr_bench_blocks: %s, %d fluid particles, %.3g s, reuse %s, %d thread(s)%s\n", args.scene.c_str(),
               solver[0]->FluidCount(), args.time, args.reuse.c_str(), args.threads,

@@ -3,8 +3,8 @@
 //
 // Rounds alternate the two configurations (with, without, with, without, ...) so that a change of the
 // machine's load hits both alike. Per configuration and round: warm-up steps, then measured steps, each
-// timed around everything a step costs (with the paddle: the frame's BeginFrame when one is due,
-// Solver::Step, PaddleSystem::AfterStep). Reported: the median over rounds of the per-round median ms
+// timed around everything a step costs (app::Simulation::Step: with the paddle, the frame's BeginFrame
+// when one is due, Solver::Step, PaddleSystem::AfterStep). Reported: the median over rounds of the per-round median ms
 // per step, the per-stage split (the "bodies" stage is the paddles' own work: placing and sorting their
 // particles, the reaction, the push-out; their terms inside the density and force loops show as the
 // difference of those stages), the mean time step (the paddle's speed enters the CFL bound) and so the
@@ -21,6 +21,7 @@
 
 #include "bench_util.h"
 #include "sphxr/app/scene_file.h"
+#include "sphxr/app/simulation.h"
 #include "sphxr/common/log.h"
 #include "sphxr/interaction/paddle.h"
 #include "sphxr/sim/solver.h"
@@ -55,43 +56,31 @@ bool RunRound(const Args& args, bool withPaddle, Round* r) {
     return false;
   }
   if (args.spacing > 0.0f) scene.setup.params.spacing = args.spacing;
-  std::unique_ptr<interaction::PaddleSystem> paddles;
-  if (withPaddle) {
-    if (scene.paddles.empty()) {
-      std::fprintf(stderr, "%s has no paddles section\n", args.scene.c_str());
-      return false;
-    }
-    if (Status s = interaction::PaddleSystem::Create(scene.paddles, scene.setup, &paddles); !s) {
-      std::fprintf(stderr, "%s\n", s.message().c_str());
-      return false;
-    }
-    paddles->AddBodies(&scene.setup);
+  if (withPaddle && scene.paddles.empty()) {
+    std::fprintf(stderr, "%s has no paddles section\n", args.scene.c_str());
+    return false;
   }
-  sim::SolverConfig config;
-  config.device = sim::Device::kCpu;
-  config.threads = args.threads;
-  std::unique_ptr<sim::Solver> solver;
-  if (Status s = sim::Solver::Create(scene.setup, config, &solver); !s) {
+  app::SimScene run = app::SimSceneFromFile(scene);
+  if (!withPaddle) run.paddles.clear();
+  app::SimulationConfig config;
+  config.solver.device = sim::Device::kCpu;
+  config.solver.threads = args.threads;
+  std::unique_ptr<app::Simulation> simulation;
+  if (Status s = app::Simulation::Create(run, config, &simulation); !s) {
     std::fprintf(stderr, "%s\n", s.message().c_str());
     return false;
   }
-  if (paddles) {
-    if (Status s = paddles->Attach(solver.get()); !s) return false;
+  const sim::Solver* solver = &simulation->Solver();
+  if (const interaction::PaddleSystem* paddles = simulation->Paddles()) {
     for (int k = 0; k < paddles->Count(); ++k) r->paddleParticles += paddles->ParticleCount(k);
   }
   r->fluid = solver->FluidCount();
   r->boundary = solver->BoundaryCount();
-  double nextFrame = 0.0;
   auto step = [&]() -> bool {
-    if (paddles && solver->Time() >= nextFrame - 1e-9) {
-      nextFrame += 1.0 / scene.paddleFrameRate;
-      if (!paddles->BeginFrame(nextFrame)) return false;
-    }
-    if (Status s = solver->Step(); !s || !std::isfinite(solver->LastStep().maxSpeed)) {
+    if (Status s = simulation->Step(); !s) {
       std::fprintf(stderr, "the run failed at t = %g s\n", solver->Time());
       return false;
     }
-    if (paddles) paddles->AfterStep();
     return true;
   };
   for (int i = 0; i < args.warmup; ++i) {

@@ -5,7 +5,8 @@ usage: /usr/bin/python3 bench/plot_tradeoff.py [bench/results/tradeoff.csv] [doc
 
 Left: wall seconds per simulated second (log x) against the RMS relative error of the surge front
 against Martin & Moyce (1952). Right: the same cost against the time-averaged mean density error.
-Each point is labelled spacing/stiffness (e.g. "a/20 x1"); lines join runs of the same spacing.
+WCSPH points (circles, solid lines) are labelled spacing/stiffness (e.g. "a/20 x1"), DFSPH points (squares,
+dashed lines) spacing/density tolerance (e.g. "a/20 0.1%"); lines join runs of one method and spacing.
 """
 import csv
 import math
@@ -37,36 +38,51 @@ def main(argv):
         sys.exit(f"{src}: no rows")
 
     quick = any(r.get("mode") == "quick" for r in rows)
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5), constrained_layout=True)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 6))
+    fig.subplots_adjust(bottom=0.22, top=0.9, wspace=0.25)
     panels = [
         ("front_rms_rel", "surge front RMS relative error vs Martin & Moyce [%]"),
         ("mean_density_error", "mean density error, time-averaged [%]"),
     ]
     divisors = sorted({int(r["spacing_divisor"]) for r in rows})
+    methods = [m for m in ("wcsph", "dfsph") if any(r.get("method", "wcsph") == m for r in rows)]
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, (key, label) in zip(axes, panels):
-        for k, d in enumerate(divisors):
-            runs = sorted((r for r in rows if int(r["spacing_divisor"]) == d), key=lambda r: number(r["stiffness_factor"]))
-            pts = [(number(r["wall_per_sim_s"]), 100.0 * number(r[key]), r) for r in runs]
-            pts = [p for p in pts if math.isfinite(p[0]) and math.isfinite(p[1]) and p[0] > 0]
-            if not pts:
-                continue
-            colour = colours[k % len(colours)]
-            fluid = int(pts[0][2]["fluid"])
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=colour,
-                    label=f"a/{d} ({fluid:,} fluid particles)")
-            for x, y, r in pts:
-                ax.annotate(f"a/{d} x{number(r['stiffness_factor']):g}", (x, y), textcoords="offset points",
-                            xytext=(5, 4), fontsize=8, color=colour)
+        for method in methods:
+            dfsph = method == "dfsph"
+            for k, d in enumerate(divisors):
+                runs = [r for r in rows if int(r["spacing_divisor"]) == d and r.get("method", "wcsph") == method]
+                order = (lambda r: -number(r["density_tolerance_pct"])) if dfsph else (lambda r: number(r["stiffness_factor"]))
+                runs.sort(key=order)
+                pts = [(number(r["wall_per_sim_s"]), 100.0 * number(r[key]), r) for r in runs]
+                pts = [p for p in pts if math.isfinite(p[0]) and math.isfinite(p[1]) and p[0] > 0]
+                if not pts:
+                    continue
+                colour = colours[k % len(colours)]
+                fluid = int(pts[0][2]["fluid"])
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], "s--" if dfsph else "o-", color=colour,
+                        label=f"{method.upper()} a/{d} ({fluid:,} fluid particles)")
+                if dfsph:  # one label per line: tolerances that give the same run would print on top of each other
+                    tols = [f"{number(r['density_tolerance_pct']):g}" for _, _, r in pts]
+                    ax.annotate(f"DFSPH a/{d}, tol {tols[0]}..{tols[-1]} %", (pts[-1][0], pts[-1][1]),
+                                textcoords="offset points", xytext=(5, -10), fontsize=7, color=colour)
+                else:
+                    for x, y, r in pts:
+                        ax.annotate(f"a/{d} x{number(r['stiffness_factor']):g}", (x, y), textcoords="offset points",
+                                    xytext=(5, 4), fontsize=7, color=colour)
         ax.set_xscale("log")
         ax.margins(x=0.2, y=0.15)
         ax.set_xlabel("wall seconds per simulated second (CPU, log scale)")
         ax.set_ylabel(label)
-        ax.set_ylim(0, ax.get_ylim()[1] * 1.1)
+        if key == "mean_density_error":
+            ax.set_yscale("log")
+        else:
+            ax.set_ylim(0, ax.get_ylim()[1] * 1.1)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3, frameon=False)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=3, frameon=False)
     r0 = rows[0]
-    title = (f"sphxr dam break (Martin & Moyce 1952): cost vs accuracy, spacing a/N x stiffness factor — "
+    title = (f"sphxr dam break (Martin & Moyce 1952): cost vs accuracy, WCSPH (stiffness) and DFSPH (density tolerance) — "
              f"{r0.get('cpu_model', '?')}, solver threads: {r0.get('threads', '?')}")
     if quick:
         title += "\n--quick smoke run: 2 configurations to t = 0.05 s, front error over T <= 0.93 only (not a result)"

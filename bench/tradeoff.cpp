@@ -1,7 +1,8 @@
 // sphxr_bench_tradeoff: cost against accuracy on the Martin & Moyce (1952) dam break
-// (scenes/dam_break.json), swept over particle spacing (a/14, a/20, a/26 with a = 0.05715 m) and Tait
-// stiffness (x0.5, x1, x4 of the scene's value). Everything else is the scene's: the column and the tank
-// are fixed in metres, so the particle count changes with the spacing.
+// (scenes/dam_break.json), swept over particle spacing (a/14, a/20, a/26 with a = 0.05715 m) and, per
+// method, the knob that buys accuracy with time: WCSPH's Tait stiffness (x0.5, x1, x4 of the scene's
+// value) and DFSPH's density tolerance (1 %, 0.1 %, 0.01 %). Everything else is the scene's: the column
+// and the tank are fixed in metres, so the particle count changes with the spacing.
 //
 // Each run goes to t = 0.19 s (T = t sqrt(2g/a) = 3.5) and records:
 //   - wall seconds per simulated second (time inside Solver::Step only; the probe is not counted),
@@ -9,7 +10,8 @@
 //     measured points with 1.0 <= T <= 3.3, the simulated Z (sim::SurgeFront on a host copy every step,
 //     minPerBin from app::DamBreakMinPerBin, as the headless runner) interpolated linearly in time at
 //     each measured T; RMS and maximum of |Z_sim / Z_measured - 1|,
-//   - the mean density error, time-averaged (weighted by dt) over the run.
+//   - the mean density error, time-averaged (weighted by dt) over the run,
+//   - under DFSPH the mean iterations of its density and divergence solves.
 // --csv writes one row per run (bench/results/tradeoff.csv); bench/plot_tradeoff.py draws docs/images/tradeoff.png.
 #include <chrono>
 #include <cmath>
@@ -41,6 +43,7 @@ namespace {
 
 struct Args {
   bool quick = false;
+  std::string methods = "wcsph,dfsph";
   int threads = 0;
   std::string csv;
   std::string scene = SPHXR_SCENES_DIR "/dam_break.json";
@@ -49,9 +52,10 @@ struct Args {
 };
 
 const char* kUsage =
-    "usage: sphxr_bench_tradeoff [--quick] [--threads N] [--csv FILE] [--scene FILE] [--data FILE]\n"
-    "  --quick       2 configurations (a/14 and a/20, stiffness x1) to t = 0.05 s (a smoke run; the front error\n"
-    "                then covers only the measured points with T <= 0.93, which the full sweep excludes)\n"
+    "usage: sphxr_bench_tradeoff [--quick] [--methods LIST] [--threads N] [--csv FILE] [--scene FILE] [--data FILE]\n"
+    "  --quick       2 configurations per method (a/14 and a/20; stiffness x1, tolerance 0.1 %) to t = 0.05 s (a\n"
+    "                smoke run; the front error then covers only the measured points with T <= 0.93)\n"
+    "  --methods L   comma-separated: wcsph, dfsph (default both)\n"
     "  --threads N   CPU backend threads (default 0 = all cores)\n"
     "  --csv FILE    write one row per run to FILE (overwritten; only a file with this bench's header)\n"
     "  --scene FILE  dam-break scene (default " SPHXR_SCENES_DIR "/dam_break.json)\n"
@@ -71,6 +75,17 @@ bool ParseArgs(int argc, char** argv, Args* out) {
     const char* v = nullptr;
     if (a == "--quick") {
       out->quick = true;
+    } else if (a == "--methods") {
+      if (!next(&v)) return false;
+      out->methods = v;
+      std::stringstream ss(out->methods);
+      for (std::string m; std::getline(ss, m, ',');) {
+        sim::SolverMethod parsed;
+        if (!sim::ParseSolverMethod(m, &parsed)) {
+          std::fprintf(stderr, "--methods: unknown method '%s' (wcsph, dfsph)\n", m.c_str());
+          return false;
+        }
+      }
     } else if (a == "--threads") {
       if (!next(&v)) return false;
       if (!IntegerOption("sphxr_bench_tradeoff", a, v, 0, 1024, &out->threads)) return false;
@@ -127,8 +142,9 @@ double Interpolate(const std::vector<Point>& s, double t) {
 }
 
 struct Config {
+  sim::SolverMethod method;
   int spacingDivisor;     // spacing = a / divisor
-  double stiffnessFactor; // x the scene's stiffness
+  double knob;            // WCSPH: x the scene's stiffness; DFSPH: the density tolerance in %
 };
 
 struct Result {
@@ -147,6 +163,7 @@ struct Result {
   double frontRms = NAN, frontMax = NAN;  // relative
   double frontBias = NAN;                 // mean signed relative error (> 0: the simulated front is ahead)
   int frontPoints = 0;
+  double densityIterations = 0.0, divergenceIterations = 0.0;  // DFSPH: means per step
   double frontTMin = 0.0, frontTMax = 0.0;
   double finalZ = 0.0;
   double meanDensityError = 0.0;     // time average
@@ -167,9 +184,13 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
   }
   const app::DamBreakProbe probe = *scene.damBreak;
   const double a = probe.columnWidth;
-  // Only the spacing and the stiffness are overridden, through the same path as --set on the command line.
-  const float stiffness = static_cast<float>(config.stiffnessFactor * scene.setup.params.stiffness);
-  for (const std::string& set : {Format("spacing=%.9g", a / config.spacingDivisor), Format("stiffness=%.9g", stiffness)}) {
+  // Only the method, the spacing and the method's knob are overridden, through the same path as --set on
+  // the command line.
+  const bool dfsph = config.method == sim::SolverMethod::kDfsph;
+  const float stiffness = static_cast<float>((dfsph ? 1.0 : config.knob) * scene.setup.params.stiffness);
+  const std::string knob = dfsph ? Format("density_tolerance=%.9g", config.knob) : Format("stiffness=%.9g", stiffness);
+  for (const std::string& set : {Format("method=%s", sim::SolverMethodName(config.method)),
+                                 Format("spacing=%.9g", a / config.spacingDivisor), knob}) {
     if (Status s = app::SetSolverParam(&scene.setup, set); !s) {
       std::fprintf(stderr, "%s\n", s.message().c_str());
       return false;
@@ -197,8 +218,9 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
   r->boundary = solver->BoundaryCount();
   r->soundSpeed = solver->SoundSpeed();
   r->threads = omp_get_max_threads();
-  std::fprintf(stderr, "a/%d (%.4g mm), stiffness x%g (%.4g Pa): %d fluid + %d boundary particles, to t = %g s ...\n",
-               config.spacingDivisor, 1e3 * dx, config.stiffnessFactor, stiffness, r->fluid, r->boundary, tEnd);
+  std::fprintf(stderr, "%s a/%d (%.4g mm), %s %g: %d fluid + %d boundary particles, to t = %g s ...\n",
+               sim::SolverMethodName(config.method), config.spacingDivisor, 1e3 * dx,
+               dfsph ? "density tolerance %" : "stiffness x", config.knob, r->fluid, r->boundary, tEnd);
 
   sim::HostFluid host;
   std::vector<Point> front;  // (T, Z)
@@ -231,6 +253,10 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
   r->wallPerSimSecond = r->simTime > 0 ? r->stepWall / r->simTime : 0.0;
   r->meanDensityError = r->simTime > 0 ? errorTime / r->simTime : 0.0;
   r->finalZ = front.back().value;
+  if (totals.steps > 0) {
+    r->densityIterations = static_cast<double>(totals.densityIterations) / static_cast<double>(totals.steps);
+    r->divergenceIterations = static_cast<double>(totals.divergenceIterations) / static_cast<double>(totals.steps);
+  }
 
   const double tReached = front.back().t;
   double sumSq = 0.0, maxAbs = 0.0, sumRel = 0.0;
@@ -277,8 +303,8 @@ int main(int argc, char** argv) {
   }
   SetLogLevel(LogLevel::kError);  // the soft stiffness warns about its sound speed: that is the point of the sweep
   const std::string header =
-      "timestamp_utc,cpu_model,nproc,threads,load_avg_start,load_avg_end,mode,spacing_divisor,spacing_m,"
-      "stiffness_factor,stiffness_pa,sound_speed,fluid,boundary,steps,dt_clamped_steps,clamped_events,sim_time_s,"
+      "timestamp_utc,cpu_model,nproc,threads,load_avg_start,load_avg_end,mode,method,spacing_divisor,spacing_m,"
+      "stiffness_factor,density_tolerance_pct,density_iterations,divergence_iterations,stiffness_pa,sound_speed,fluid,boundary,steps,dt_clamped_steps,clamped_events,sim_time_s,"
       "step_wall_s,loop_wall_s,wall_per_sim_s,front_rms_rel,front_max_rel,front_bias_rel,front_points,front_T_min,front_T_max,final_Z,"
       "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_viscosity,cfl,"
       "max_dt";
@@ -298,14 +324,24 @@ int main(int argc, char** argv) {
 
   std::vector<Config> configs;
   double tEnd = 0.19, tMin = 1.0, tMax = 3.3;
+  std::stringstream methods(args.methods);
+  for (std::string name; std::getline(methods, name, ',');) {
+    sim::SolverMethod m = sim::SolverMethod::kWcsph;
+    sim::ParseSolverMethod(name, &m);
+    const bool dfsph = m == sim::SolverMethod::kDfsph;
+    if (args.quick) {
+      for (int d : {14, 20}) configs.push_back({m, d, dfsph ? 0.1 : 1.0});
+    } else {
+      for (int d : {14, 20, 26}) {
+        for (double k : dfsph ? std::vector<double>{1.0, 0.1, 0.01} : std::vector<double>{0.5, 1.0, 4.0}) {
+          configs.push_back({m, d, k});
+        }
+      }
+    }
+  }
   if (args.quick) {
-    configs = {{14, 1.0}, {20, 1.0}};
     tEnd = 0.05;
     tMin = 0.0;  // the smoke run ends at T = 0.93: compare what it reaches
-  } else {
-    for (int d : {14, 20, 26}) {
-      for (double k : {0.5, 1.0, 4.0}) configs.push_back({d, k});
-    }
   }
 
   const std::string model = CpuModel();
@@ -324,7 +360,7 @@ int main(int argc, char** argv) {
   const double loadEnd = LoadAverage();
 
   std::printf("\n## sphxr_bench_tradeoff%s\n\n", args.quick ? " (--quick: a smoke run, not a measurement)" : "");
-  std::printf("- scene: %s to t = %g s (T = %.2f), CPU backend, adaptive dt\n", args.scene.c_str(), tEnd,
+  std::printf("- scene: %s to t = %g s (T = %.2f), CPU backend, adaptive dt (WCSPH: CFL on c + v; DFSPH: CFL on v)\n", args.scene.c_str(), tEnd,
               tEnd * std::sqrt(2.0 * 9.81 / 0.05715));
   std::printf("- front error over the Martin & Moyce points with %g <= T <= %g reached by the run\n", tMin, tMax);
   std::printf("- machine: %s, nproc %d, solver threads %d; 1-min load average %.2f at start, %.2f at end; %s\n",
@@ -343,13 +379,18 @@ int main(int argc, char** argv) {
                 loadStart);
   }
   std::printf("\n");
-  std::printf("| spacing | stiffness | fluid | steps | wall s per simulated s | front RMS error | front max error | "
-              "front mean signed error | points | mean density error | final Z |\n");
-  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf("| method | spacing | stiffness or tolerance | fluid | steps | iterations (density, divergence) | wall s per "
+              "simulated s | front RMS error | front max error | front mean signed error | points | mean density error | "
+              "final Z |\n");
+  std::printf("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const Result& r : results) {
-    std::printf("| a/%d (%.3f mm) | x%g (%.0f Pa, c = %.1f m/s) | %d | %lld | %.1f | %s | %s | %s | %d | %.3f %% | %.3f |\n",
-                r.config.spacingDivisor, 1e3 * r.spacing, r.config.stiffnessFactor, r.stiffness, r.soundSpeed, r.fluid,
-                static_cast<long long>(r.steps), r.wallPerSimSecond, Percent(r.frontRms).c_str(),
+    const bool dfsph = r.config.method == sim::SolverMethod::kDfsph;
+    const std::string knob = dfsph ? Format("tolerance %g %%", r.config.knob)
+                                   : Format("x%g (%.0f Pa, c = %.1f m/s)", r.config.knob, r.stiffness, r.soundSpeed);
+    const std::string iterations = dfsph ? Format("%.1f, %.1f", r.densityIterations, r.divergenceIterations) : "—";
+    std::printf("| %s | a/%d (%.3f mm) | %s | %d | %lld | %s | %.1f | %s | %s | %s | %d | %.3f %% | %.3f |\n",
+                sim::SolverMethodName(r.config.method), r.config.spacingDivisor, 1e3 * r.spacing, knob.c_str(), r.fluid,
+                static_cast<long long>(r.steps), iterations.c_str(), r.wallPerSimSecond, Percent(r.frontRms).c_str(),
                 Percent(r.frontMax).c_str(), Percent(r.frontBias).c_str(), r.frontPoints, 100.0 * r.meanDensityError, r.finalZ);
   }
 
@@ -362,8 +403,11 @@ int main(int argc, char** argv) {
     csv.precision(9);
     for (const Result& r : results) {
       csv << when << ',' << CsvField(model) << ',' << cpus << ',' << r.threads << ',' << loadStart << ',' << loadEnd << ','
-          << (args.quick ? "quick" : "full") << ',' << r.config.spacingDivisor << ',' << r.spacing << ','
-          << r.config.stiffnessFactor << ',' << r.stiffness << ',' << r.soundSpeed << ',' << r.fluid << ',' << r.boundary
+          << (args.quick ? "quick" : "full") << ',' << sim::SolverMethodName(r.config.method) << ','
+          << r.config.spacingDivisor << ',' << r.spacing << ','
+          << (r.config.method == sim::SolverMethod::kDfsph ? 1.0 : r.config.knob) << ','
+          << (r.config.method == sim::SolverMethod::kDfsph ? Format("%g", r.config.knob) : std::string()) << ','
+          << r.densityIterations << ',' << r.divergenceIterations << ',' << r.stiffness << ',' << r.soundSpeed << ',' << r.fluid << ',' << r.boundary
           << ',' << r.steps << ',' << r.dtClampedSteps << ',' << r.clampedEvents << ',' << r.simTime << ','
           << r.stepWall << ',' << r.loopWall << ',' << r.wallPerSimSecond << ',' << r.frontRms << ',' << r.frontMax
           << ',' << r.frontBias << ',' << r.frontPoints << ',' << r.frontTMin << ',' << r.frontTMax << ',' << r.finalZ << ','

@@ -16,77 +16,24 @@ using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 }  // namespace
 
-SimScene SimSceneFromFile(const SceneFile& scene, std::initializer_list<int> hands) {
-  SimScene out;
-  out.setup = scene.setup;
-  out.paddles = scene.paddles;
-  out.paddleFrameRate = scene.paddleFrameRate;
-  out.surface.params = scene.surface.value_or(sim::SurfaceParams{});
-  for (int hand : hands) {
-    const interaction::Holder holder = hand == 0 ? interaction::Holder::kLeftHand : interaction::Holder::kRightHand;
-    bool held = false;
-    for (const interaction::PaddleDesc& d : out.paddles) held = held || d.holder == holder;
-    if (!held) out.paddles.push_back(DefaultHandPaddle(out.setup, hand));
-  }
-  return out;
-}
-
-interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand) {
-  interaction::PaddleDesc d;
-  d.name = hand == 0 ? "left hand" : "right hand";
-  d.holder = hand == 0 ? interaction::Holder::kLeftHand : interaction::Holder::kRightHand;
-  const sim::Aabb& t = setup.tank;
-  // At most 10 cm wide, and no wider than a third of the tank's narrower horizontal side.
-  const float width = std::min(0.1f, std::min(t.max.x - t.min.x, t.max.z - t.min.z) / 3.0f);
-  const float spacing = setup.params.spacing;
-  d.shapes = interaction::BladeOnHandle(1.5f * width, std::max(0.6f * spacing, 0.12f * width), width, 1.2f * width,
-                                        std::max(1.2f * spacing, 0.12f * width));
-  // Full scale at the drag of a brisk 1.4 m/s stroke, 1/2 rho Cd A v^2 with Cd = 2 for a flat plate:
-  // 2 rho A (the blade held still in the water then shows about a tenth, its buoyancy).
-  d.haptics.fullScaleForce = std::max(0.05f, 2.0f * setup.params.restDensity * width * 1.2f * width);
-  return d;
-}
-
 SimWorker::SimWorker(const sim::SolverConfig& config) : m_config(config) {}
 
 SimWorker::~SimWorker() { Stop(); }
 
-Status SimWorker::Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-                        std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock,
-                        int64_t* stepsBefore) const {
-  sim::SceneSetup setup = scene.setup;
-  paddles->reset();
-  if (!scene.paddles.empty()) {
-    if (Status s = interaction::PaddleSystem::Create(scene.paddles, setup, paddles); !s) return s;
-    (*paddles)->AddBodies(&setup);
-  }
-  if (Status s = sim::Solver::Create(setup, m_config, solver); !s) return s;
-  bool restored = false;
-  if (scene.start) {
-    // On a reset, a mismatch (the panel changed the spacing since) falls back to the scene's own start,
-    // with a fresh solver: a refused restore may have changed nothing, but not provably so.
-    if (Status s = RestoreState(*scene.start, solver->get()); !s) {
-      if (strict) return Status::Error("--load-state " + s.message());
-      SPHXR_LOG_WARN("%s; starting from the scene instead", s.message().c_str());
-      if (Status c = sim::Solver::Create(setup, m_config, solver); !c) return c;
-    } else {
-      restored = true;
-      SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.start->path.c_str(), scene.start->clock.time);
-    }
-  }
-  *paddleClock = (*solver)->Time();
-  *stepsBefore = restored ? scene.start->step : 0;  // -1 (unknown) stays unknown in what it saves
-  if (*paddles) {
-    if (Status s = (*paddles)->Attach(solver->get()); !s) return s;
-    if (restored) RestorePaddles(*scene.start, **solver, paddles->get(), paddleClock);
+Status SimWorker::Build(const SimScene& scene, bool strict, std::unique_ptr<Simulation>* out) const {
+  SimulationConfig config;
+  config.solver = m_config;
+  config.strictStart = strict;
+  if (Status s = Simulation::Create(scene, config, out); !s) return s;
+  if ((*out)->Restored()) {
+    SPHXR_LOG_INFO("started from %s at t = %.6g s", scene.start->path.c_str(), scene.start->clock.time);
   }
   return Status::Ok();
 }
 
 Status SimWorker::Start(const SimScene& scene) {
-  double paddleClock = 0.0;
-  if (Status s = Build(scene, &m_solver, &m_paddles, true, &paddleClock, &m_stepsBefore); !s) return s;
-  m_path = ChooseSurfacePath(m_solver->ActiveDevice());
+  if (Status s = Build(scene, true, &m_sim); !s) return s;
+  m_path = ChooseSurfacePath(m_sim->Solver().ActiveDevice());
   if (m_path.load() == SurfacePath::kInterop) {
     LogOnce("surface-path", LogLevel::kInfo,
             "surface: solver on the CUDA device: the mesh is written into the GL buffers in place (CUDA-GL interop, "
@@ -95,7 +42,6 @@ Status SimWorker::Start(const SimScene& scene) {
     LogOnce("surface-path", LogLevel::kInfo,
             "surface: solver on the CPU: the mesh is copied into each snapshot and uploaded to GL (host path)");
   }
-  m_nextPaddleFrame = paddleClock;
   {
     std::lock_guard lock(m_mutex);
     m_scene = scene;
@@ -193,7 +139,7 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
   if (reuseSurface) request.enabled = false;
   {
     std::unique_lock solverLock = LockSolver();
-    if (Status s = CaptureSnapshot(*m_solver, m_paddles.get(), request, snap.get(), path); !s) {
+    if (Status s = CaptureSnapshot(m_sim->Solver(), m_sim->Paddles(), request, snap.get(), path); !s) {
       std::lock_guard lock(m_mutex);
       m_error = "surface: " + s.message();
     }
@@ -230,14 +176,14 @@ void SimWorker::Run() {
   omp_set_num_threads(m_config.threads > 0 ? m_config.threads : omp_get_num_procs());
   // Real-time pacing: simulated time may not run ahead of wall time (anchored again after a pause).
   Clock::time_point anchorWall = Clock::now();
-  double anchorSim = m_solver->Time();
+  double anchorSim = m_sim->Solver().Time();
   Clock::time_point lastPublish = Clock::now(), rateWindow = Clock::now();
-  int64_t rateSteps0 = m_solver->GetTotals().steps;
-  double rateSim0 = m_solver->Time();
-  sim::Totals published = m_solver->GetTotals();
+  int64_t rateSteps0 = m_sim->Solver().GetTotals().steps;
+  double rateSim0 = m_sim->Solver().Time();
+  sim::Totals published = m_sim->Solver().GetTotals();
   bool dirty = false;
   auto publishNow = [&](Clock::time_point now) {
-    const sim::Totals& t = m_solver->GetTotals();
+    const sim::Totals& t = m_sim->Solver().GetTotals();
     const double n = std::max<double>(1.0, static_cast<double>(t.steps - published.steps));
     double stageMs[static_cast<int>(sim::Stage::kCount)];
     for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) {
@@ -266,22 +212,16 @@ void SimWorker::Run() {
       reset = std::move(m_pendingReset);
     }
     if (reset) {
-      std::unique_ptr<sim::Solver> fresh;
-      std::unique_ptr<interaction::PaddleSystem> freshPaddles;
-      double paddleClock = 0.0;
-      int64_t stepsBefore = 0;
-      const Status s = Build(*reset, &fresh, &freshPaddles, false, &paddleClock, &stepsBefore);
+      std::unique_ptr<Simulation> fresh;
+      const Status s = Build(*reset, false, &fresh);
       if (!s) {
         SPHXR_LOG_WARN("scene rebuild refused: %s", s.message().c_str());
         std::lock_guard lock(m_mutex);
         m_error = s.message();
       } else {
         std::unique_lock solverLock = LockSolver();
-        m_paddles = std::move(freshPaddles);  // bound to the old solver: replaced first
-        m_solver = std::move(fresh);
+        m_sim = std::move(fresh);
         m_builtBuild = 0;  // the new solver has built no surface yet
-        m_nextPaddleFrame = paddleClock;  // (under the solver lock: a save reads both)
-        m_stepsBefore = stepsBefore;
         solverLock.unlock();
         {
           std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
@@ -290,10 +230,10 @@ void SimWorker::Run() {
           m_error.clear();
         }
         anchorWall = Clock::now();
-        anchorSim = m_solver->Time();
-        published = m_solver->GetTotals();
+        anchorSim = m_sim->Solver().Time();
+        published = m_sim->Solver().GetTotals();
         rateSteps0 = published.steps;
-        rateSim0 = m_solver->Time();  // a state file's start is not 0
+        rateSim0 = m_sim->Solver().Time();  // a state file's start is not 0
         rateWindow = Clock::now();
         double zero[static_cast<int>(sim::Stage::kCount)] = {};
         Publish(zero, 0.0);
@@ -311,48 +251,35 @@ void SimWorker::Run() {
       std::unique_lock lock(m_mutex);
       m_wake.wait_for(lock, std::chrono::milliseconds(20));
       anchorWall = Clock::now();
-      anchorSim = m_solver->Time();
+      anchorSim = m_sim->Solver().Time();
       continue;
     }
-    if (!stepRequested && m_solver->Time() - anchorSim > Seconds(Clock::now() - anchorWall)) {
+    if (!stepRequested && m_sim->Solver().Time() - anchorSim > Seconds(Clock::now() - anchorWall)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));  // ahead of real time
     } else {
       if (stepRequested) --m_stepRequests;
       std::unique_lock solverLock = LockSolver();
-      if (m_paddles && m_solver->Time() >= m_nextPaddleFrame - 1e-9) {
-        // A paddle frame: the newest hands become the paddles' targets one frame ahead in simulated time.
-        m_nextPaddleFrame = m_solver->Time() + 1.0 / m_scene.paddleFrameRate;
-        std::vector<interaction::HandInput> hands;
-        {
-          std::lock_guard lock(m_mutex);
-          hands = m_hands;
-        }
-        for (interaction::HandInput& h : hands) h.time = m_nextPaddleFrame;
-        if (Status s = m_paddles->BeginFrame(m_nextPaddleFrame, hands); !s) {
-          std::lock_guard lock(m_mutex);
-          m_error = s.message();
-        }
-      }
-      if (Status s = m_solver->Step(); !s) {
+      std::vector<interaction::HandInput> hands;  // the newest: the paddles' targets at their next frame
+      {
         std::lock_guard lock(m_mutex);
-        m_error = s.message();
-        m_paused = true;
+        hands = m_hands;
       }
-      if (m_paddles) m_paddles->AfterStep();
-      if (!std::isfinite(m_solver->LastStep().maxSpeed)) {
+      if (Status s = m_sim->Step(hands); !s) {
         std::lock_guard lock(m_mutex);
-        m_error = "the simulation became non-finite: press reset, and lower the time step or raise the stiffness";
+        m_error = std::isfinite(m_sim->Solver().LastStep().maxSpeed)
+                      ? s.message()
+                      : "the simulation became non-finite: press reset, and lower the time step or raise the stiffness";
         m_paused = true;
       }
       dirty = true;
     }
     const Clock::time_point now = Clock::now();
     if (Seconds(now - rateWindow) >= 0.5) {  // rates over half-second windows
-      m_rateSteps = (m_solver->GetTotals().steps - rateSteps0) / Seconds(now - rateWindow);
-      m_rateSim = (m_solver->Time() - rateSim0) / Seconds(now - rateWindow);
+      m_rateSteps = (m_sim->Solver().GetTotals().steps - rateSteps0) / Seconds(now - rateWindow);
+      m_rateSim = (m_sim->Solver().Time() - rateSim0) / Seconds(now - rateWindow);
       rateWindow = now;
-      rateSteps0 = m_solver->GetTotals().steps;
-      rateSim0 = m_solver->Time();
+      rateSteps0 = m_sim->Solver().GetTotals().steps;
+      rateSim0 = m_sim->Solver().Time();
     }
     if (dirty && (Seconds(now - lastPublish) >= 1.0 / 60.0 || m_paused)) publishNow(now);
   }
@@ -394,8 +321,8 @@ std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::s
     ++m_surfaceWriters;  // ahead of the worker's next step, as a surface writer
     std::unique_lock solverLock(m_solverMutex);
     --m_surfaceWriters;
-    t = m_solver->Time();
-    s = WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextPaddleFrame, m_stepsBefore);
+    t = m_sim->Solver().Time();
+    s = m_sim->WriteState(path, sceneName);
   }
   if (!s) {
     SPHXR_LOG_WARN("save state: %s", s.message().c_str());
@@ -449,7 +376,7 @@ Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, u
   render::InteropMesh::DevicePointers target;
   if (Status s = (*mesh)->Map(&target); !s) return s;
   sim::SurfaceStats stats;
-  const Status written = m_solver->WriteSurface({target.positions, target.normals, target.capacity}, &stats);
+  const Status written = m_sim->Solver().WriteSurface({target.positions, target.normals, target.capacity}, &stats);
   if (Status s = (*mesh)->Unmap(written ? static_cast<int>(vertices) : 0); !s) return s;
   if (!written) return written;
   *build = m_builtBuild;

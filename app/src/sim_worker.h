@@ -1,6 +1,6 @@
 #pragma once
-// The simulation on its own thread, so the frame loop never waits on it. The worker steps the solver
-// (no faster than real time) with the paddles driven by the newest hands (SetHands), and publishes a
+// The simulation on its own thread, so the frame loop never waits on it. The worker steps a Simulation
+// (simulation.h; no faster than real time) with the paddles driven by the newest hands (SetHands), and publishes a
 // snapshot (particles, the water surface, the paddles' poses, the haptic amplitudes) at most ~60 times
 // a second; the frame loop draws the newest snapshot with the newest camera, again and again when a
 // step is slower than a frame.
@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "sphxr/app/simulation.h"
 #include "sphxr/app/snapshot.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/status.h"
@@ -23,26 +24,6 @@
 #include "sphxr/sim/solver.h"
 
 namespace sphxr::app {
-
-struct SceneFile;
-
-/// What the worker runs: the scene without the paddles' bodies (the worker samples the paddles at the
-/// scene's spacing and adds them on every (re)build), the paddles, and the surface to extract.
-struct SimScene {
-  sim::SceneSetup setup;
-  std::vector<interaction::PaddleDesc> paddles;
-  double paddleFrameRate = 90.0;  // Hz (simulated): the paddles get the newest hands' targets this often
-  SurfaceRequest surface;
-  /// --load-state: the fluid and clock to start from instead of the scene's (every reset returns
-  /// there); null: the scene's own start.
-  std::shared_ptr<const StateFile> start;
-};
-
-/// The scene file's scene, with a default hand-held paddle (interaction::BladeOnHandle sized to the
-/// tank) for each hand in `hands` (0 left, 1 right) that no paddle of the scene is held by.
-SimScene SimSceneFromFile(const SceneFile& scene, std::initializer_list<int> hands = {});
-/// The default paddle for a hand: a blade on a handle, at most 10 cm wide, narrower in a small tank.
-interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand);
 
 /// "<scene name>.state" for a save without --save-state: the name's letters, digits, '-', '_' and a '.'
 /// after a letter or digit only (others become '_'), so a shared scene cannot name a path outside the
@@ -114,18 +95,14 @@ class SimWorker {
   std::unique_lock<std::mutex> LockSolver();
   void Run();
   void Publish(double stageMs[], double stepMs);
-  /// `strict` (the first build): a state file that does not fit is an error; on a reset it is a
-  /// logged fallback to the scene's own start.
-  Status Build(const SimScene& scene, std::unique_ptr<sim::Solver>* solver,
-               std::unique_ptr<interaction::PaddleSystem>* paddles, bool strict, double* paddleClock,
-               int64_t* stepsBefore) const;
+  /// Builds the Simulation for `scene` with the worker's solver configuration. `strict` (the first
+  /// build): a state file that does not fit is an error; on a reset it is a logged fallback to the
+  /// scene's own start.
+  Status Build(const SimScene& scene, bool strict, std::unique_ptr<Simulation>* out) const;
 
   sim::SolverConfig m_config;
-  std::unique_ptr<sim::Solver> m_solver;
-  std::unique_ptr<interaction::PaddleSystem> m_paddles;
+  std::unique_ptr<Simulation> m_sim;
   SimScene m_scene;
-  double m_nextPaddleFrame = 0.0;
-  int64_t m_stepsBefore = 0;  // the state file's step count when the solver started from one (-1: unknown)
   std::thread m_thread;
   mutable std::mutex m_mutex;
   std::condition_variable m_wake;

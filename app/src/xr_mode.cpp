@@ -207,13 +207,7 @@ Status OpenWindowAndSession(XrApp& app, XrOutcome* outcome) {
 
 Status StartSimulation(XrApp& app) {
   const Options& options = app.options;
-  sim::SolverConfig solverConfig;
-  solverConfig.device = options.device;
-  solverConfig.threads = options.threads;
-  if (options.threads == 0) {
-    // One core is left to the frame loop (and llvmpipe's rasteriser, on machines without a GPU).
-    solverConfig.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
-  }
+  const sim::SolverConfig solverConfig = InteractiveSolverConfig(options, false);
   if (Status s = ApplyAutoQuality(options, options.quality != 0, app.start.get(), solverConfig, &app.setup); !s) return s;
   // Each controller holds a paddle: the scene's hand-held ones, else the default blade on a handle
   // (sized at the spacing in use).
@@ -244,10 +238,14 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   *outcome = XrOutcome{};
   XrApp app;
   app.options = options;
-  if (Status s = LoadSceneWithOptions(options, &app.scene); !s) return s;
-  app.setup = app.scene.setup;
-  // A bad state file is one line before the headset session starts.
-  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), app.scene.name, &app.setup, &app.start); !s) return s;
+  {
+    // A bad state file is one line before the headset session starts.
+    RunStart start;
+    if (Status s = PrepareStart(options, &start); !s) return s;
+    app.scene = std::move(start.scene);
+    app.setup = start.setup;
+    app.start = start.state;
+  }
   app.offset = XrSceneOffset(app.setup.tank);
   app.mode = options.particleImages ? render::RenderMode::kParticles : render::RenderMode::kWater;
 

@@ -8,7 +8,7 @@
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/solver.h"
-#include "body_stages.h"
+#include "stages/bodies.h"
 #include "stages.h"
 #include "surface_extractor.h"
 
@@ -45,7 +45,7 @@ class Backend {
   virtual int FluidCount() const = 0;
   virtual int BoundaryCount() const = 0;
 
-  // Moving boundaries (body_stages.h). Without InitBodies a step has no body work at all.
+  // Moving boundaries (stages/bodies.h). Without InitBodies a step has no body work at all.
   /// Body-frame particles (w = Psi_b), the body of each, its alpha, and every body's primitives.
   virtual void InitBodies(const std::vector<Vec4>& local, const std::vector<uint32_t>& bodyOf,
                           const std::vector<float>& alpha, const std::vector<ShapePrimitive>& shapes) = 0;
@@ -57,10 +57,14 @@ class Backend {
   virtual void DownloadBodies(std::vector<Vec4>* position, std::vector<Vec4>* velocity) const = 0;
   /// The HPMC stages on this backend's system (surface_impl.h); building from the particles re-grids them.
   virtual SurfaceExtractor* Surface() = 0;
+  /// The CPU backend's density blocks from pairs of cells only, drawn from every particle with the lanes
+  /// that reuse masked: the layout before the fitted boxes and the compacted blocks (cpu/blocks.h,
+  /// docs/design/simd_stages.md). The same bits; tests and sphxr_bench_blocks hold the two together.
+  /// Before the first step. The other backends have no blocks and ignore it.
+  virtual void UsePairDensityBlocks() {}
 };
 
-/// `pairBlocks`: SolverConfig::pairDensityBlocks.
-std::unique_ptr<Backend> MakeCpuBackend(int threads, bool pairBlocks = false);
+std::unique_ptr<Backend> MakeCpuBackend(int threads);
 /// The CUDA backend's orchestration on the host (backend_cpu_reference.cpp): every stage the per-particle
 /// form of stages.h, launched as backend_cuda.cu launches it, on thrust's OpenMP system.
 std::unique_ptr<Backend> MakeCpuReferenceBackend(int threads);

@@ -4,7 +4,7 @@
 #include <thrust/system/omp/vector.h>
 
 #include "backend_impl.h"
-#include "cpu_stages.h"  // before the traits below name its stages
+#include "cpu/stages.h"  // before the traits below name its stages
 
 namespace sphxr::sim {
 namespace {
@@ -17,7 +17,7 @@ struct OmpTraits {
   static constexpr const char* kName = "cpu";
   static constexpr bool kOnDevice = false;  // where the surface mesh lives
   static constexpr int kTraversalRun = 256;  // a descent per run of vertices: few threads, each stepping along the mesh
-  static constexpr bool kSimdStages = true;  // density and forces in SIMD (cpu_stages.h)
+  static constexpr bool kSimdStages = true;  // density and forces in SIMD (cpu/density.h, cpu/forces.h)
   using BlockSet = sim::BlockSet;
   using DensityBlockStart = sim::DensityBlockStart;
   using DensityBlockStage = sim::DensityBlockStage;
@@ -42,10 +42,10 @@ struct OmpTraits {
 
 }  // namespace
 
-std::unique_ptr<Backend> MakeCpuBackend(int threads, bool pairBlocks) {
+std::unique_ptr<Backend> MakeCpuBackend(int threads) {
   // 0 = all cores, also after an earlier solver in this process asked for fewer.
   omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
-  return std::make_unique<BackendImpl<OmpTraits>>(pairBlocks);
+  return std::make_unique<BackendImpl<OmpTraits>>();
 }
 
 }  // namespace sphxr::sim

@@ -2,7 +2,7 @@
 // per particle over the full or compacted lists, the per-particle DensityStage and ForceStage, the
 // per-cell WallPressureStage, a traversal work item per surface vertex) on thrust's OpenMP system. No
 // machine here has a GPU, so this is how every suite exercises the code the CUDA backend runs; the
-// `cpu` backend replaces density, forces and wall pressure by the SIMD forms of cpu_stages.h and is
+// `cpu` backend replaces density, forces and wall pressure by the SIMD forms of cpu/ and is
 // held against this one step by step (tests/sim/backend_agreement_test.cpp). Slow: that is fine.
 #include <omp.h>
 #include <thrust/system/omp/execution_policy.h>

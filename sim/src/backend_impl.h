@@ -22,7 +22,6 @@
 #include "backend.h"
 #include "backend_guard.h"
 #include "dfsph_solver.h"
-#include "stages/density_diffusion.h"
 #include "surface_impl.h"
 
 namespace sphxr::sim {
@@ -37,10 +36,6 @@ class BackendImpl final : public Backend {
   using Vector = typename Traits::template Vector<T>;
 
  public:
-  /// `pairBlocks`: the CPU's density blocks from pairs of cells only (the layout before the fitted boxes,
-  /// cpu_stages.h BlockBoxOf); the same results bit for bit, for benchmarks. CUDA ignores it.
-  explicit BackendImpl(bool pairBlocks = false) : m_pairBlocks(pairBlocks) {}
-
   const char* Name() const override { return Traits::kName; }
 
   Status Init(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
@@ -212,18 +207,18 @@ class BackendImpl final : public Backend {
     if (physics.wallDensity && !m_wallCells.empty()) {
       const WallPressureStage wallPressure{View(), fv, physics, Raw(m_wallCells), Raw(m_boundaryPressureTerm)};
       const int wallCells = static_cast<int>(m_wallCells.size());
-      if constexpr (Traits::kSimdStages) {  // the CPU: kLanes wall particles of a cell at once (cpu_stages.h)
+      if constexpr (Traits::kSimdStages) {  // the CPU: kLanes wall particles of a cell at once (cpu/walls.h)
         loop(wallCells, 8, typename Traits::WallPressureBlockStage{wallPressure});
       } else {
         loop(wallCells, 8, wallPressure);
       }
     }
-    // 4. density and pressure. The CPU runs it in blocks of cells (cpu_stages.h), with reuse drawn from
+    // 4. density and pressure. The CPU runs it in blocks of cells (cpu/density.h), with reuse drawn from
     // the compacted list; CUDA a thread per particle (over the compacted list with reuse).
     const DensityStage density{View(), fv, Neighbours(physics), physics};
     if constexpr (Traits::kSimdStages) {
       // The blocks are drawn from every particle, or with reuse from the compacted list, so that the
-      // particles that reuse take no lane (cpu_stages.h BlockSet). The pairs-only layout (benchmarks)
+      // particles that reuse take no lane (cpu/blocks.h BlockSet). The pairs-only layout (benchmarks)
       // keeps the layout before both: every particle, the lanes that reuse masked.
       typename Traits::BlockSet set{Raw(m_keys), n};
       const bool compacted = densityCount < n && !m_pairBlocks;
@@ -271,7 +266,7 @@ class BackendImpl final : public Backend {
     if (bodies && m_bodyPressureTerm.size() != static_cast<size_t>(n)) m_bodyPressureTerm.resize(n);
     const ForceStage forces{View(), fv, Neighbours(physics), physics, bodies ? Raw(m_bodyPressureTerm) : nullptr};
     if constexpr (Traits::kSimdStages) {
-      overComputing(32, typename Traits::ForceListStage{forces});  // SIMD over each neighbour list (cpu_stages.h)
+      overComputing(32, typename Traits::ForceListStage{forces});  // SIMD over each neighbour list (cpu/forces.h)
     } else {
       overComputing(32, forces);
     }
@@ -378,6 +373,8 @@ class BackendImpl final : public Backend {
 
   int FluidCount() const override { return static_cast<int>(m_fluid.position.size()); }
   int BoundaryCount() const override { return static_cast<int>(m_boundary.size()); }
+  void UsePairDensityBlocks() override { m_pairBlocks = true; }
+
   SurfaceExtractor* Surface() override { return &m_surface; }
 
   void InitBodies(const std::vector<Vec4>& local, const std::vector<uint32_t>& bodyOf, const std::vector<float>& alpha,
@@ -578,16 +575,16 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_computeList;  // reuse: indices of the particles that compute this step
   Vector<uint32_t> m_cellCount;    // reuse: particles (fluid and wall) in each cell; scratch of the 27-cell sums
   Vector<uint32_t> m_cellCrowd;    // reuse: particles in the 27 cells around each cell
-  Vector<uint32_t> m_blockStart;   // CPU density blocks: first entry of each (cpu_stages.h)
+  Vector<uint32_t> m_blockStart;   // CPU density blocks: first entry of each (cpu/blocks.h)
   Vector<uint32_t> m_computeKeys;  // CPU density blocks with reuse: the compacted list's Morton keys
   Vector<uint32_t> m_computeRank;  // and the computing particles before each particle (n + 1)
-  bool m_pairBlocks = false;       // CPU density blocks from pairs of cells only (the constructor's)
+  bool m_pairBlocks = false;       // CPU density blocks from pairs of cells only (UsePairDensityBlocks)
   Vector<Vec4> m_boundary;
   Vector<float> m_boundaryAlpha;
   Vector<float> m_boundaryPressureTerm;  // per boundary particle, walls with their own density only
   Vector<float> m_boundaryInvReference;
   Vector<uint32_t> m_wallCells;  // linear indices of the cells holding boundary particles
-  // Moving boundaries (body_stages.h): canonical body-frame particles, their sorted world copies.
+  // Moving boundaries (stages/bodies.h): canonical body-frame particles, their sorted world copies.
   Vector<Vec4> m_bodyLocal;        // body frame, w = Psi_b
   Vector<uint32_t> m_bodyOfLocal;  // body index of each canonical particle
   Vector<float> m_bodyAlpha;       // alpha of each canonical particle

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "sphxr/app/scene_file.h"
+#include "sphxr/app/simulation.h"
 #include "sphxr/interaction/paddle.h"
 #include "support.h"
 
@@ -82,27 +83,22 @@ void PrintTo(const Pair& p, std::ostream* os) { *os << p.name; }
 
 class BackendAgreement : public ::testing::TestWithParam<std::tuple<Pair, Case>> {};
 
+// The run as every mode builds it (app::Simulation: the scene's paddles, the solver, the paddle clock).
 struct Rig {
-  std::unique_ptr<Solver> solver;
-  std::unique_ptr<interaction::PaddleSystem> paddles;
+  std::unique_ptr<app::Simulation> run;
+  Solver* solver = nullptr;
 };
 
 Rig Make(const app::SceneFile& file, const SceneSetup& setup, Device device) {
   Rig r;
-  SceneSetup scene = setup;
-  if (!file.paddles.empty()) {
-    Status s = interaction::PaddleSystem::Create(file.paddles, scene, &r.paddles);
-    EXPECT_TRUE(s.ok()) << s.message();
-    if (!s) return r;
-    r.paddles->AddBodies(&scene);
-  }
-  SolverConfig config = test::TestConfig();
-  config.device = device;
-  r.solver = test::CreateOrFail(scene, config);
-  if (r.solver && r.paddles) {
-    Status s = r.paddles->Attach(r.solver.get());
-    EXPECT_TRUE(s.ok()) << s.message();
-  }
+  app::SimScene scene = app::SimSceneFromFile(file);
+  scene.setup = setup;
+  app::SimulationConfig config;
+  config.solver = test::TestConfig();
+  config.solver.device = device;
+  const Status s = app::Simulation::Create(scene, config, &r.run);
+  EXPECT_TRUE(s.ok()) << s.message();
+  if (r.run) r.solver = &r.run->Solver();
   return r;
 }
 
@@ -143,8 +139,6 @@ TEST_P(BackendAgreement, OneStepFromTheSameStateAgreesToRounding) {
   const double h = 0.5 * p.spacing * p.supportFactor;
   const double n = 2.0 * (4.0 / 3.0) * M_PI * std::pow(p.supportFactor, 3.0);
   const double nu = n * kUnitRoundoff;
-  const double frameDt = file.paddles.empty() ? 0.0 : 1.0 / file.paddleFrameRate;
-  double nextFrame = 0.0;
 
   Errors worst;
   float leastActive = 1.0f;  // under reuse: the compacted lists must have been exercised
@@ -153,14 +147,10 @@ TEST_P(BackendAgreement, OneStepFromTheSameStateAgreesToRounding) {
   for (int step = 1; step <= c.steps; ++step) {
     tested.solver->Download(&before);
     ASSERT_TRUE(reference.solver->Upload(before).ok());
-    if (tested.paddles && tested.solver->Time() >= nextFrame - 1e-9) {
-      nextFrame += frameDt;
-      ASSERT_TRUE(tested.paddles->BeginFrame(nextFrame).ok());
-      ASSERT_TRUE(reference.paddles->BeginFrame(nextFrame).ok());
-    }
-    ASSERT_TRUE(test::StepN(*tested.solver, 1));
-    ASSERT_TRUE(test::StepN(*reference.solver, 1));
-    if (tested.paddles) tested.paddles->AfterStep(), reference.paddles->AfterStep();
+    // (Both paddle clocks give the same frames: the same start and the same dt on both.)
+    const Status testedStep = tested.run->Step(), referenceStep = reference.run->Step();
+    ASSERT_TRUE(testedStep.ok()) << "step " << step << ": " << testedStep.message();
+    ASSERT_TRUE(referenceStep.ok()) << "step " << step << ": " << referenceStep.message();
     ASSERT_EQ(tested.solver->GetTotals().dtClampedSteps, 0) << "the stability limit fell below the fixed step at step " << step;
     ASSERT_EQ(tested.solver->LastStep().dt, reference.solver->LastStep().dt) << "step " << step;
     // Under reuse the same particles compute: the classification reads the uploaded state only.

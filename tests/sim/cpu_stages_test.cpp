@@ -17,7 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "cpu_stages.h"
+#include "cpu/stages.h"
+#include "stages/integrate.h"  // StepReduction
 #include "morton.h"
 
 namespace sphxr::sim {

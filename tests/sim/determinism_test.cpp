@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "backend.h"  // sim/src: UsePairDensityBlocks
 #include "support.h"
 
 namespace sphxr::sim {
@@ -28,10 +29,10 @@ struct RunResult {
 RunResult RunScene(const SceneSetup& scene, int threads, int steps, bool pairDensityBlocks = false) {
   SolverConfig config = test::TestConfig();
   config.threads = threads;
-  config.pairDensityBlocks = pairDensityBlocks;
   RunResult run;
   auto solver = test::CreateOrFail(scene, config);
   if (!solver) return run;
+  if (pairDensityBlocks) solver->BackendForTests()->UsePairDensityBlocks();
   EXPECT_EQ(omp_get_max_threads(), threads) << "SolverConfig.threads did not reach the OpenMP runtime";
   for (int s = 0; s < steps; ++s) {
     const Status st = solver->Step();
@@ -113,7 +114,7 @@ TEST(DeterminismTest, OneAndTwoThreadsGiveIdenticalResultsWithReuse) {
 }
 
 // The CPU's density blocks fitted to the particles (boxes of up to 4 x 4 x 4 cells in the spreading front,
-// crowded pairs cut per cell) change no bit against the pairs-only layout (SolverConfig::pairDensityBlocks,
+// crowded pairs cut per cell) change no bit against the pairs-only layout (Backend::UsePairDensityBlocks,
 // which sphxr_bench_blocks times against them), with reuse off and on. tests/sim/cpu_stages_test.cpp
 // checks the same for one density pass per layout on made-up particles; this runs the whole solver.
 TEST(DeterminismTest, DensityBlocksFittedToTheParticlesGiveThePairsBits) {

@@ -19,7 +19,7 @@
 // gradient instead of being diffused toward uniform density (which would lift the bottom layers'
 // pressure off rho0 g depth). We use its first order, rho0 g.x_ij / c0^2: within 1e-6 relative for
 // pairs within a support (rho0 g |x_ij| / B < 2e-3 in every scene here).
-#include "../stages.h"
+#include "stages/views.h"
 
 namespace sphxr::sim {
 

@@ -32,11 +32,6 @@ struct SolverConfig {
   Device device = Device::kAuto;
   int threads = 0;        // CPU backends (cpu, cpu-reference): 0 = all cores
   bool validate = false;  // check every stage for non-finite values (slow)
-  /// CPU backend: density blocks from pairs of cells only, not the boxes fitted to the particles, and
-  /// with reuse drawn from every particle with the lanes that reuse masked, not from the compacted list
-  /// (docs/design/simd_stages.md): the layout before both. The
-  /// results are the same bit for bit; sphxr_bench_blocks steps both layouts in lock-step to time them.
-  bool pairDensityBlocks = false;
 };
 
 /// Stages of one step, each timed.
@@ -220,7 +215,7 @@ class Solver {
   /// which must hold that many vertices (device memory on the CUDA backend, host memory on the CPU).
   Status BuildSurface(const SurfaceParams& params, SurfaceStats* stats);
   Status WriteSurface(const SurfaceTarget& target, SurfaceStats* stats);
-  /// Test access to the backend (tests include the private headers on purpose).
+  /// Access to the backend for tests and benchmarks (they include the private headers on purpose).
   Backend* BackendForTests() { return m_backend.get(); }
 
  private:

@@ -15,7 +15,8 @@
 #include <cstdint>
 
 #include "sphxr/sim/rigid.h"
-#include "stages.h"
+#include "stages/grid.h"
+#include "stages/views.h"
 
 namespace sphxr::sim {
 

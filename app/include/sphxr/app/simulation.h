@@ -1,0 +1,119 @@
+#pragma once
+// One run of a scene, under every mode: the headless runner, the desktop window's and the headset's
+// simulation thread (SimWorker), the benchmarks and the tests build it the same way and step it the
+// same way. A Simulation owns the solver and the paddles; outputs (the stats CSV, exports, pictures,
+// checkpoints, progress, probes) are sinks attached to it, called after every step.
+//
+//   SimScene ──Create──> paddles sampled and added as bodies, Solver::Create, Restore (a state file),
+//                        PaddleSystem::Attach, the paddles' saved state and clock
+//   Step(hands) ───────> PaddleSystem::Step (a frame when due, the solver step, the paddles' loads)
+//                        or Solver::Step; then every sink's OnStep
+//   Finish() ──────────> every sink's Finish
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sphxr/app/snapshot.h"
+#include "sphxr/common/status.h"
+#include "sphxr/interaction/hand.h"
+#include "sphxr/interaction/paddle.h"
+#include "sphxr/sim/solver.h"
+
+namespace sphxr::app {
+
+struct SceneFile;
+struct StateFile;
+
+/// What a run is built from: the scene without the paddles' bodies (Create samples the paddles at the
+/// scene's spacing and adds them), the paddles, and the surface to extract.
+struct SimScene {
+  std::string name;  // the scene's name (saved in state files)
+  sim::SceneSetup setup;
+  std::vector<interaction::PaddleDesc> paddles;
+  double paddleFrameRate = 90.0;  // Hz (simulated): the paddles get new targets this often
+  SurfaceRequest surface;
+  /// --load-state: the fluid and clock to start from instead of the scene's (every reset of the window
+  /// returns there); null: the scene's own start.
+  std::shared_ptr<const StateFile> start;
+};
+
+/// The scene file's scene, with a default hand-held paddle (interaction::BladeOnHandle sized to the
+/// tank) for each hand in `hands` (0 left, 1 right) that no paddle of the scene is held by.
+SimScene SimSceneFromFile(const SceneFile& scene, std::initializer_list<int> hands = {});
+/// The default paddle for a hand: a blade on a handle, at most 10 cm wide, narrower in a small tank.
+interaction::PaddleDesc DefaultHandPaddle(const sim::SceneSetup& setup, int hand);
+
+class Simulation;
+
+/// An output of a run, called by the Simulation: OnStart once before the first step (after Create and
+/// any settle), OnStep after every step, Finish at the end (`interrupted`: a signal stopped the run).
+/// A status that is not ok stops the run with it.
+class SimulationSink {
+ public:
+  virtual ~SimulationSink() = default;
+  virtual Status OnStart(Simulation&) { return Status::Ok(); }
+  virtual Status OnStep(Simulation& simulation, const sim::StepInfo& info) = 0;
+  virtual Status Finish(Simulation&, bool /*interrupted*/) { return Status::Ok(); }
+};
+
+struct SimulationConfig {
+  sim::SolverConfig solver;
+  /// A state file that does not fit the scene is an error (`--load-state ...`); false (a reset of the
+  /// window after the panel changed the spacing): a logged fallback to the scene's own start.
+  bool strictStart = true;
+  /// Put before the paddles' and the solver's errors (the scene's path and ": " in the headless runner).
+  std::string errorPrefix;
+};
+
+class Simulation {
+ public:
+  static Status Create(const SimScene& scene, const SimulationConfig& config, std::unique_ptr<Simulation>* out);
+
+  /// One step: the paddles (a frame with `hands` when one is due; index 0 left, 1 right; poses in the
+  /// simulation's world frame) or the solver alone, then every sink. Errors: the solver's (--validate's
+  /// named with the whole run's step after a state file), and water that became non-finite.
+  Status Step(const std::vector<interaction::HandInput>& hands = {});
+  /// The sinks' OnStart (call once, before the first Step) and Finish.
+  Status Start();
+  Status Finish(bool interrupted);
+  /// Sinks are called in the order they were added; the Simulation does not own them.
+  void AddSink(SimulationSink* sink) { m_sinks.push_back(sink); }
+
+  /// The state file of this run now (state_file.h): fluid, clock, paddles and their clock, the whole
+  /// run's step count.
+  Status WriteState(const std::string& path, const std::string& sceneName) const;
+
+  sim::Solver& Solver() { return *m_solver; }
+  const sim::Solver& Solver() const { return *m_solver; }
+  /// Null without paddles.
+  interaction::PaddleSystem* Paddles() { return m_paddles.get(); }
+  const interaction::PaddleSystem* Paddles() const { return m_paddles.get(); }
+  const SimScene& Scene() const { return m_scene; }
+  /// The scene as the solver was built from it (with the paddles' bodies).
+  const sim::SceneSetup& Setup() const { return m_setup; }
+  /// Restored from the scene's state file.
+  bool Restored() const { return m_restored; }
+  /// The state file's step count when restored from one (-1: unknown, and saved as unknown again), else 0.
+  int64_t StepsBefore() const { return m_stepsBefore; }
+  /// The whole run's step number (the CSV's, the exports' file names): StepsBefore (0 when unknown)
+  /// plus this solver's steps.
+  int64_t WholeStep() const;
+  /// The paddles' next frame (the state file's paddle clock); the start time without paddles.
+  double PaddleClock() const;
+
+ private:
+  Simulation() = default;
+
+  SimScene m_scene;
+  sim::SceneSetup m_setup;
+  std::unique_ptr<sim::Solver> m_solver;
+  std::unique_ptr<interaction::PaddleSystem> m_paddles;  // bound to m_solver (destroyed before it)
+  bool m_restored = false;
+  int64_t m_stepsBefore = 0;
+  double m_startTime = 0.0;
+  std::vector<SimulationSink*> m_sinks;
+};
+
+}  // namespace sphxr::app
