@@ -1,5 +1,5 @@
 // The clamp behind the walls: where a fluid particle is put back (the tank's faces and the obstacles),
-// that each clamp is counted at its site, and that the walls hold a jet without it.
+// and that each clamp is counted at its site.
 #include <gtest/gtest.h>
 
 #include "support.h"
