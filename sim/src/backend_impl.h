@@ -243,11 +243,6 @@ class BackendImpl final : public Backend {
     } else {
       loop(n, 32, density);
     }
-    // 4b. delta_sph: the density's rate of change (stages/density_diffusion.h), of the step's start
-    if (physics.continuityDensity) {
-      m_densityRate.resize(n);
-      loop(n, 32, DensityRateStage{View(), fv, Neighbours(physics), physics, Raw(m_densityRate)});
-    }
     if (Status s = lap(Stage::kDensity); !s) return s;
 
     // DFSPH (dfsph_solver.h): the factor and kernel-gradient cache, the divergence-free solve, then the
@@ -296,7 +291,15 @@ class BackendImpl final : public Backend {
 
     // 6. integrate (DFSPH drifted in its Finish), then the statistics the next time step needs
     if (!physics.dfsph) thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
-    if (physics.continuityDensity) thrust::for_each_n(policy, first, n, DensityIntegrateStage{fv, Raw(m_densityRate), dt});
+    // 6a. delta_sph (stages/density_diffusion.h): rho += dt d rho/dt with the velocities that drifted the
+    // positions (symplectic Euler's v^{n+1}, at x^{n+1}). With the step's start velocities the density
+    // lagged the drift by a step and the sound waves grew: still water rang between 0 and 4x its
+    // hydrostatic pressure.
+    if (physics.continuityDensity) {
+      m_densityRate.resize(n);
+      loop(n, 32, DensityRateStage{View(), fv, Neighbours(physics), physics, Raw(m_densityRate)});
+      thrust::for_each_n(policy, first, n, DensityIntegrateStage{fv, Raw(m_densityRate), dt});
+    }
     // 6b. push fluid out of the bodies at their end-of-step pose
     if (bodies) {
       if (Status s = lap(Stage::kIntegrate); !s) return s;

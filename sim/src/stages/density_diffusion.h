@@ -26,8 +26,11 @@ namespace sphxr::sim {
 /// delta of the diffusion term (Antuono et al. 2010: 0.1 for the usual resolutions).
 inline constexpr float kDensityDiffusionDelta = 0.1f;
 
-/// The density's rate of change of particle i into rate[i]. One work item per particle, over the
-/// density stage's neighbour list (the cell scan when it overflowed); both backends.
+/// The density's rate of change of particle i into rate[i], after the integrator's kick and drift (the
+/// positions and velocities of the step's end, so the density moves with the drift). One work item per
+/// particle, over the density stage's neighbour list (the cell scan when it overflowed: a pair that came
+/// within the support during the drift is missed, at the kernel's edge where W and its gradient are
+/// near zero); both backends.
 struct DensityRateStage {
   GridView grid;
   FluidView fluid;
@@ -82,7 +85,7 @@ struct DensityRateStage {
   }
 };
 
-/// rho_i += dt rate_i, after the integrator's drift (the rate is of the step's start, as the forces are).
+/// rho_i += dt rate_i (DensityRateStage, after the drift).
 struct DensityIntegrateStage {
   FluidView fluid;
   const float* rate;

@@ -45,7 +45,7 @@ bool ParseSolverMethod(const std::string& text, SolverMethod* out);
 /// every step (Becker & Teschner 2007). kDeltaSph: density is integrated state, the continuity equation
 /// with the delta-SPH diffusion term (Molteni & Colagrossi 2009, Antuono et al. 2010) and the hydrostatic
 /// correction of Fourtakas et al. (2019), meant to give a pressure field without the summation's
-/// flicker; not yet better in still water (docs/dev/physics.md; sim/src/stages/density_diffusion.h). DFSPH always sums; reuse needs the summation.
+/// flicker (docs/dev/physics.md; sim/src/stages/density_diffusion.h). DFSPH always sums; reuse needs the summation.
 enum class DensityModel { kSummation, kDeltaSph };
 const char* DensityModelName(DensityModel model);
 /// Parses "summation" | "delta_sph".
