@@ -291,10 +291,7 @@ class BackendImpl final : public Backend {
 
     // 6. integrate (DFSPH drifted in its Finish), then the statistics the next time step needs
     if (!physics.dfsph) thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
-    // 6a. delta_sph (stages/density_diffusion.h): rho += dt d rho/dt with the velocities that drifted the
-    // positions (symplectic Euler's v^{n+1}, at x^{n+1}). With the step's start velocities the density
-    // lagged the drift by a step and the sound waves grew: still water rang between 0 and 4x its
-    // hydrostatic pressure.
+    // 6a. delta_sph: rho += dt d rho/dt at the drifted state (stages/density_diffusion.h says why)
     if (physics.continuityDensity) {
       m_densityRate.resize(n);
       loop(n, 32, DensityRateStage{View(), fv, Neighbours(physics), physics, Raw(m_densityRate)});

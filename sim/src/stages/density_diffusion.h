@@ -27,7 +27,9 @@ namespace sphxr::sim {
 inline constexpr float kDensityDiffusionDelta = 0.1f;
 
 /// The density's rate of change of particle i into rate[i], after the integrator's kick and drift (the
-/// positions and velocities of the step's end, so the density moves with the drift). One work item per
+/// positions and velocities of the step's end, so the density moves with the drift: with the step's
+/// start velocities it lagged the drift by a step, the sound waves grew, and still water rang between
+/// 0 and 4x its hydrostatic pressure). One work item per
 /// particle, over the density stage's neighbour list (the cell scan when it overflowed: a pair that came
 /// within the support during the drift is missed, at the kernel's edge where W and its gradient are
 /// near zero); both backends.
