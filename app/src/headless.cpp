@@ -116,8 +116,10 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
                 target.steps > 0 ? Format("%lld steps", static_cast<long long>(target.steps)).c_str()
                                 : Format("%.4g s", target.time).c_str());
   }
-  std::printf("  particles lost  %lld (clamped back into the tank: %lld times)\n", static_cast<long long>(summary->lost),
-              static_cast<long long>(summary->clampedEvents));
+  std::printf("  particles lost  %lld (clamped back into the tank: %lld times, %.3g per 1,000 particle-steps%s%s)\n",
+              static_cast<long long>(summary->lost), static_cast<long long>(summary->clampedEvents),
+              summary->clampsPerThousand, summary->clampedMost.empty() ? "" : ", most at the ",
+              summary->clampedMost.c_str());
   if (scene.damBreak) {
     std::printf("  dam break       surge front Z = %.3f, column height H = %.3f (Martin & Moyce units)\n",
                 summary->surgeFront, summary->columnHeight);
@@ -261,6 +263,13 @@ void Summarise(const SceneFile& scene, const sim::Solver& solver, const SummaryS
   summary->meanDensityError = solver.LastStep().meanDensityError;
   summary->maxDensityError = solver.LastStep().maxDensityError;
   summary->clampedEvents = totals.clampedEvents;
+  if (totals.particleSteps > 0) {
+    summary->clampsPerThousand = 1e3 * static_cast<double>(totals.clampedEvents) / static_cast<double>(totals.particleSteps);
+  }
+  if (totals.clampedEvents > 0) {
+    const auto most = std::max_element(totals.clampedAt.begin(), totals.clampedAt.end());
+    summary->clampedMost = sim::ClampSiteName(static_cast<int>(most - totals.clampedAt.begin()));
+  }
   summary->pushedOut = totals.pushedOutEvents;
   if (summary->paddles > 0 && totals.steps > 0) {
     summary->paddleMeanForce = measures.ForceSum() / static_cast<double>(totals.steps * summary->paddles);

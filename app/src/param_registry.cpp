@@ -109,6 +109,11 @@ void Table(const char* group, std::string* out) {
                      "([../design/dfsph.md](../design/dfsph.md)) |\n",
                      sim::SolverMethodName(sim::SolverMethod::kWcsph), sim::SolverMethodName(sim::SolverMethod::kWcsph),
                      sim::SolverMethodName(sim::SolverMethod::kDfsph));
+      *out += "| `density` | | `\"summation\"` | `\"summation\"`, `\"delta_sph\"` | wcsph: how a particle's density is "
+              "found: summed over its neighbours every step (Becker & Teschner 2007), or integrated by the continuity "
+              "equation with delta-SPH density diffusion (Molteni & Colagrossi 2009, Antuono et al. 2010; Fourtakas et "
+              "al. 2019's hydrostatic correction); reuse needs `\"summation\"` and is switched off with one warning "
+              "otherwise; dfsph ignores it ([../dev/physics.md](../dev/physics.md)) |\n";
     }
   }
 }

@@ -72,6 +72,11 @@ Status Reader::Solver(const json& root) {
       if (!sim::ParseSolverMethod(v, &s.method)) return Error("solver.method", "must be \"wcsph\" or \"dfsph\"");
       continue;
     }
+    if (it.key() == "density") {  // how WCSPH finds the density, by name (docs/dev/physics.md)
+      const std::string v = it.value().is_string() ? it.value().get<std::string>() : "";
+      if (!sim::ParseDensityModel(v, &s.density)) return Error("solver.density", "must be \"summation\" or \"delta_sph\"");
+      continue;
+    }
     const sim::ParamInfo* info = sim::FindSolverParam(it.key());
     if (!info) {
       Unknown("solver." + Shown(it.key()));
@@ -250,6 +255,12 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
   if (key == "method" || key == "solver.method") {
     if (!sim::ParseSolverMethod(value, &setup->method)) {
       return Status::Error("--set " + key + "=" + value + ": must be wcsph or dfsph");
+    }
+    return Status::Ok();
+  }
+  if (key == "density" || key == "solver.density") {
+    if (!sim::ParseDensityModel(value, &setup->density)) {
+      return Status::Error("--set " + key + "=" + value + ": must be summation or delta_sph");
     }
     return Status::Ok();
   }

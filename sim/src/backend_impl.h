@@ -274,6 +274,12 @@ class BackendImpl final : public Backend {
     // step needs
     if (!physics.dfsph) thrust::for_each_n(policy, first, n, IntegrateStage{fv, physics, dt});
     if (physics.dfsph && probes) thrust::for_each_n(policy, first, n, DriftStage{fv, physics, dt});
+    // 6a. delta_sph: rho += dt d rho/dt at the drifted state (stages/density_diffusion.h says why)
+    if (physics.continuityDensity) {
+      m_densityRate.resize(n);
+      loop(n, 32, DensityRateStage{View(), fv, Neighbours(physics), physics, Raw(m_densityRate)});
+      thrust::for_each_n(policy, first, n, DensityIntegrateStage{fv, Raw(m_densityRate), dt});
+    }
     // 6b. push fluid out of the bodies at their end-of-step pose
     if (bodies) {
       if (Status s = lap(Stage::kIntegrate); !s) return s;
@@ -283,7 +289,7 @@ class BackendImpl final : public Backend {
       if (Status s = lap(Stage::kBodies); !s) return s;
     }
     const StepReduction solves = *out;
-    *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics.invRestDensity},
+    *out = thrust::transform_reduce(policy, first, first + n, StepReductionOp{fv, physics},
                                     StepReduction{}, StepReductionCombine{});
     out->computed = computing;
     out->densityIterations = solves.densityIterations;
@@ -607,6 +613,7 @@ class BackendImpl final : public Backend {
   Vector<Vec4> m_probePoints;        // pressure sensors (stages/probes.h); all three empty: no probes
   Vector<ProbeLine> m_probeLines;    // level gauges
   Vector<float> m_probeOut;          // two floats per probe, the last evaluation
+  Vector<float> m_densityRate;       // per fluid particle, solver.density delta_sph (DensityRateStage)
   DfsphSolver<Traits> m_dfsph;       // DFSPH's arrays (sized at its first step)
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the

@@ -62,6 +62,17 @@ bool ParseSolverMethod(const std::string& text, SolverMethod* out) {
   return true;
 }
 
+const char* DensityModelName(DensityModel model) {
+  return model == DensityModel::kDeltaSph ? "delta_sph" : "summation";
+}
+
+bool ParseDensityModel(const std::string& text, DensityModel* out) {
+  if (text == "summation") *out = DensityModel::kSummation;
+  else if (text == "delta_sph") *out = DensityModel::kDeltaSph;
+  else return false;
+  return true;
+}
+
 const ParamInfo* FindSolverParam(const std::string& key) {
   for (const ParamInfo& p : kParams) {
     if (key == p.key) return &p;

@@ -159,6 +159,11 @@ Status ValidateScene(const SceneSetup& scene) {
       }
     }
   }
+  if (scene.obstacles.size() > static_cast<size_t>(kMaxObstacles)) {
+    return Status::Error(Format("obstacles: %zu boxes given, at most %d are supported (each is checked for fluid "
+                                "inside it every step): merge touching boxes",
+                                scene.obstacles.size(), kMaxObstacles));
+  }
   for (size_t i = 0; i < scene.obstacles.size(); ++i) {
     const std::string key = Format("obstacles[%zu]", i);
     if (Status s = ValidateBox(scene.obstacles[i], key); !s) return s;
@@ -266,7 +271,14 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
                    "errors above 1%% (WCSPH wants 10x); solver.stiffness >= %.3g Pa would give that",
                    soundSpeed, soundSpeed / vRef, vRef, needB);
   }
-  if (wcsph) {
+  const bool deltaSph = scene.density == DensityModel::kDeltaSph;
+  if (!wcsph && deltaSph) {
+    SPHXR_LOG_WARN("solver.density delta_sph is a WCSPH model; DFSPH sums the density (the setting is ignored)");
+  }
+  if (wcsph && deltaSph && scene.reuse.enabled) {
+    SPHXR_LOG_WARN("reuse is off under solver.density delta_sph: an integrated density cannot skip steps (use "
+                   "\"summation\" for reuse)");
+  } else if (wcsph) {
     WarnAboutReuse(scene.reuse);
   } else if (scene.reuse.enabled) {
     SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method dfsph (docs/design/dfsph.md)");

@@ -32,6 +32,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
     }
   } restoreReuse{this, reuse};
   SettleReport r;
+  m_leakWarned = true;  // the settle's steps are not the run's: it clamps what it relaxes
   double alpha = 0.1;
   int downhill = 0;
   while (m_last.time < seconds) {
@@ -65,6 +66,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
   for (BodyMotion& b : m_bodies) HoldBody(&b, b.pose, 0.0);  // where it is, at rest, on the restarted clock
   m_last = StepInfo{};
   m_totals = Totals{};
+  m_leakWarned = false;
   m_maxAccel = 0.0f;
   if (reuse.enabled) {
     if (Status s = SetReuse(reuse); !s) return s;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "backend.h"
 #include "sampling.h"
@@ -34,7 +35,10 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.bodyGradScale = WallGradientCorrection(ph.kernel, p.spacing, 1) / WallDensityCorrection(ph.kernel, p.spacing, 1);
   ph.bodyClearance = 0.25f * p.spacing;
   const ReuseParams& r = scene.reuse;
-  ph.reuseEnabled = r.enabled && !ph.dfsph;  // reuse is WCSPH's (docs/design/dfsph.md)
+  ph.continuityDensity = scene.density == DensityModel::kDeltaSph && !ph.dfsph;
+  // Reuse is WCSPH's (docs/design/dfsph.md), and holds a summation density: an integrated density
+  // cannot skip steps.
+  ph.reuseEnabled = r.enabled && !ph.dfsph && !ph.continuityDensity;
   ph.reuseDelta1 = r.delta1;
   ph.reuseDelta2 = r.delta2;
   ph.reuseThreshold = r.threshold;
@@ -55,6 +59,15 @@ Physics MakePhysics(const SceneSetup& scene) {
   const float inset = 0.25f * p.spacing;
   ph.domainMin = Vec3{scene.tank.min.x + inset, scene.tank.min.y + inset, scene.tank.min.z + inset};
   ph.domainMax = Vec3{scene.tank.max.x - inset, scene.tank.max.y - inset, scene.tank.max.z - inset};
+  // Obstacles are sampled like the tank (a sheet half a spacing inside each face, fluid seeded half a
+  // spacing outside): the same quarter-spacing inset, outward.
+  ph.obstacleCount = static_cast<int>(std::min<size_t>(scene.obstacles.size(), kMaxObstacles));
+  for (int k = 0; k < kMaxObstacles; ++k) {
+    const bool used = k < ph.obstacleCount;
+    const Aabb o = used ? scene.obstacles[k] : Aabb{};
+    ph.obstacleMin[k] = used ? Vec3{o.min.x - inset, o.min.y - inset, o.min.z - inset} : Vec3{};
+    ph.obstacleMax[k] = used ? Vec3{o.max.x + inset, o.max.y + inset, o.max.z + inset} : Vec3{};
+  }
   ph.volume = ph.mass / p.restDensity;
   ph.densityTolerance = 0.01f * p.densityTolerance;  // % to a fraction
   ph.divergenceTolerance = 0.01f * p.divergenceTolerance;
@@ -65,6 +78,29 @@ Physics MakePhysics(const SceneSetup& scene) {
 }
 
 }  // namespace
+
+std::string ClampSiteName(int site) {
+  static const char* const kFaces[kTankFaces] = {"x- wall", "x+ wall", "floor", "top", "z- wall", "z+ wall"};
+  SPHXR_ASSERT(site >= 0 && site < kClampSites);
+  return site < kTankFaces ? kFaces[site] : Format("obstacles[%d]", site - kTankFaces);
+}
+
+void Solver::WarnIfWallsLeak() {
+  // Judged once the run has taken 100,000 particle-steps (a few steps of a large scene, some tens of a
+  // small one), then at most once per run.
+  if (m_leakWarned || m_totals.particleSteps < 100000) return;
+  const double rate = static_cast<double>(m_totals.clampedEvents) / static_cast<double>(m_totals.particleSteps);
+  if (rate <= kLeakingClampRate) return;
+  m_leakWarned = true;
+  int worst = 0;
+  for (int k = 1; k < kClampSites; ++k) {
+    if (m_totals.clampedAt[k] > m_totals.clampedAt[worst]) worst = k;
+  }
+  const double share = static_cast<double>(m_totals.clampedAt[worst]) / static_cast<double>(m_totals.clampedEvents);
+  SPHXR_LOG_WARN("the walls leak: %.3g clamps per 1,000 particle-steps by t = %.3g s (a safety net clamps under "
+                 "%.2g), %.0f %% of them at the %s (logged once; docs/design/walls.md)",
+                 1000.0 * rate, m_last.time, 1000.0 * kLeakingClampRate, 100.0 * share, ClampSiteName(worst).c_str());
+}
 
 const char* DeviceName(Device device) {
   switch (device) {
@@ -159,11 +195,23 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
       SceneSetup one = scene;
       one.fluid = {block};
       const int64_t n = SampleFluid(one, nullptr);
+      // delta_sph integrates the density from here: a hydrostatic block starts at the Tait density of
+      // each particle's depth below the block's top layer (plus half a spacing), as its lattice is
+      // compressed; everything else at rho0.
+      const bool hydrostatic = block.hydrostatic && scene.density == DensityModel::kDeltaSph;
+      float top = -std::numeric_limits<float>::infinity();
+      for (int64_t k = 0; k < n; ++k) top = std::max(top, positions[i + k].y);
+      top += 0.5f * scene.params.spacing;
       for (int64_t k = 0; k < n; ++k, ++i) {
         fluid.position[i] = positions[i];
         fluid.velocity[i] = MakeVec4(block.velocity);
         fluid.id[i] = static_cast<uint32_t>(i);
         fluid.density[i] = scene.params.restDensity;
+        if (hydrostatic) {
+          const SolverParams& p = scene.params;
+          const float head = p.restDensity * Length(scene.gravity) * (top - positions[i].y) / p.stiffness;
+          fluid.density[i] = p.restDensity * std::pow(1.0f + head, 1.0f / p.exponent);
+        }
         fluid.idle[i] = -1;  // every particle computes its first step
       }
     }
@@ -326,6 +374,9 @@ Status Solver::Step() {
   m_last.activeFraction = n > 0 ? static_cast<float>(red.computed) / static_cast<float>(n) : 1.0f;
   m_totals.steps += 1;
   m_totals.clampedEvents += red.clamped;
+  for (int k = 0; k < kClampSites; ++k) m_totals.clampedAt[k] += red.clampedAt[k];
+  m_totals.particleSteps += n;
+  WarnIfWallsLeak();
   m_last.pushedOut = red.pushed;
   m_totals.pushedOutEvents += red.pushed;
   m_last.densityIterations = red.densityIterations;

@@ -8,6 +8,8 @@
 //   2. sort:      stable radix/merge sort by code; gather every field         (fields.h list)
 //   3. grid:      cellStart/cellEnd per cell from the sorted codes
 //   4. density:   rho_i = sum_j m W_ij + sum_b Psi_b W_ib                     (Akinci et al. 2012, eq. 4-5)
+//                 or, under solver.density delta_sph, integrated from d rho_i/dt (continuity equation with
+//                 density diffusion, stages/density_diffusion.h)
 //                 p_i = B ((rho_i/rho0)^gamma - 1), clamped at 0             (B&T 2007, eq. 7)
 //   5. forces:    a_i = -sum_j m (p_i/rho_i^2 + p_j/rho_j^2 + Pi_ij) gradW_ij  (B&T 2007, eq. 6 and 10)
 //                       -sum_b Psi_b (s (p_i + p_b)/rho_i^2 + Pi_ib) gradW_ib (Akinci et al. 2012, eq. 10-11, in the
@@ -24,6 +26,8 @@
 #include "stages/reuse.h"      // 3b: activity, the compacted list
 #include "stages/walls.h"      // 3c: the walls' volumes and own pressure
 #include "stages/density.h"    // 4: density, Tait pressure
+#include "stages/density_diffusion.h"  // 4b: delta_sph, the continuity equation with density diffusion
 #include "stages/forces.h"     // 5: pressure, viscosity, gravity
-#include "stages/integrate.h"  // 6: symplectic Euler, domain clamp, the step's statistics
+#include "stages/clamp.h"      // 6: the domain and obstacle clamps, and where they caught a particle
+#include "stages/integrate.h"  // 6: symplectic Euler, the clamps, the step's statistics
 #include "stages/settle.h"     // FIRE, before a run

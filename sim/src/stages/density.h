@@ -85,7 +85,9 @@ struct DensityStage {
         if (r2 < k.H2) sumBoundary += grid.body[j].w * k.W(sqrtf(r2));
       });
     }
-    const float rho = ph.mass * sumFluid + sumBoundary;
+    // delta_sph: the density is integrated state (stages/density_diffusion.h); the sums above still give
+    // the neighbour list and the wall flag.
+    const float rho = ph.continuityDensity ? fluid.density[i] : ph.mass * sumFluid + sumBoundary;
     fluid.density[i] = rho;
     const float pressure = TaitPressure(ph, rho);
     fluid.pressure[i] = pressure;

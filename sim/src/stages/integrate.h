@@ -3,32 +3,22 @@
 // statistics (a reduction over the particles: what the next time step depends on).
 #include <cstdint>
 
+#include "stages/clamp.h"
 #include "stages/views.h"
 
 namespace sphxr::sim {
 
-/// Puts a particle that left the domain back on its edge with the outward velocity removed; true when
-/// it did (the step counts them: acceleration.w, StepReductionOp).
-SPHXR_HD SPHXR_INLINE bool ClampToDomain(const Physics& ph, Vec4* x, Vec4* v) {
-  bool clamped = false;
-  if (x->x < ph.domainMin.x) { x->x = ph.domainMin.x; if (v->x < 0.0f) v->x = 0.0f; clamped = true; }
-  if (x->x > ph.domainMax.x) { x->x = ph.domainMax.x; if (v->x > 0.0f) v->x = 0.0f; clamped = true; }
-  if (x->y < ph.domainMin.y) { x->y = ph.domainMin.y; if (v->y < 0.0f) v->y = 0.0f; clamped = true; }
-  if (x->y > ph.domainMax.y) { x->y = ph.domainMax.y; if (v->y > 0.0f) v->y = 0.0f; clamped = true; }
-  if (x->z < ph.domainMin.z) { x->z = ph.domainMin.z; if (v->z < 0.0f) v->z = 0.0f; clamped = true; }
-  if (x->z > ph.domainMax.z) { x->z = ph.domainMax.z; if (v->z > 0.0f) v->z = 0.0f; clamped = true; }
-  return clamped;
-}
-
-/// The end of every integrator: x += dt v, the domain clamp (flagged in acceleration.w, so that the
-/// step reports how many were clamped), and the store of particle i's position, velocity and
-/// acceleration.
+/// The end of every integrator: x += dt v, the domain and obstacle clamps (flagged in acceleration.w, so
+/// that the step reports how many were clamped, and where: StepReductionOp), and the store of particle
+/// i's position, velocity and acceleration.
 SPHXR_HD SPHXR_INLINE void DriftAndStore(const FluidView& fluid, const Physics& ph, float dt, int i, Vec4 x, Vec4 v,
                                          Vec4 a) {
   x.x += dt * v.x;
   x.y += dt * v.y;
   x.z += dt * v.z;
-  a.w = ClampToDomain(ph, &x, &v) ? 1.0f : 0.0f;
+  bool clamped = ph.obstacleCount > 0 && ClampOutOfObstacles(ph, &x, &v);
+  clamped = ClampToDomain(ph, &x, &v) || clamped;
+  a.w = clamped ? 1.0f : 0.0f;
   fluid.acceleration[i] = a;
   fluid.velocity[i] = v;
   fluid.position[i] = x;
@@ -89,6 +79,7 @@ struct StepReduction {
   float maxDensityError = 0.0f;
   double sumCompression = 0.0;
   int32_t clamped = 0;
+  int32_t clampedAt[kClampSites] = {};  // the same per tank face and obstacle (ClampSiteOf)
   int32_t computed = 0;  // particles that computed density and forces this step (set by the backend)
   int32_t pushed = 0;    // fluid particles pushed out of a moving body this step (stages/bodies.h)
   int32_t nonFinite = 0; // fluid particles with a NaN or infinite position, velocity, acceleration or density
@@ -101,8 +92,9 @@ struct StepReduction {
 
 struct StepReductionOp {
   FluidView fluid;
-  float invRestDensity;
+  Physics ph;
   SPHXR_HD StepReduction operator()(int i) const {
+    const float invRestDensity = ph.invRestDensity;
     StepReduction r;
     const Vec4 v = fluid.velocity[i];
     const Vec4 a = fluid.acceleration[i];
@@ -116,6 +108,10 @@ struct StepReductionOp {
     r.maxDensityError = fabsf(err);
     r.sumCompression = err > 0.0f ? err : 0.0f;
     r.clamped = WasClamped(a.w) ? 1 : 0;
+    if (r.clamped) {
+      const int site = ClampSiteOf(ph, Xyz(x));
+      if (site >= 0) r.clampedAt[site] = 1;
+    }
     r.pushed = WasPushed(a.w) ? 1 : 0;
     return r;
   }
@@ -129,6 +125,7 @@ struct StepReductionCombine {
     r.maxDensityError = MaxDroppingNaN(a.maxDensityError, b.maxDensityError);
     r.sumCompression = a.sumCompression + b.sumCompression;
     r.clamped = a.clamped + b.clamped;
+    for (int s = 0; s < kClampSites; ++s) r.clampedAt[s] = a.clampedAt[s] + b.clampedAt[s];
     r.pushed = a.pushed + b.pushed;
     r.nonFinite = a.nonFinite + b.nonFinite;
     return r;

@@ -9,6 +9,7 @@
 #include "sphxr/common/assert.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/common/hd.h"
+#include "sphxr/sim/params.h"
 #include "sphxr/sim/vec.h"
 
 namespace sphxr::sim {
@@ -156,6 +157,7 @@ struct Physics {
   float reuseInvPressureScale;  // 1 / P_pc
   float reuseCellCount;         // N_CPN
   bool reuseSyncStep;           // this step's number is a multiple of IDLE + 1 (the impulse hold's schedule)
+  bool continuityDensity;       // solver.density delta_sph: density is state (stages/density_diffusion.h)
   bool wallDensity;             // walls with their own density (WallPressureStage), else mirrored pressure
   float bodyGradScale;          // as boundaryGradScale, for the one-sheet shells of moving bodies
   float bodyClearance;          // m outside a moving body's solid where push-out puts a fluid particle
@@ -167,6 +169,11 @@ struct Physics {
   Vec3 gravity;
   Vec3 domainMin;       // clamp box for fluid particles
   Vec3 domainMax;
+  // Obstacles (static boxes), each grown by the same inset as the clamp box: a fluid particle inside
+  // one is put back on its nearest face (ClampOutOfObstacles).
+  int obstacleCount;
+  Vec3 obstacleMin[kMaxObstacles];
+  Vec3 obstacleMax[kMaxObstacles];
   // DFSPH (dfsph_solver.h); unused by WCSPH.
   bool dfsph;                   // SolverMethod::kDfsph
   float volume;                 // m / rho0, each fluid particle's rest volume

@@ -26,6 +26,8 @@ struct RunSummary {
   float maxSpeed = 0.0f;             // over the run
   double meanActiveFraction = 1.0;   // reuse: mean over the steps of the fraction that computed
   int64_t clampedEvents = 0;
+  double clampsPerThousand = 0.0;    // clamps per 1,000 particle-steps over the run
+  std::string clampedMost;           // the wall (or obstacle) that clamped most, empty without clamps
   int64_t lost = 0;                  // particles missing at the end (always 0: clamped, never removed)
   int64_t exports = 0;
   int64_t surfaceExports = 0;

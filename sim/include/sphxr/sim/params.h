@@ -41,6 +41,16 @@ const char* SolverMethodName(SolverMethod method);
 /// Parses "wcsph" | "dfsph".
 bool ParseSolverMethod(const std::string& text, SolverMethod* out);
 
+/// How WCSPH finds each particle's density (`solver.density`, a name). kSummation: rho_i = sum_j m W_ij
+/// every step (Becker & Teschner 2007). kDeltaSph: density is integrated state, the continuity equation
+/// with the delta-SPH diffusion term (Molteni & Colagrossi 2009, Antuono et al. 2010) and the hydrostatic
+/// correction of Fourtakas et al. (2019), meant to give a pressure field without the summation's
+/// flicker (docs/dev/physics.md; sim/src/stages/density_diffusion.h). DFSPH always sums; reuse needs the summation.
+enum class DensityModel { kSummation, kDeltaSph };
+const char* DensityModelName(DensityModel model);
+/// Parses "summation" | "delta_sph".
+bool ParseDensityModel(const std::string& text, DensityModel* out);
+
 struct ParamInfo {
   const char* key;    // scene-file key and command-line name
   const char* unit;
@@ -53,6 +63,12 @@ struct ParamInfo {
 /// The table of solver parameters (same order as SolverParams).
 std::span<const ParamInfo> SolverParamInfos();
 const ParamInfo* FindSolverParam(const std::string& key);
+
+/// Where a fluid particle can be clamped back into the water (Totals::clampedAt): the tank's six faces
+/// (x-, x+, floor, top, z-, z+), then each obstacle. A scene has at most kMaxObstacles obstacles.
+inline constexpr int kTankFaces = 6;
+inline constexpr int kMaxObstacles = 16;
+inline constexpr int kClampSites = kTankFaces + kMaxObstacles;
 
 struct FluidBlock {
   Aabb box;
@@ -104,6 +120,7 @@ const char* ReusePresetNames();
 struct SceneSetup {
   SolverParams params;
   SolverMethod method = SolverMethod::kWcsph;
+  DensityModel density = DensityModel::kSummation;
   Vec3 gravity{0.0f, -9.81f, 0.0f};
   /// The tank: its interior is the simulation domain. Walls and floor are sampled as boundary
   /// particles on its faces (the top face only when `openTop` is false).

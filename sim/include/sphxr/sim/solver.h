@@ -65,6 +65,8 @@ struct StepInfo {
 struct Totals {
   int64_t steps = 0;
   int64_t clampedEvents = 0;     // sum of StepInfo::clamped
+  std::array<int64_t, kClampSites> clampedAt{};  // the same, per tank face and obstacle (ClampSiteName)
+  int64_t particleSteps = 0;     // sum over steps of the fluid particles stepped (the clamp rate's denominator)
   int64_t dtClampedSteps = 0;    // steps where a fixed dt was clamped to the CFL limit
   int64_t pushedOutEvents = 0;   // sum of StepInfo::pushedOut
   int64_t densityIterations = 0;     // DFSPH: sums of StepInfo's iterations
@@ -73,6 +75,12 @@ struct Totals {
   std::array<double, static_cast<int>(Stage::kCount)> stageSeconds{};
   double stepSeconds = 0.0;      // wall time in Step()
 };
+
+/// "x- wall", "x+ wall", "floor", "top", "z- wall", "z+ wall", then "obstacles[k]" (params.h kClampSites).
+std::string ClampSiteName(int site);
+/// The clamp rate above which the walls leak (the solver warns once, naming the wall): 1 in 10,000
+/// particle-steps. Below it the clamp is a safety net, not what holds the water.
+inline constexpr double kLeakingClampRate = 1e-4;
 
 /// What Solver::Settle did.
 struct SettleReport {
@@ -262,6 +270,9 @@ class Solver {
                   ProbeSample* out) const;
   void SampleProbesNow();  // the backend's re-grid and evaluation (solver.cpp: it has the step's physics)
   bool m_dtClampLogged = false;
+  bool m_leakWarned = false;
+  /// Logs once per run when the clamps exceed kLeakingClampRate, naming the wall that clamps most.
+  void WarnIfWallsLeak();
   double m_iterationWarnTime = -1.0;  // simulated time of the last "iteration cap reached" warning
 };
 
