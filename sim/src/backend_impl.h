@@ -9,7 +9,6 @@
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/gather.h>
-#include <thrust/iterator/counting_iterator.h>
 #include <thrust/sequence.h>
 #include <thrust/functional.h>
 #include <thrust/scan.h>
@@ -22,6 +21,7 @@
 #include "backend.h"
 #include "backend_guard.h"
 #include "dfsph_solver.h"
+#include "probe_arrays.h"
 #include "reuse_lists.h"
 #include "surface_impl.h"
 
@@ -248,7 +248,7 @@ class BackendImpl final : public Backend {
       out->densityIterations = density.iterations;
       out->densityError = density.error;
       if (Status s = lap(Stage::kPressure); !s) return s;
-      m_dfsph.Finish(fv, physics, dt, bodies ? Raw(m_bodyPressureTerm) : nullptr, /*drift=*/m_probeOut.empty());
+      m_dfsph.Finish(fv, physics, dt, bodies ? Raw(m_bodyPressureTerm) : nullptr, /*drift=*/m_probes.Empty());
     }
 
     // 5b. the fluid's force on each body particle (the reaction). DFSPH's term is the solves' own
@@ -264,7 +264,7 @@ class BackendImpl final : public Backend {
 
     // 5c. probes, on the state at the start of the step (positions, grid, densities and pressures of one
     // state; DFSPH's Finish stored its pressure and leaves the drift to the stage below while probes run)
-    const bool probes = !m_probeOut.empty();
+    const bool probes = !m_probes.Empty();
     if (probes) {
       EvaluateProbes(physics);
       if (Status s = lap(Stage::kProbes); !s) return s;
@@ -354,20 +354,11 @@ class BackendImpl final : public Backend {
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), FluidCount(), FireMixStage{Fluid(), keep, mix});
   }
 
-  void SetProbes(const std::vector<Vec4>& points, const std::vector<ProbeLine>& lines) override {
-    m_probePoints.assign(points.begin(), points.end());
-    m_probeLines.assign(lines.begin(), lines.end());
-    m_probeOut.resize(2 * (points.size() + lines.size()));
-    thrust::fill(m_probeOut.begin(), m_probeOut.end(), 0.0f);
-  }
-
-  void ProbeValues(std::vector<float>* out) const override {
-    out->resize(m_probeOut.size());
-    if (!out->empty()) thrust::copy(m_probeOut.begin(), m_probeOut.end(), out->begin());
-  }
+  void SetProbes(const std::vector<Vec4>& p, const std::vector<ProbeLine>& l) override { m_probes.Set(p, l); }
+  void ProbeValues(std::vector<float>* out) const override { m_probes.Values(out); }
 
   void SampleProbesNow(const Physics& physics) override {
-    if (m_probeOut.empty()) return;
+    if (m_probes.Empty()) return;
     CellCodes();
     SortAndReorder();
     CellRanges();
@@ -446,7 +437,6 @@ class BackendImpl final : public Backend {
 #undef SPHXR_DEVICE_FIELD
   };
 
-
   template <class T>
   Vector<T>& Scratch() {
     if constexpr (std::is_same_v<T, Vec4>) return m_scratchVec4;
@@ -494,34 +484,13 @@ class BackendImpl final : public Backend {
     thrust::fill(policy, m_movingNear.begin(), m_movingNear.end(), uint8_t{0});
     const GridView g = View();
     for (const BodyState& s : m_hostStates) {
-      const float r = s.boundRadius;
-      int lo[3], hi[3];
-      g.CellOf(s.position - Vec3{r, r, r}, &lo[0], &lo[1], &lo[2]);
-      g.CellOf(s.position + Vec3{r, r, r}, &hi[0], &hi[1], &hi[2]);
-      const int top[3] = {g.nx - 1, g.ny - 1, g.nz - 1};
-      MovingNearStage stage{g, {}, {}, Raw(m_movingNear)};
-      for (int a = 0; a < 3; ++a) {
-        stage.lo[a] = lo[a] > 0 ? lo[a] - 1 : 0;
-        stage.dims[a] = (hi[a] < top[a] ? hi[a] + 1 : top[a]) - stage.lo[a] + 1;
-      }
-      thrust::for_each_n(policy, first, stage.dims[0] * stage.dims[1] * stage.dims[2], stage);
+      const MovingNearStage stage = MovingNearStage::Around(g, s.position, s.boundRadius, Raw(m_movingNear));
+      thrust::for_each_n(policy, first, stage.Items(), stage);
     }
   }
 
-  /// One work item per probe (stages/probes.h) over the current grid.
-  void EvaluateProbes(const Physics& physics) {
-    const int points = static_cast<int>(m_probePoints.size());
-    const int items = points + static_cast<int>(m_probeLines.size());
-    const ProbeStage stage{View(), Fluid(), physics, Raw(m_probePoints), points, Raw(m_probeLines), Raw(m_probeOut)};
-    if constexpr (Traits::kSimdStages) {
-      // The CPU: on the calling thread. A few dozen probes are tens of microseconds of work; a parallel
-      // region for them cost more than that on a loaded machine (sphxr_bench_probes: the probes stage
-      // took 5 % of a 2-thread step, 0.5 % of a 1-thread one).
-      for (int k = 0; k < items; ++k) stage(k);
-    } else {
-      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), items, stage);
-    }
-  }
+  /// One work item per probe over the current grid (probe_arrays.h).
+  void EvaluateProbes(const Physics& physics) { m_probes.Evaluate(View(), Fluid(), physics); }
 
   /// Applies the sort permutation to every field of the list (one gather and one O(1) swap each).
   void Reorder() {
@@ -610,9 +579,7 @@ class BackendImpl final : public Backend {
   Vector<uint32_t> m_bodyStart, m_bodyEnd;
   Vector<uint8_t> m_movingNear;
   Vector<float> m_bodyPressureTerm;  // per fluid particle (ForceStage or DFSPH's Finish -> BodyReactionStage)
-  Vector<Vec4> m_probePoints;        // pressure sensors (stages/probes.h); all three empty: no probes
-  Vector<ProbeLine> m_probeLines;    // level gauges
-  Vector<float> m_probeOut;          // two floats per probe, the last evaluation
+  ProbeArrays<Traits> m_probes;      // the probes and their last readings (empty: no probes)
   Vector<float> m_densityRate;       // per fluid particle, solver.density delta_sph (DensityRateStage)
   DfsphSolver<Traits> m_dfsph;       // DFSPH's arrays (sized at its first step)
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message

@@ -87,6 +87,21 @@ struct MovingNearStage {
     });
     out[grid.Linear(cx, cy, cz)] = near;
   }
+  int Items() const { return dims[0] * dims[1] * dims[2]; }
+
+  /// The cells of a body's bounding sphere (centre, radius r), grown by one cell and cut to the grid.
+  static MovingNearStage Around(const GridView& g, Vec3 centre, float r, uint8_t* out) {
+    int lo[3], hi[3];
+    g.CellOf(centre - Vec3{r, r, r}, &lo[0], &lo[1], &lo[2]);
+    g.CellOf(centre + Vec3{r, r, r}, &hi[0], &hi[1], &hi[2]);
+    const int top[3] = {g.nx - 1, g.ny - 1, g.nz - 1};
+    MovingNearStage stage{g, {}, {}, out};
+    for (int a = 0; a < 3; ++a) {
+      stage.lo[a] = lo[a] > 0 ? lo[a] - 1 : 0;
+      stage.dims[a] = (hi[a] < top[a] ? hi[a] + 1 : top[a]) - stage.lo[a] + 1;
+    }
+    return stage;
+  }
 };
 
 // c. force of the fluid on body particle b: minus the sum of what b added to each fluid neighbour's
