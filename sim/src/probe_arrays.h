@@ -24,8 +24,11 @@ class ProbeArrays {
   bool Empty() const { return m_out.empty(); }
 
   void Set(const std::vector<Vec4>& points, const std::vector<ProbeLine>& lines) {
-    m_points.assign(points.begin(), points.end());
-    m_lines.assign(lines.begin(), lines.end());
+    // thrust's copy of an empty std::vector binds a reference to its null data (UBSan): clear instead.
+    if (points.empty()) m_points.clear();
+    else m_points.assign(points.begin(), points.end());
+    if (lines.empty()) m_lines.clear();
+    else m_lines.assign(lines.begin(), lines.end());
     m_out.resize(2 * (points.size() + lines.size()));
     thrust::fill(m_out.begin(), m_out.end(), 0.0f);
   }
