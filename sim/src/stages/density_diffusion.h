@@ -57,17 +57,7 @@ struct DensityRateStage {
       continuity += Dot(vi - Xyz(fluid.velocity[j]), d) * f;
       diffused += (rhoi - rhoj - hydrostatic * Dot(ph.gravity, d)) * f / rhoj;
     };
-    const uint32_t found = list.count[i];
-    if (found <= static_cast<uint32_t>(list.maxNeighbours)) {
-      const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
-      for (uint32_t n = 0; n < found; ++n) {
-        const uint32_t j = slots[n];
-        const Vec4 pj = fluid.position[j];
-        fluidNeighbour(j, Vec3{xi.x - pj.x, xi.y - pj.y, xi.z - pj.z});
-      }
-    } else {
-      ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, fluidNeighbour);
-    }
+    ForEachFluidNeighbour(grid, fluid, list, i, xi, fluidNeighbour);
     float walls = 0.0f;
     if (pi.w != 0.0f) {  // a wall within the support (the density stage's flag)
       ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t b, Vec3 d) {

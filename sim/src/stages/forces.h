@@ -73,17 +73,7 @@ struct ForceStage {
       if (vx < 0.0f) term -= viscFluid * vx / ((r2 + eps) * (rhoi + rhoj));
       a -= d * (ph.mass * term * k.GradFactor(r));
     };
-    const uint32_t found = list.count[i];
-    if (found <= static_cast<uint32_t>(list.maxNeighbours)) {
-      const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
-      for (uint32_t n = 0; n < found; ++n) {
-        const uint32_t j = slots[n];
-        const Vec4 pj = fluid.position[j];
-        fluidNeighbour(j, Vec3{xi.x - pj.x, xi.y - pj.y, xi.z - pj.z});
-      }
-    } else {
-      ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, fluidNeighbour);
-    }
+    ForEachFluidNeighbour(grid, fluid, list, i, xi, fluidNeighbour);
     End(i, P, a);
   }
 

@@ -139,6 +139,24 @@ SPHXR_HD SPHXR_INLINE void ForEachInCells(const GridView& g, const uint32_t* sta
   }
 }
 
+/// Calls f(j, xi - xj) for every fluid neighbour candidate j of particle i: its neighbour list (in list
+/// order), or for a particle whose list overflowed (count > maxNeighbours) the 27 cells around xi.
+template <class F>
+SPHXR_HD SPHXR_INLINE void ForEachFluidNeighbour(const GridView& grid, const FluidView& fluid, const NeighbourList& list,
+                                                  int i, Vec3 xi, F&& f) {
+  const uint32_t found = list.count[i];
+  if (found <= static_cast<uint32_t>(list.maxNeighbours)) {
+    const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+    for (uint32_t n = 0; n < found; ++n) {
+      const uint32_t j = slots[n];
+      const Vec4 pj = fluid.position[j];
+      f(j, Vec3{xi.x - pj.x, xi.y - pj.y, xi.z - pj.z});
+    }
+  } else {
+    ForEachInCells(grid, grid.fluidStart, grid.fluidEnd, fluid.position, xi, f);
+  }
+}
+
 /// Constants of one step, passed by value into every stage.
 struct Physics {
   CubicSpline kernel;
