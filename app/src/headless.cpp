@@ -48,7 +48,16 @@ class InterruptScope {
   ~InterruptScope() {
     sigaction(SIGINT, &m_int, nullptr);
     sigaction(SIGTERM, &m_term, nullptr);
-    sigaction(SIGHUP, &m_hup, nullptr);
+    // After a hang-up the terminal is gone and more SIGHUPs may follow: they are ignored until the
+    // process exits, so one arriving after the run (while the summary prints) cannot end it by default.
+    if (g_interrupt == SIGHUP) {
+      struct sigaction ignore {};
+      ignore.sa_handler = SIG_IGN;
+      sigemptyset(&ignore.sa_mask);
+      sigaction(SIGHUP, &ignore, nullptr);
+    } else {
+      sigaction(SIGHUP, &m_hup, nullptr);
+    }
   }
   InterruptScope(const InterruptScope&) = delete;
   InterruptScope& operator=(const InterruptScope&) = delete;
