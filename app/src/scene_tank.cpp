@@ -7,7 +7,7 @@ Status Reader::Tank(const json& root) {
   if (!root.contains("tank")) return Error("tank", "missing: every scene needs a tank (its interior is the domain)");
   const json& tank = root["tank"];
   if (!tank.is_object()) return Error("tank", "must be an object");
-  CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity", "wall_pressure"});
+  CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity", "wall_pressure", "wall_contact"});
   if (Status st = Box(tank, "tank", &s.tank); !st) return st;
   if (tank.contains("open_top")) {
     if (!tank["open_top"].is_boolean()) return Error("tank.open_top", "must be true or false");
@@ -25,6 +25,10 @@ Status Reader::Tank(const json& root) {
     if (v == "mirrored") s.wallPressure = sim::SceneSetup::WallPressure::kMirrored;
     else if (v == "wall_density") s.wallPressure = sim::SceneSetup::WallPressure::kWallDensity;
     else return Error("tank.wall_pressure", "must be \"mirrored\" or \"wall_density\"");
+  }
+  if (tank.contains("wall_contact")) {
+    if (!tank["wall_contact"].is_boolean()) return Error("tank.wall_contact", "must be true or false");
+    s.wallContact = tank["wall_contact"].get<bool>();
   }
   if (tank.contains("boundary_layers")) {
     if (!tank["boundary_layers"].is_number_integer()) return Error("tank.boundary_layers", "must be an integer");

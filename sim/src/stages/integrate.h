@@ -4,15 +4,22 @@
 #include <cstdint>
 
 #include "stages/clamp.h"
+#include "stages/contact.h"
 #include "stages/views.h"
 
 namespace sphxr::sim {
 
-/// The end of every integrator: x += dt v, the domain and obstacle clamps (flagged in acceleration.w, so
+/// The end of every integrator: the walls' contact kick (stages/contact.h), x += dt v, the domain and obstacle clamps (flagged in acceleration.w, so
 /// that the step reports how many were clamped, and where: StepReductionOp), and the store of particle
 /// i's position, velocity and acceleration.
 SPHXR_HD SPHXR_INLINE void DriftAndStore(const FluidView& fluid, const Physics& ph, float dt, int i, Vec4 x, Vec4 v,
                                          Vec4 a) {
+  if (ph.contactStrength > 0.0f) {
+    const Vec3 push = WallContact(ph, Xyz(x), dt);
+    v.x += dt * push.x;
+    v.y += dt * push.y;
+    v.z += dt * push.z;
+  }
   x.x += dt * v.x;
   x.y += dt * v.y;
   x.z += dt * v.z;

@@ -192,6 +192,11 @@ struct Physics {
   int obstacleCount;
   Vec3 obstacleMin[kMaxObstacles];
   Vec3 obstacleMax[kMaxObstacles];
+  // The walls' contact force (stages/contact.h): the zone's width before the clamp box (m) and the
+  // acceleration at its floor (m/s^2; 0: tank.wall_contact off); the top face counts when the tank is closed.
+  float contactWidth;
+  float contactStrength;
+  bool closedTop;
   // DFSPH (dfsph_solver.h); unused by WCSPH.
   bool dfsph;                   // SolverMethod::kDfsph
   float volume;                 // m / rho0, each fluid particle's rest volume

@@ -138,6 +138,10 @@ struct SceneSetup {
   /// +14 % against Martin & Moyce (mirrored: +8.8 %, through a dip at the wall; physics.md).
   enum class WallPressure { kMirrored, kWallDensity };
   WallPressure wallPressure = WallPressure::kMirrored;
+  /// A short-range contact force from the tank's faces and the obstacles on water the boundary
+  /// particles do not hold (pressure-free films and spray; stages/contact.h). false: the boundary
+  /// particles and the clamp alone.
+  bool wallContact = true;
   std::vector<FluidBlock> fluid;
   std::vector<Aabb> obstacles;   // solid boxes inside the tank, surfaces sampled
   ReuseParams reuse;             // no "reuse" section in the scene: disabled
