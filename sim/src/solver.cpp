@@ -68,7 +68,7 @@ Physics MakePhysics(const SceneSetup& scene) {
     ph.obstacleMin[k] = used ? Vec3{o.min.x - inset, o.min.y - inset, o.min.z - inset} : Vec3{};
     ph.obstacleMax[k] = used ? Vec3{o.max.x + inset, o.max.y + inset, o.max.z + inset} : Vec3{};
   }
-  ph.contactWidth = 0.15f * p.spacing;
+  ph.contactWidth = 0.1f * p.spacing;
   // Its potential at the clamp box stops a particle arriving at a quarter of the sound speed.
   ph.contactStrength = scene.wallContact ? 3.0f * ph.soundSpeed * ph.soundSpeed / (32.0f * ph.contactWidth) : 0.0f;
   ph.closedTop = !scene.openTop;

@@ -14,12 +14,7 @@ namespace sphxr::sim {
 /// i's position, velocity and acceleration.
 SPHXR_HD SPHXR_INLINE void DriftAndStore(const FluidView& fluid, const Physics& ph, float dt, int i, Vec4 x, Vec4 v,
                                          Vec4 a) {
-  if (ph.contactStrength > 0.0f) {
-    const Vec3 push = WallContact(ph, Xyz(x), dt);
-    v.x += dt * push.x;
-    v.y += dt * push.y;
-    v.z += dt * push.z;
-  }
+  if (ph.contactStrength > 0.0f) WallContact(ph, Xyz(x), dt, &v);
   x.x += dt * v.x;
   x.y += dt * v.y;
   x.z += dt * v.z;
