@@ -181,9 +181,9 @@ TEST_P(Buchner, WallPressureMatchesBuchner2002) {
 }
 
 // In CI: the scene's density (delta_sph) with P2 and the walls checked; one run takes about 75 s on two
-// threads. P1 misses its bounds (first rise 2.83 against 2.48, RMS 31 % against 15 %: the run-up that
+// threads. P1 misses its bounds (first rise 2.87 against 2.48, RMS 34 % against 15 %: the run-up that
 // reaches P1 first is a jet one or two particles thick at zero pressure; docs/dev/physics.md), so the
-// whole target, and the summation density's run (its pressure flickers: P2's RMS 81 %), are disabled;
+// whole target, and the summation density's run (its pressure flickers: P2's RMS 30 %), are disabled;
 // run them with --gtest_also_run_disabled_tests --gtest_filter='DISABLED_*/Buchner.*'.
 auto Name = [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.density); };
 INSTANTIATE_TEST_SUITE_P(Density, Buchner, ::testing::Values(Case{"delta_sph", false}), Name);
