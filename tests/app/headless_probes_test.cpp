@@ -186,5 +186,53 @@ TEST(HeadlessTest, ExportIntervalStampsStepAndTime) {
   }
 }
 
+// A fixed structure (a scripted paddle whose trajectory is one pose, held) in still water: its force
+// probe reads Archimedes' buoyancy, rho0 g times the submerged volume. Where the water's surface against
+// the structure lies is resolution-dependent: between the solid's faces and half a spacing out (the
+// fluid keeps half a spacing from its shell), so the buoyancy lies between that of the solid and of the
+// solid grown by half a spacing, at the water level the gauge reads. Averaged over the last 0.2 s of 0.6 s
+// (the start's sloshing has calmed).
+TEST(HeadlessTest, AHeldStructureFeelsArchimedesBuoyancy) {
+  test::TempDir dir("buoyancy");
+  dir.Write("hold.csv", "time,px,py,pz\n0,0.15,0.10,0.10\n");
+  const std::string scene = dir.Write("scene.json", R"({
+    "name": "held_post",
+    "solver": { "spacing": 0.01, "stiffness": 20000.0, "viscosity": 0.05 },
+    "tank": { "min": [0, 0, 0], "max": [0.3, 0.25, 0.2], "wall_pressure": "wall_density" },
+    "fluid": [ { "min": [0, 0, 0], "max": [0.3, 0.12, 0.2], "hydrostatic": true } ],
+    "paddles": { "frame_rate": 90, "list": [ { "name": "post", "hand": "script", "trajectory": "hold.csv",
+        "shapes": [ { "box": { "center": [0, 0, 0], "half_extents": [0.03, 0.05, 0.03] } } ] } ] },
+    "probes": { "every": 0.01, "force": [ { "name": "F", "body": "post" } ],
+                "level": [ { "name": "L", "x": 0.04, "z": 0.04 } ] }
+  })");
+  const std::string csv = dir.File("probes.csv");
+  const SphxrRun r = Sphxr(dir, {"--headless", "--scene", scene, "--time", "0.6", "--probes", csv, "--threads", "1",
+                                 "--no-progress"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<std::string> lines = test::Lines(test::ReadFile(csv));
+  ASSERT_FALSE(lines.empty());
+  ASSERT_EQ(lines[0], "time,step,L_level,F_fx,F_fy,F_fz,F_tx,F_ty,F_tz");
+  double fy = 0.0, level = 0.0;
+  int n = 0;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> c = Cells(lines[i]);
+    ASSERT_EQ(c.size(), 9u) << lines[i];
+    if (std::stod(c[0]) < 0.4 - 1e-9) continue;
+    level += std::stod(c[2]);
+    fy += std::stod(c[4]);
+    ++n;
+  }
+  ASSERT_GE(n, 19);
+  fy /= n;
+  level /= n;
+  const double rho0g = 1000.0 * 9.81, dx = 0.01, bottom = 0.05, half = 0.03;
+  ASSERT_GT(level, bottom + 0.05) << "the post stands in the water";
+  const double solid = rho0g * (2 * half) * (2 * half) * (level - bottom);
+  const double grown = rho0g * (2 * half + dx) * (2 * half + dx) * (level - bottom + 0.5 * dx);
+  std::printf("buoyancy %.3f N: solid %.3f N, grown by half a spacing %.3f N (level %.4f m)\n", fy, solid, grown, level);
+  EXPECT_GE(fy, solid);
+  EXPECT_LE(fy, grown);
+}
+
 }  // namespace
 }  // namespace sphxr::app
