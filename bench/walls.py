@@ -65,7 +65,14 @@ def main():
                                           "--no-progress"], capture_output=True, text=True,
                                          env=dict(os.environ, OMP_WAIT_POLICY="active"))
                     if out.returncode != 0:
-                        sys.exit(f"bench/walls.py: {name} failed: {out.stderr.strip().splitlines()[-1:]}")
+                        # An unstable run is a result too: its row says where it stopped.
+                        last = (out.stderr.strip().splitlines() or ["no message"])[-1]
+                        stop = re.search(r"at t = ([0-9.]+) s", last)
+                        row = [machine, str(args.threads), name, "on" if contact else "off", density, "", "",
+                               "unstable at t = %s s" % (stop.group(1) if stop else "?"), "", "", ""]
+                        print(",".join(row), flush=True)
+                        rows.append(row)
+                        continue
                     m = re.search(r"particles lost +(\d+) \(clamped back into the tank: (\d+) times, ([0-9.e+-]+) per "
                                   r"1,000 particle-steps(?:, most at the ([^)]+))?\)", out.stdout)
                     wall = re.search(r"in ([0-9.]+) s wall", out.stdout)
