@@ -339,7 +339,9 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
       return Status::Error("--probes " + options.probesPath + ": " + options.scenePath +
                            " has no \"probes\" section (docs/user/scenes.md#probes)");
     }
-    if (Status s = ProbeSink::Create(options.probesPath, *scene.probes, &probes); !s) return s;
+    if (Status s = ProbeSink::Create(options.probesPath, *scene.probes, state ? state->clock.time : 0.0, &probes); !s) {
+      return s;
+    }
   }
   std::unique_ptr<PicturesSink> pictures;
   if (Status s = PrepareOutputs(options, scene, summary, &stats, &pictures); !s) return s;

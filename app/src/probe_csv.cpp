@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 
 #include "sphxr/common/log.h"
 
@@ -21,6 +23,37 @@ void Cell(std::string* row, float v) {
   *row += ',';
   if (std::isnan(v)) return;
   *row += Format("%.7g", v);
+}
+
+/// The bytes of an earlier run's probe CSV at `path` to keep when a run continues it with rows from
+/// `firstRow` (s) on: the header and the whole rows before firstRow. -1 when the file is not such a
+/// file (not regular, another header, rows out of time order or torn before firstRow): it is then
+/// written anew. `dropped`: rows at or after firstRow, replaced.
+int64_t ProbeBytesToKeep(const std::string& path, const std::string& header, double firstRow, double every,
+                         int64_t* dropped) {
+  *dropped = 0;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return -1;  // never read a pipe or device
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line) || line != header || in.eof()) return -1;
+  int64_t keep = static_cast<int64_t>(line.size()) + 1, at = keep;
+  double previous = -1.0;
+  while (std::getline(in, line)) {
+    const bool whole = !in.eof();  // ended by '\n' (a torn last row is not)
+    char* end = nullptr;
+    const double t = std::strtod(line.c_str(), &end);
+    if (end == line.c_str() || *end != ',' || !(t > previous)) return -1;  // not our rows, or not in order
+    previous = t;
+    at += static_cast<int64_t>(line.size()) + (whole ? 1 : 0);
+    if (t < firstRow - 0.5 * every) {
+      if (!whole) return -1;
+      keep = at;
+    } else {
+      ++*dropped;
+    }
+  }
+  return keep;
 }
 
 }  // namespace
@@ -46,11 +79,24 @@ Status ProbeCsv::Open(const std::string& path, const ProbeConfig& config, double
   // The first row at or after `start`; the tiny slack keeps a start that is a multiple of `every` in
   // (k every rounds either way in binary).
   csv->StartAt(start);
-  csv->m_file = std::fopen(path.c_str(), "wb");
-  if (!csv->m_file) return Status::Error("--probes " + path + ": cannot open for writing: " + std::strerror(errno));
-  const std::string header = ProbeCsvHeader(config.set) + "\n";
-  if (std::fwrite(header.data(), 1, header.size(), csv->m_file) != header.size() || std::fflush(csv->m_file) != 0) {
-    return Status::Error("--probes " + path + ": write failed (disk full?)");
+  const std::string header = ProbeCsvHeader(config.set);
+  int64_t dropped = 0;
+  const int64_t keep = start > 0.0 ? ProbeBytesToKeep(path, header, csv->NextTime(), config.every, &dropped) : -1;
+  if (keep >= 0) {
+    std::error_code ec;
+    std::filesystem::resize_file(path, static_cast<uintmax_t>(keep), ec);
+    if (ec) return Status::Error("--probes " + path + ": cannot continue the file: " + ec.message());
+    csv->m_file = std::fopen(path.c_str(), "ab");
+    if (!csv->m_file) return Status::Error("--probes " + path + ": cannot open for writing: " + std::strerror(errno));
+    SPHXR_LOG_INFO("--probes %s: the rows continue the earlier run's (its rows before t = %.6g s kept%s)", path.c_str(),
+                   csv->NextTime(), dropped > 0 ? Format(", %lld after it replaced", static_cast<long long>(dropped)).c_str() : "");
+  } else {
+    csv->m_file = std::fopen(path.c_str(), "wb");
+    if (!csv->m_file) return Status::Error("--probes " + path + ": cannot open for writing: " + std::strerror(errno));
+    const std::string line = header + "\n";
+    if (std::fwrite(line.data(), 1, line.size(), csv->m_file) != line.size() || std::fflush(csv->m_file) != 0) {
+      return Status::Error("--probes " + path + ": write failed (disk full?)");
+    }
   }
   csv->m_lastFlush = WallSeconds();
   *out = std::move(csv);
@@ -113,11 +159,12 @@ Status ProbeCsv::Flush() {
   return Status::Ok();
 }
 
-Status ProbeSink::Create(const std::string& path, const ProbeConfig& config, std::unique_ptr<ProbeSink>* out) {
+Status ProbeSink::Create(const std::string& path, const ProbeConfig& config, double start,
+                         std::unique_ptr<ProbeSink>* out) {
   std::unique_ptr<ProbeSink> sink(new ProbeSink());
   sink->m_path = path;
   sink->m_config = config;
-  if (Status s = ProbeCsv::Open(path, config, 0.0, &sink->m_csv); !s) return s;
+  if (Status s = ProbeCsv::Open(path, config, start, &sink->m_csv); !s) return s;
   *out = std::move(sink);
   return Status::Ok();
 }
@@ -132,6 +179,14 @@ Status ProbeSink::OnStep(Simulation& simulation, const sim::StepInfo&) {
   return m_csv->Add(simulation.Solver().LastProbes());
 }
 
-Status ProbeSink::Finish(Simulation&, bool) { return m_csv->Flush(); }
+Status ProbeSink::Finish(Simulation& simulation, bool) {
+  // The readings so far end at the last step's start; one more on the final state gives the rows up to
+  // the end, so a run continued from this state (whose first reading is here) leaves no row out.
+  sim::ProbeSample last;
+  if (simulation.Solver().Time() > 0.0 && simulation.Solver().SampleProbes(m_config.set, &last).ok()) {
+    if (Status s = m_csv->Add(last); !s) return s;
+  }
+  return m_csv->Flush();
+}
 
 }  // namespace sphxr::app

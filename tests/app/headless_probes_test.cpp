@@ -178,7 +178,9 @@ TEST(HeadlessTest, ExportIntervalStampsStepAndTime) {
         EXPECT_NEAR(time, timeOfStep[step], 1e-6 * (1.0 + time)) << "the stamp's time is the step's";
         const double due = interval * static_cast<double>(k);
         EXPECT_GE(time, due - 1e-12) << "file " << k << " before its time";
-        if (step > 0) EXPECT_LT(timeOfStep[step - 1], due) << "file " << k << ": the step before had reached it";
+        if (step > 0) {
+          EXPECT_LT(timeOfStep[step - 1], due) << "file " << k << ": the step before had reached it";
+        }
       }
     };
     check(particles, 0.01, 4);
@@ -232,6 +234,46 @@ TEST(HeadlessTest, AHeldStructureFeelsArchimedesBuoyancy) {
   std::printf("buoyancy %.3f N: solid %.3f N, grown by half a spacing %.3f N (level %.4f m)\n", fy, solid, grown, level);
   EXPECT_GE(fy, solid);
   EXPECT_LE(fy, grown);
+}
+
+// A run continued from its state file continues its probe file: the rows of the whole run, at the same
+// times, with the same readings (to float rounding: the reading of the final state at the join is taken
+// after a re-grid, its sums in another order), and an earlier continuation's rows past the state replaced.
+TEST(HeadlessTest, AContinuedRunContinuesItsProbeFile) {
+  test::TempDir dir("probes_continue");
+  const std::string scene = dir.Write("scene.json", kScene);
+  const std::string whole = dir.File("whole.csv"), parts = dir.File("parts.csv"), state = dir.File("mid.state");
+  const std::vector<std::string> common = {"--headless", "--scene", scene, "--threads", "1", "--no-progress"};
+  auto run = [&](std::vector<std::string> more) {
+    std::vector<std::string> args = common;
+    args.insert(args.end(), more.begin(), more.end());
+    return Sphxr(dir, args);
+  };
+  SphxrRun r = run({"--time", "0.04", "--probes", whole});
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The first half, then a second half run twice (the second time its own rows are replaced).
+  r = run({"--time", "0.0205", "--probes", parts, "--save-state", state});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int k = 0; k < 2; ++k) {
+    r = run({"--time", "0.04", "--load-state", state, "--probes", parts});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("the rows continue the earlier run's"), std::string::npos) << r.err;
+  }
+  const std::vector<std::string> a = test::Lines(test::ReadFile(whole)), b = test::Lines(test::ReadFile(parts));
+  ASSERT_EQ(b.size(), a.size()) << "the same rows";
+  ASSERT_GT(a.size(), 40u);
+  EXPECT_EQ(b[0], a[0]);
+  for (size_t i = 1; i < a.size(); ++i) {
+    const std::vector<std::string> x = Cells(a[i]), y = Cells(b[i]);
+    ASSERT_EQ(y.size(), x.size()) << b[i];
+    EXPECT_EQ(y[0], x[0]) << "row " << i << ": the same time";
+    for (size_t c = 2; c < x.size(); ++c) {
+      ASSERT_EQ(x[c].empty(), y[c].empty()) << "row " << i << " column " << c << ": " << a[i] << " / " << b[i];
+      if (x[c].empty()) continue;
+      const double u = std::stod(x[c]), v = std::stod(y[c]);
+      EXPECT_NEAR(v, u, 1e-4 * (std::fabs(u) + 1.0)) << "row " << i << " column " << c;
+    }
+  }
 }
 
 }  // namespace

@@ -31,8 +31,10 @@ std::string ProbeCsvHeader(const sim::ProbeSet& set);
 
 class ProbeCsv {
  public:
-  /// Opens `path` anew and writes the header; rows start at the first multiple of `every` at or after
-  /// `start` (s: a continued run's start time; rows before it are the earlier run's).
+  /// Opens `path` and writes the header; rows start at the first multiple of `every` at or after
+  /// `start` (s: a continued run's start time). A continued run (start > 0) whose file is a regular
+  /// file with the same header and rows in time order continues it: the earlier run's rows before the
+  /// first new row are kept, any after it (an earlier continuation's) cut off, and rows appended.
   static Status Open(const std::string& path, const ProbeConfig& config, double start, std::unique_ptr<ProbeCsv>* out);
   ~ProbeCsv();
   ProbeCsv(const ProbeCsv&) = delete;
@@ -63,10 +65,13 @@ class ProbeCsv {
 
 /// --probes FILE.csv as a sink of the Simulation: the file made (and its header written) by Create,
 /// before the solver exists; OnStart sets the probes on the solver and starts the rows at its time;
-/// every step adds the solver's LastProbes; Finish hands the last rows to the file.
+/// every step adds the solver's LastProbes; Finish adds a reading of the final state (the rows up to the
+/// run's end) and hands the last rows to the file.
 class ProbeSink : public SimulationSink {
  public:
-  static Status Create(const std::string& path, const ProbeConfig& config, std::unique_ptr<ProbeSink>* out);
+  /// `start`: the run's start time (a state file's; 0 for a new run), as ProbeCsv::Open takes it.
+  static Status Create(const std::string& path, const ProbeConfig& config, double start,
+                       std::unique_ptr<ProbeSink>* out);
   Status OnStart(Simulation& simulation) override;
   Status OnStep(Simulation& simulation, const sim::StepInfo& info) override;
   Status Finish(Simulation& simulation, bool interrupted) override;
