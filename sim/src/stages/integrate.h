@@ -9,9 +9,9 @@
 
 namespace sphxr::sim {
 
-/// The end of every integrator: the walls' contact kick (stages/contact.h), x += dt v, the domain and obstacle clamps (flagged in acceleration.w, so
-/// that the step reports how many were clamped, and where: StepReductionOp), and the store of particle
-/// i's position, velocity and acceleration.
+/// The end of every integrator: the walls' contact kick (stages/contact.h), x += dt v, the domain and
+/// obstacle clamps (flagged in acceleration.w, so that the step reports how many were clamped, and
+/// where: StepReductionOp), and the store of particle i's position, velocity and acceleration.
 SPHXR_HD SPHXR_INLINE void DriftAndStore(const FluidView& fluid, const Physics& ph, float dt, int i, Vec4 x, Vec4 v,
                                          Vec4 a) {
   if (ph.contactStrength > 0.0f) WallContact(ph, Xyz(x), dt, &v);
