@@ -1,5 +1,7 @@
 #include "headless_sinks.h"
 
+#include "csv_continue.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,29 +24,18 @@ namespace {
 /// file is written anew. `*dropped` counts the rows after that step (a second half run before).
 int64_t StatsBytesToKeep(const std::string& path, const std::string& header, int64_t stepsBefore, int64_t* dropped) {
   *dropped = 0;
-  std::error_code ec;
-  if (stepsBefore <= 0 || !std::filesystem::is_regular_file(path, ec)) return -1;  // never read a pipe or device
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  if (!in || !std::getline(in, line) || line != header || in.eof()) return -1;
-  int64_t keep = static_cast<int64_t>(line.size()) + 1, at = keep;
-  bool found = false;
+  if (stepsBefore <= 0) return -1;
   long long previous = 0;
-  while (std::getline(in, line)) {
-    const bool whole = !in.eof();  // ended by '\n' (a torn last row is not)
+  bool found = false;  // the row of the state's step itself
+  const int64_t keep = CsvBytesToKeep(path, header, [&](const std::string& line) {
     char* end = nullptr;
     const long long step = std::strtoll(line.c_str(), &end, 10);
-    if (end == line.c_str() || *end != ',' || step <= previous) return -1;  // not our rows, or not in order
+    if (end == line.c_str() || *end != ',' || step <= previous) return RowFate::kForeign;  // not ours, or not in order
     previous = step;
-    at += static_cast<int64_t>(line.size()) + (whole ? 1 : 0);
-    if (step <= stepsBefore) {
-      if (!whole) return -1;
-      keep = at;
-      found = step == stepsBefore;
-    } else {
-      ++*dropped;
-    }
-  }
+    if (step > stepsBefore) return RowFate::kDrop;
+    found = step == stepsBefore;
+    return RowFate::kKeep;
+  }, dropped);
   return found ? keep : -1;
 }
 

@@ -3,10 +3,11 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 
+#include "csv_continue.h"
 #include "sphxr/common/log.h"
 
 namespace sphxr::app {
@@ -26,34 +27,18 @@ void Cell(std::string* row, float v) {
 }
 
 /// The bytes of an earlier run's probe CSV at `path` to keep when a run continues it with rows from
-/// `firstRow` (s) on: the header and the whole rows before firstRow. -1 when the file is not such a
-/// file (not regular, another header, rows out of time order or torn before firstRow): it is then
-/// written anew. `dropped`: rows at or after firstRow, replaced.
+/// `firstRow` (s) on: the header and the whole rows before firstRow (csv_continue.h); rows out of time
+/// order are foreign.
 int64_t ProbeBytesToKeep(const std::string& path, const std::string& header, double firstRow, double every,
                          int64_t* dropped) {
-  *dropped = 0;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return -1;  // never read a pipe or device
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  if (!in || !std::getline(in, line) || line != header || in.eof()) return -1;
-  int64_t keep = static_cast<int64_t>(line.size()) + 1, at = keep;
   double previous = -1.0;
-  while (std::getline(in, line)) {
-    const bool whole = !in.eof();  // ended by '\n' (a torn last row is not)
+  return CsvBytesToKeep(path, header, [&](const std::string& line) {
     char* end = nullptr;
     const double t = std::strtod(line.c_str(), &end);
-    if (end == line.c_str() || *end != ',' || !(t > previous)) return -1;  // not our rows, or not in order
+    if (end == line.c_str() || *end != ',' || !(t > previous)) return RowFate::kForeign;
     previous = t;
-    at += static_cast<int64_t>(line.size()) + (whole ? 1 : 0);
-    if (t < firstRow - 0.5 * every) {
-      if (!whole) return -1;
-      keep = at;
-    } else {
-      ++*dropped;
-    }
-  }
-  return keep;
+    return t < firstRow - 0.5 * every ? RowFate::kKeep : RowFate::kDrop;
+  }, dropped);
 }
 
 }  // namespace
