@@ -27,6 +27,11 @@ pack)
   mkdir -p .gpu/build-gpu
   tar -C build-gpu -cf - --exclude='*.o' --exclude='*.a' --exclude='*.ninja' --exclude='.ninja_*' \
       --exclude='*.dir' --exclude='CMakeFiles' --exclude='test-artifacts' . | tar -C .gpu/build-gpu -xf -
+  # only the executables gpu_check.sh runs (the carry is limited)
+  keep=" tests/sphxr_gpu_tests tests/sphxr_backend_tests bench/sphxr_bench_perf bench/sphxr_bench_surface bench/sphxr_bench_frame app/sphxr "
+  (cd .gpu/build-gpu && find . -type f -perm -u+x | sed 's|^\./||' | while read -r f; do
+     case "$keep" in *" $f "*) ;; *) head -c 4 "$f" | grep -q ELF && rm -f "$f" ;; esac
+   done)
   # the shared libraries, except the C library's own (the machine's are newer); Debian's libstdc++ and
   # libgcc_s apart, used only if the machine's are older than the build's
   for exe in .gpu/build-gpu/tests/sphxr_gpu_tests .gpu/build-gpu/tests/sphxr_backend_tests \
