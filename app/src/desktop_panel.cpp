@@ -7,6 +7,7 @@
 #include "desktop_impl.h"
 #include "sphxr/app/param_registry.h"
 #include "sphxr/common/log.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
 
@@ -119,18 +120,27 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     return edited;
   };
   if (ImGui::CollapsingHeader("solver (edits rebuild the scene)")) {
-    // The pressure solver by name, as the scene's solver.method (docs/design/dfsph.md).
-    for (sim::SolverMethod m : {sim::SolverMethod::kWcsph, sim::SolverMethod::kDfsph}) {
-      if (m != sim::SolverMethod::kWcsph) ImGui::SameLine();
-      if (ImGui::RadioButton(sim::SolverMethodName(m), setup.method == m) && setup.method != m) {
-        setup.method = m;
+    // The pressure solver by name, as the scene's solver.method: one button per row of the solver table.
+    bool first = true;
+    for (const sim::SolverInfo& row : sim::SolverTable()) {
+      if (!first) ImGui::SameLine();
+      first = false;
+      if (ImGui::RadioButton(row.name, setup.method == row.method) && setup.method != row.method) {
+        setup.method = row.method;
         Rebuild();
       }
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s\n%s", row.summary, row.paper);
     }
-    if (setup.method == sim::SolverMethod::kDfsph) {
-      ImGui::Text("last step: %d density, %d divergence iterations; errors %.3g %%, %.3g %%",
-                  snap.last.densityIterations, snap.last.divergenceIterations, 100.0 * snap.last.solverDensityError,
-                  100.0 * snap.last.solverDivergenceError);
+    // The method's own statistics of the last step (its row's stats, as in the stats CSV).
+    const sim::SolverInfo& method = sim::SolverInfoOf(setup.method);
+    if (!method.stats.empty()) {
+      std::string line = "last step:";
+      for (sim::SolverStat stat : method.stats) {
+        const double value = sim::SolverStatValue(snap.last, stat);
+        const bool error = stat == sim::SolverStat::kDensityError || stat == sim::SolverStat::kDivergenceError;
+        line += Format(" %s %.3g%s", sim::SolverStatName(stat), error ? 100.0 * value : value, error ? " %" : "");
+      }
+      ImGui::TextUnformatted(line.c_str());
     }
     for (const ParamDesc& p : ParamRegistry()) {
       if (p.group == "solver" && editor(p)) Rebuild();

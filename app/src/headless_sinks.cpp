@@ -157,11 +157,11 @@ Status StatsSink::Open() {
 
 Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBreakProbe>& probe) {
   m_probe = probe;
-  m_dfsph = simulation.Solver().Method() == sim::SolverMethod::kDfsph;
+  m_stats = sim::SolverInfoOf(simulation.Solver().Method()).stats;
   const interaction::PaddleSystem* paddles = simulation.Paddles();
   std::string header = "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction";
   if (m_probe) header += ",front_Z,height_H";
-  if (m_dfsph) header += ",density_iterations,divergence_iterations,solver_density_error,solver_divergence_error";
+  for (sim::SolverStat stat : m_stats) header += std::string(",") + sim::SolverStatName(stat);
   if (paddles) {
     header += ",pushed_out";
     for (int k = 0; k < paddles->Count(); ++k) header += Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
@@ -203,10 +203,7 @@ Status StatsSink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
     const DamBreakMeasure m = MeasureDamBreak(*m_probe, m_host, simulation.Setup().params.spacing);
     row << ',' << m.front << ',' << m.height;
   }
-  if (m_dfsph) {
-    row << ',' << info.densityIterations << ',' << info.divergenceIterations << ',' << info.solverDensityError << ','
-        << info.solverDivergenceError;
-  }
+  for (sim::SolverStat stat : m_stats) row << ',' << sim::SolverStatValue(info, stat);
   if (const interaction::PaddleSystem* paddles = simulation.Paddles()) {
     row << ',' << info.pushedOut;
     for (int k = 0; k < paddles->Count(); ++k) {

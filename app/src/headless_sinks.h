@@ -1,4 +1,7 @@
 #pragma once
+#include <span>
+
+#include "sphxr/sim/solver_table.h"
 // The headless runner's outputs, each a sink of the Simulation (simulation.h): the stats CSV, particle
 // and surface exports, pictures (--frames, --screenshot), checkpoints, the progress bar and the
 // summary's per-step measures. They are made (and their files checked) before the solver allocates
@@ -88,7 +91,7 @@ class StatsSink : public SimulationSink {
   std::string m_path;
   std::ofstream m_out;
   std::optional<DamBreakProbe> m_probe;
-  bool m_dfsph = false;
+  std::span<const sim::SolverStat> m_stats;  // the method's own columns (its solver-table row)
   std::string m_pending;
   std::chrono::steady_clock::time_point m_last = std::chrono::steady_clock::now();
   sim::HostFluid m_host;

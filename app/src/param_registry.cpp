@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "sphxr/sim/solver_table.h"
 #include "sphxr/common/log.h"
 
 namespace sphxr::app {
@@ -104,11 +105,15 @@ void Table(const char* group, std::string* out) {
     *out += "| `" + p.name + "` | " + p.unit + " | " + Number(p.defaultValue) + " | " + Number(p.min) + " – " +
             Number(p.max) + " | " + p.help + " |\n";
     if (p.name == "fixed_dt") {  // the one solver key that is a name, not a number (sim::SolverMethod)
-      *out += Format("| `method` | | `\"%s\"` | `\"%s\"`, `\"%s\"` | the pressure solver: weakly compressible SPH (Tait) or "
-                     "divergence-free SPH (Bender & Koschier 2017), whose step follows the flow speed "
-                     "([../design/dfsph.md](../design/dfsph.md)) |\n",
-                     sim::SolverMethodName(sim::SolverMethod::kWcsph), sim::SolverMethodName(sim::SolverMethod::kWcsph),
-                     sim::SolverMethodName(sim::SolverMethod::kDfsph));
+      // `method`'s row from the solver table: its names and each method's one-line summary.
+      std::string names, meaning = "the pressure solver:";
+      for (const sim::SolverInfo& row : sim::SolverTable()) {
+        names += std::string(names.empty() ? "" : ", ") + "`\"" + row.name + "\"`";
+        meaning += std::string(" `") + row.name + "`, " + row.summary + ";";
+      }
+      meaning.back() = ' ';
+      *out += Format("| `method` | | `\"%s\"` | %s | %s|\n", sim::SolverMethodName(sim::SolverMethod::kWcsph), names.c_str(),
+                     meaning.c_str());
       *out += "| `density` | | `\"summation\"` | `\"summation\"`, `\"delta_sph\"` | wcsph: how a particle's density is "
               "found: summed over its neighbours every step (Becker & Teschner 2007), or integrated by the continuity "
               "equation with delta-SPH density diffusion (Molteni & Colagrossi 2009, Antuono et al. 2010; Fourtakas et "

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "sphxr/common/log.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
 namespace {
@@ -50,18 +51,20 @@ Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& conf
   const float maxH = std::max(h0, std::min(4.0f * h0, static_cast<float>(h0 * std::cbrt(std::max(n, 1.0) / kMinFluid))));
   // The first steps of a scene are calm; splashes shorten the step later. Aim 30 % above the target.
   const double aim = 1.3 * target;
-  // The method first: both measured at the scene's spacing, the faster kept (DFSPH's step follows the
-  // flow, WCSPH's the sound speed: on calm, stirred water DFSPH is usually several times faster).
+  // The method first: every row of the solver table measured at the scene's spacing in half the budget,
+  // the fastest kept (WCSPH's step follows the sound speed, DFSPH's the flow, PBF's the frame).
+  const double share = 0.5 * budgetSeconds / static_cast<double>(sim::SolverTable().size());
   double r0 = 0.0;
   int n0 = 0;
   sim::SceneSetup trial = scene;
-  if (Status s = Measure(scene, config, 0.25 * budgetSeconds, &r0, &n0); !s) return s;
-  {
+  if (Status s = Measure(scene, config, share, &r0, &n0); !s) return s;
+  for (const sim::SolverInfo& row : sim::SolverTable()) {  // every other method, measured alike
+    if (row.method == scene.method) continue;
     sim::SceneSetup other = scene;
-    other.method = scene.method == sim::SolverMethod::kDfsph ? sim::SolverMethod::kWcsph : sim::SolverMethod::kDfsph;
+    other.method = row.method;
     double r = 0.0;
     int n = 0;
-    if (Status s = Measure(other, config, 0.25 * budgetSeconds, &r, &n); s && r > r0) {
+    if (Status s = Measure(other, config, share, &r, &n); s && r > r0) {
       r0 = r;
       trial.method = other.method;
     }

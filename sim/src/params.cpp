@@ -40,7 +40,7 @@ const std::array<ParamInfo, 24> kParams = {{
      100.0, &SolverParams::pbfIterations, true, "pbf"},
     {"pbf_substeps", "", "pbf: steps per pbf_frame", 1.0, 16.0,
      &SolverParams::pbfSubsteps, true, "pbf"},
-    {"pbf_relaxation", "", "pbf: constraint-force mixing epsilon, as a fraction of the rest lattice's sum of |grad C|^2",
+    {"pbf_relaxation", "", "pbf: constraint-force mixing epsilon, as a fraction of the rest lattice's sum of squared constraint gradients",
      1e-6, 10.0, &SolverParams::pbfRelaxation, false, "pbf"},
     {"pbf_corr_k", "", "pbf: artificial pressure s_corr = -k (W(r)/W(dq))^n against clumping at the surface (0 = off)",
      0.0, 1.0, &SolverParams::pbfCorrK, false, "pbf"},

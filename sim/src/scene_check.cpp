@@ -13,6 +13,7 @@
 #include "sampling.h"
 #include "sphxr/common/host_memory.h"
 #include "sphxr/common/log.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::sim {
 namespace {
@@ -264,24 +265,30 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
   float height = 0.0f;
   for (const FluidBlock& b : scene.fluid) height = std::max(height, b.box.max.y - scene.tank.min.y);
   const float vRef = std::sqrt(2.0f * g * height);
-  const bool wcsph = scene.method == SolverMethod::kWcsph;
-  if (wcsph && vRef > 0.0f && soundSpeed < 5.0f * vRef) {
+  // What the method supports and what bounds it: its row of the solver table.
+  const SolverInfo& method = SolverInfoOf(scene.method);
+  if (method.acoustic && vRef > 0.0f && soundSpeed < 5.0f * vRef) {
     const float needB = scene.params.restDensity * 100.0f * vRef * vRef / scene.params.exponent;
     SPHXR_LOG_WARN("sound speed %.3g m/s is only %.1fx the expected flow speed sqrt(2gH) = %.3g m/s: expect density "
                    "errors above 1%% (WCSPH wants 10x); solver.stiffness >= %.3g Pa would give that",
                    soundSpeed, soundSpeed / vRef, vRef, needB);
   }
   const bool deltaSph = scene.density == DensityModel::kDeltaSph;
-  if (!wcsph && deltaSph) {
-    SPHXR_LOG_WARN("solver.density delta_sph is a WCSPH model; DFSPH sums the density (the setting is ignored)");
+  if (!method.deltaSph && deltaSph) {
+    SPHXR_LOG_WARN("solver.density delta_sph is not a model of solver.method %s, which sums the density (the setting "
+                   "is ignored)", method.name);
   }
-  if (wcsph && deltaSph && scene.reuse.enabled) {
+  if (!method.wallDensity && scene.wallPressure == SceneSetup::WallPressure::kWallDensity) {
+    SPHXR_LOG_WARN("tank.wall_pressure wall_density is not a model of solver.method %s (the walls' particles take "
+                   "Akinci's volumes)", method.name);
+  }
+  if (method.reuse && deltaSph && scene.reuse.enabled) {
     SPHXR_LOG_WARN("reuse is off under solver.density delta_sph: an integrated density cannot skip steps (use "
                    "\"summation\" for reuse)");
-  } else if (wcsph) {
+  } else if (method.reuse) {
     WarnAboutReuse(scene.reuse);
   } else if (scene.reuse.enabled) {
-    SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method dfsph (docs/design/dfsph.md)");
+    SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method %s", method.name);
   }
   for (size_t i = 0; i < scene.fluid.size(); ++i) {
     const Aabb& b = scene.fluid[i].box;
@@ -293,7 +300,7 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
     // Weak compressibility holds below Mach 0.1 (about 1 % compression); a block started at 1,000 m/s
     // compressed by 885 % without a word.
     const float speed = Length(scene.fluid[i].velocity);
-    if (speed > 0.1f * soundSpeed) {
+    if (method.acoustic && speed > 0.1f * soundSpeed) {
       SPHXR_LOG_WARN("fluid[%zu].velocity: %.3g m/s is %.2gx the sound speed %.3g m/s: expect large density errors "
                      "(WCSPH wants below 0.1x; raise solver.stiffness or lower the speed)",
                      i, speed, speed / soundSpeed, soundSpeed);

@@ -36,6 +36,7 @@ struct SolverInfo {
   bool deltaSph;     // solver.density "delta_sph"
   bool reuse;        // activity-based reuse (Huang et al. 2013, §3.3)
   bool wallContact;  // tank.wall_contact (stages/contact.h)
+  bool acoustic;     // its step and its compression follow the sound speed (the scene check's Mach warnings)
   /// Its stable step for the current state, solver.max_dt included (solver.fixed_dt is clamped to it).
   float (*stableDt)(const StableDtInput& in);
   std::span<const SolverStat> stats;  // what its steps report, in the stats CSV's order
