@@ -1,7 +1,7 @@
 #pragma once
 // The interface between the Solver (host logic: validation, time step, statistics) and a backend
-// (where the particle arrays live and the stages run). Both backends are instances of the one template
-// in backend_impl.h.
+// (where the particle arrays live, the stages run and the method's pressure solver steps). Every
+// backend is an instance of the one template in backend_impl.h.
 #include <functional>
 #include <memory>
 
@@ -29,8 +29,9 @@ class Backend {
  public:
   virtual ~Backend() = default;
   virtual const char* Name() const = 0;
-  /// Uploads particles, sorts the boundary once and computes its volumes (Akinci et al. 2012).
-  virtual Status Init(const GridShape& grid, const Physics& physics, const HostFluid& fluid,
+  /// Uploads particles, sorts the boundary once and computes its volumes (Akinci et al. 2012), and
+  /// makes the `method`'s pressure solver (solvers/factory.h).
+  virtual Status Init(const GridShape& grid, const Physics& physics, SolverMethod method, const HostFluid& fluid,
                       const HostBoundary& boundary) = 0;
   /// One step of size dt. Adds each stage's wall time to stageSeconds.
   virtual Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,

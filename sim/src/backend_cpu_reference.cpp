@@ -1,14 +1,15 @@
-// The CUDA backend's step on the host: backend_impl.h with backend_cuda.cu's orchestration (a work item
-// per particle over the full or compacted lists, the per-particle DensityStage and ForceStage, the
-// per-cell WallPressureStage, a traversal work item per surface vertex) on thrust's OpenMP system. No
-// machine here has a GPU, so this is how every suite exercises the code the CUDA backend runs; the
-// `cpu` backend replaces density, forces and wall pressure by the SIMD forms of cpu/ and is
-// held against this one step by step (tests/sim/backend_agreement_test.cpp). Slow: that is fine.
+// The CUDA backend's step on the host: backend_impl.h with backend_cuda.cu's launcher (launch/plain.h: a
+// work item per particle over the full or compacted lists, the per-particle DensityStage and ForceStage,
+// the per-cell WallPressureStage; a traversal work item per surface vertex) on thrust's OpenMP system.
+// Without a GPU this is how every suite exercises the code the CUDA backend runs; the `cpu` backend's
+// launcher (cpu/launcher.h) replaces density, forces and wall pressure by the SIMD forms and is held
+// against this one step by step (tests/backend/agreement_test.cpp). Slow: that is fine.
 #include <omp.h>
 #include <thrust/system/omp/execution_policy.h>
 #include <thrust/system/omp/vector.h>
 
 #include "backend_impl.h"
+#include "launch/plain.h"
 
 namespace sphxr::sim {
 namespace {
@@ -21,7 +22,7 @@ struct OmpReferenceTraits {
   static constexpr const char* kName = "cpu-reference";
   static constexpr bool kOnDevice = false;   // the mesh is host memory (CUDA's is device memory: the only difference)
   static constexpr int kTraversalRun = 1;    // as CUDA: one descent per vertex
-  static constexpr bool kSimdStages = false; // as CUDA: a work item per particle (DensityStage, ForceStage)
+  using Launcher = PlainLauncher<OmpReferenceTraits>;  // as CUDA: a work item per particle (launch/plain.h)
 };
 
 }  // namespace

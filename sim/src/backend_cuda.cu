@@ -4,6 +4,7 @@
 #include <thrust/system/cuda/vector.h>
 
 #include "backend_impl.h"
+#include "launch/plain.h"
 
 namespace sphxr::sim {
 namespace {
@@ -26,7 +27,7 @@ struct CudaTraits {
   static constexpr const char* kName = "cuda";
   static constexpr bool kOnDevice = true;  // where the surface mesh lives
   static constexpr int kTraversalRun = 1;  // one descent per vertex: a thread each
-  static constexpr bool kSimdStages = false;  // a thread per particle (DensityStage, ForceStage)
+  using Launcher = PlainLauncher<CudaTraits>;  // a thread per particle (launch/plain.h)
 };
 
 }  // namespace

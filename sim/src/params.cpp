@@ -3,11 +3,12 @@
 
 #include "sampling.h"
 #include "sphxr/sim/params.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::sim {
 namespace {
 
-const std::array<ParamInfo, 15> kParams = {{
+const std::array<ParamInfo, 23> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
     {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
@@ -24,14 +25,29 @@ const std::array<ParamInfo, 15> kParams = {{
     {"fixed_dt", "s", "fixed time step (0 = adaptive); clamped to the stability limit", 0.0, 0.1,
      &SolverParams::fixedDt},
     {"density_tolerance", "%", "dfsph: the density solve stops at this mean compression", 1e-5, 10.0,
-     &SolverParams::densityTolerance},
+     &SolverParams::densityTolerance, false, "dfsph"},
     {"divergence_tolerance", "%", "dfsph: the divergence solve stops at this mean compression per step", 1e-5, 100.0,
-     &SolverParams::divergenceTolerance},
-    {"min_iterations", "", "dfsph: density solve iterations at least", 0.0, 1000.0, &SolverParams::minIterations, true},
+     &SolverParams::divergenceTolerance, false, "dfsph"},
+    {"min_iterations", "", "dfsph: density solve iterations at least", 0.0, 1000.0, &SolverParams::minIterations, true,
+     "dfsph"},
     {"max_iterations", "", "dfsph: density solve iterations at most (reaching it is a warning; 0 = no density solve)", 0.0, 10000.0,
-     &SolverParams::maxIterations, true},
+     &SolverParams::maxIterations, true, "dfsph"},
     {"max_divergence_iterations", "", "dfsph: divergence solve iterations at most (0 = no divergence solve)", 0.0,
-     10000.0, &SolverParams::maxDivergenceIterations, true},
+     10000.0, &SolverParams::maxDivergenceIterations, true, "dfsph"},
+    {"pbf_iterations", "", "pbf: Jacobi iterations of the density constraint per step (the cost is fixed by it)", 1.0,
+     100.0, &SolverParams::pbfIterations, true, "pbf"},
+    {"pbf_substeps", "", "pbf: steps per max_dt (in the window and the headset: per displayed frame)", 1.0, 16.0,
+     &SolverParams::pbfSubsteps, true, "pbf"},
+    {"pbf_relaxation", "", "pbf: constraint-force mixing epsilon, as a fraction of the rest lattice's sum of |grad C|^2",
+     1e-6, 10.0, &SolverParams::pbfRelaxation, false, "pbf"},
+    {"pbf_corr_k", "", "pbf: artificial pressure s_corr = -k (W(r)/W(dq))^n against clumping at the surface (0 = off)",
+     0.0, 1.0, &SolverParams::pbfCorrK, false, "pbf"},
+    {"pbf_corr_n", "", "pbf: the artificial pressure's exponent n", 1.0, 8.0, &SolverParams::pbfCorrN, true, "pbf"},
+    {"pbf_corr_dq", "", "pbf: the artificial pressure's dq, in kernel support radii", 0.01, 0.9, &SolverParams::pbfCorrDq,
+     false, "pbf"},
+    {"pbf_xsph", "", "pbf: XSPH viscosity c (0 = none)", 0.0, 1.0, &SolverParams::pbfXsph, false, "pbf"},
+    {"pbf_max_speed", "m/s", "pbf: speeds are capped here (a safety net against a runaway correction)", 0.01, 1000.0,
+     &SolverParams::pbfMaxSpeed, false, "pbf"},
 }};
 
 const std::array<ReuseParamInfo, 6> kReuseParams = {{
@@ -50,17 +66,6 @@ const std::array<ReuseParamInfo, 6> kReuseParams = {{
 
 std::span<const ParamInfo> SolverParamInfos() { return kParams; }
 std::span<const ReuseParamInfo> ReuseParamInfos() { return kReuseParams; }
-
-const char* SolverMethodName(SolverMethod method) {
-  return method == SolverMethod::kDfsph ? "dfsph" : "wcsph";
-}
-
-bool ParseSolverMethod(const std::string& text, SolverMethod* out) {
-  if (text == "wcsph") *out = SolverMethod::kWcsph;
-  else if (text == "dfsph") *out = SolverMethod::kDfsph;
-  else return false;
-  return true;
-}
 
 const char* DensityModelName(DensityModel model) {
   return model == DensityModel::kDeltaSph ? "delta_sph" : "summation";
@@ -89,7 +94,7 @@ ParticleCounts CountParticles(const SceneSetup& scene) {
   for (const RigidBodySetup& b : scene.bodies) c.bodyParticles += static_cast<int64_t>(b.points.size());
   c.reuse = scene.reuse.enabled;
   c.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity;
-  c.dfsph = scene.method == SolverMethod::kDfsph;
+  c.solverBytesPerFluid = SolverInfoOf(scene.method).bytesPerFluid(c.neighbourSlots);
   return c;
 }
 
@@ -104,12 +109,10 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
   // 4 ranges of 4 B and the near-boundary flag per cell; with bodies their 2 ranges and near flag (9),
   // with wall_density the wall-cell list's first size (4), with reuse the cells' counts and crowding (8). Bodies'
   // own particles: body frame, index and alpha (24), sorted world copies of position, velocity and
-  // force (48), keys, order and owner (12). DFSPH (sim/src/dfsph_solver.h): a kernel gradient per
-  // neighbour slot (12), the boundary terms (16), factor, increment, neighbour count and the two
-  // stiffnesses (20), the step's start velocity (16) and the error terms (8).
+  // force (48), keys, order and owner (12). The pressure solver's own arrays: its row of the solver table.
   const int64_t perFluid = 68 + 8 + 28 + 8 + 4 + 68 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 12 : 0) +
                            (counts.bodyParticles > 0 ? 4 : 0) +
-                           (counts.dfsph ? 12 * counts.neighbourSlots + 16 + 20 + 16 + 8 : 0);
+                           counts.solverBytesPerFluid;
   const int64_t perBoundary = 16 + 40 + 16 + (counts.wallDensity ? 4 : 0);
   const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0) + (counts.reuse ? 8 : 0);
   return counts.fluid * perFluid + counts.boundary * perBoundary + counts.gridCells * perCell +

@@ -39,19 +39,14 @@ class ProbeArrays {
     if (!out->empty()) thrust::copy(m_out.begin(), m_out.end(), out->begin());
   }
 
-  void Evaluate(const GridView& grid, const FluidView& fluid, const Physics& physics) {
+  /// One work item per probe, run by the backend's launcher (`Few`: the CPU runs them on the calling thread).
+  template <class Launcher>
+  void Evaluate(const GridView& grid, const FluidView& fluid, const Physics& physics, Launcher& launch) {
     const int points = static_cast<int>(m_points.size());
     const int items = points + static_cast<int>(m_lines.size());
     const ProbeStage stage{grid,          fluid, physics, thrust::raw_pointer_cast(m_points.data()), points,
                            thrust::raw_pointer_cast(m_lines.data()), thrust::raw_pointer_cast(m_out.data())};
-    if constexpr (Traits::kSimdStages) {
-      // The CPU: on the calling thread. A few dozen probes are tens of microseconds of work; a parallel
-      // region for them cost more than that on a loaded machine (sphxr_bench_probes: the probes stage
-      // took 5 % of a 2-thread step, 0.5 % of a 1-thread one).
-      for (int k = 0; k < items; ++k) stage(k);
-    } else {
-      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), items, stage);
-    }
+    launch.Few(items, stage);
   }
 
  private:

@@ -257,6 +257,19 @@ float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers) {
   return static_cast<float>(lattice.Dx3() * missing / boundary);
 }
 
+float PbfRestGradientSum(const CubicSpline& kernel, float dx, float volume) {
+  const RestLattice lattice{kernel, dx, 1};
+  // |grad_j C_i|^2 = (V |grad W_ij|)^2 over the whole lattice around i (the sum of the gradients, the
+  // i = j term of the constraint's gradient, is zero at rest by symmetry).
+  const double sum = lattice.SumFluid(-lattice.reach, lattice.reach, [&](int i, int j, int k) {
+    const float r = dx * std::sqrt(static_cast<float>(i * i + j * j + k * k));
+    if (r <= 0.0f || r >= kernel.H) return 0.0;
+    const double g = static_cast<double>(volume) * r * kernel.GradFactor(r);
+    return g * g;
+  });
+  return static_cast<float>(sum);
+}
+
 float WallFluidSum(const CubicSpline& kernel, float dx) {
   const RestLattice lattice{kernel, dx, 1};
   // Seen from the boundary particle at -1: the fluid points at i >= 0 are at offsets i + 1.

@@ -39,6 +39,10 @@ float WallDensityCorrection(const CubicSpline& kernel, float dx, int layers);
 /// 4.7 % above it at 2.5 dx, where using the density factor let particles sink into the walls.
 float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers);
 
+/// PBF's constraint-force mixing scale (solvers/pbf.h): sum_j |grad_j C_i|^2 = sum_j (V |grad W_ij|)^2
+/// for a particle inside the rest lattice, in 1/m^2; the scene's pbf_relaxation is a fraction of it.
+float PbfRestGradientSum(const CubicSpline& kernel, float dx, float volume);
+
 /// sum_f W_bf for a boundary particle of the first sheet of a flat wall with the fluid's rest lattice
 /// beside it (the fluid's first layer one spacing away): the reference of the walls' own density.
 float WallFluidSum(const CubicSpline& kernel, float dx);

@@ -11,6 +11,7 @@
 #include "backend.h"
 #include "sampling.h"
 #include "sphxr/common/log.h"
+#include "sphxr/sim/solver_table.h"
 #include "scene_check.h"
 
 namespace sphxr::sim {
@@ -26,19 +27,17 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.invRestDensity = 1.0f / p.restDensity;
   ph.boundaryGamma = WallDensityCorrection(ph.kernel, p.spacing, scene.boundaryLayers);
   ph.boundaryGradScale = WallGradientCorrection(ph.kernel, p.spacing, scene.boundaryLayers) / ph.boundaryGamma;
-  // DFSPH's solve gives every wall its pressure (the boundary term of the Jacobi update): the walls' own
-  // density is a WCSPH model.
-  ph.dfsph = scene.method == SolverMethod::kDfsph;
-  ph.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity && !ph.dfsph;
+  // The models the method supports (its row of the solver table); the scene check warns about the rest.
+  const SolverInfo& method = SolverInfoOf(scene.method);
+  ph.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity && method.wallDensity;
   ph.maxNeighbours = NeighbourCapacity(p.supportFactor);
   // Moving bodies are one-sheet shells (interaction::SamplePaddle): their own flat-wall corrections.
   ph.bodyGradScale = WallGradientCorrection(ph.kernel, p.spacing, 1) / WallDensityCorrection(ph.kernel, p.spacing, 1);
   ph.bodyClearance = 0.25f * p.spacing;
   const ReuseParams& r = scene.reuse;
-  ph.continuityDensity = scene.density == DensityModel::kDeltaSph && !ph.dfsph;
-  // Reuse is WCSPH's (docs/design/dfsph.md), and holds a summation density: an integrated density
-  // cannot skip steps.
-  ph.reuseEnabled = r.enabled && !ph.dfsph && !ph.continuityDensity;
+  ph.continuityDensity = scene.density == DensityModel::kDeltaSph && method.deltaSph;
+  // Reuse holds a summation density: an integrated density cannot skip steps.
+  ph.reuseEnabled = r.enabled && method.reuse && !ph.continuityDensity;
   ph.reuseDelta1 = r.delta1;
   ph.reuseDelta2 = r.delta2;
   ph.reuseThreshold = r.threshold;
@@ -69,10 +68,9 @@ Physics MakePhysics(const SceneSetup& scene) {
     ph.obstacleMax[k] = used ? Vec3{o.max.x + inset, o.max.y + inset, o.max.z + inset} : Vec3{};
   }
   ph.contactWidth = 0.1f * p.spacing;
-  // Its potential at the clamp box stops a particle arriving at a quarter of the sound speed. WCSPH only:
-  // DFSPH's first layer rests inside the zone (its floor layer is 6.6 % dense), where the contact would
-  // carry part of the water's weight (tank_rest's layers 5.5 % light; docs/design/dfsph.md).
-  ph.contactStrength = scene.wallContact && !ph.dfsph ? 3.0f * ph.soundSpeed * ph.soundSpeed / (32.0f * ph.contactWidth) : 0.0f;
+  // Its potential at the clamp box stops a particle arriving at a quarter of the sound speed.
+  ph.contactStrength =
+      scene.wallContact && method.wallContact ? 3.0f * ph.soundSpeed * ph.soundSpeed / (32.0f * ph.contactWidth) : 0.0f;
   ph.closedTop = !scene.openTop;
   ph.volume = ph.mass / p.restDensity;
   ph.densityTolerance = 0.01f * p.densityTolerance;  // % to a fraction
@@ -80,6 +78,13 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.minIterations = static_cast<int>(p.minIterations);
   ph.maxIterations = static_cast<int>(p.maxIterations);
   ph.maxDivergenceIterations = static_cast<int>(p.maxDivergenceIterations);
+  ph.pbfIterations = static_cast<int>(p.pbfIterations);
+  ph.pbfRelaxation = p.pbfRelaxation * PbfRestGradientSum(ph.kernel, p.spacing, ph.volume);
+  ph.pbfCorrK = p.pbfCorrK;
+  ph.pbfCorrN = static_cast<int>(p.pbfCorrN);
+  ph.pbfInvCorrW = 1.0f / ph.kernel.W(p.pbfCorrDq * support);
+  ph.pbfXsph = p.pbfXsph;
+  ph.pbfMaxSpeed = p.pbfMaxSpeed;
   return ph;
 }
 
@@ -227,7 +232,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
 
   const Physics physics = MakePhysics(scene);
   if (physics.wallDensity) boundary.invReference = WallInverseReferences(scene, physics.kernel, boundary.position, 0.25f);
-  if (Status s = solver->m_backend->Init(MakeGridShape(scene), physics, fluid, boundary); !s) return s;
+  if (Status s = solver->m_backend->Init(MakeGridShape(scene), physics, scene.method, fluid, boundary); !s) return s;
   if (!scene.bodies.empty()) solver->InitBodies(physics);
   WarnAboutSettings(scene, static_cast<int64_t>(positions.size()), physics.soundSpeed);
   LogCutBlocks(scene);
@@ -241,30 +246,9 @@ float Solver::ParticleMass() const { return MakePhysics(m_scene).mass; }
 float Solver::SoundSpeed() const { return MakePhysics(m_scene).soundSpeed; }
 
 float Solver::StableDt() const {
-  const SolverParams& p = m_scene.params;
-  const float h = 0.5f * p.spacing * p.supportFactor;
-  const float c = std::sqrt(p.exponent * p.stiffness / p.restDensity);
-  float dt = p.maxDt;
   const float speed = std::max(m_last.maxSpeed, MaxBodySpeed());
-  if (m_scene.method == SolverMethod::kDfsph) {
-    // DFSPH's step follows the flow (Bender & Koschier 2017, sec. 5): no particle, fluid or paddle, moves
-    // more than cfl * h per step. The pressure is implicit, so neither the sound speed nor the
-    // acceleration limits it; the explicit viscosity still does.
-    if (speed > 0.0f) dt = std::min(dt, p.cfl * h / speed);
-    const float alpha = std::max({p.viscosity, p.boundaryViscosity, m_scene.floorViscosity});
-    if (alpha > 0.0f) dt = std::min(dt, 0.5f * h / (alpha * c));
-    return dt;
-  }
-  // Acoustic CFL condition (Monaghan 1992; Becker & Teschner 2007, sec. 5), with the fastest point of a
-  // moving body: it then moves less than cfl * h per step, so it cannot jump over fluid particles.
-  dt = std::min(dt, p.cfl * h / (c + speed));
-  // Force condition: a particle must not move more than ~h/16 per step under its acceleration.
   const float accel = std::max(m_maxAccel, Length(m_scene.gravity));
-  if (accel > 0.0f) dt = std::min(dt, 0.25f * std::sqrt(h / accel));
-  // Viscous diffusion condition for the artificial viscosity (nu ~ alpha c h / 8).
-  const float alpha = std::max({p.viscosity, p.boundaryViscosity, m_scene.floorViscosity});
-  if (alpha > 0.0f) dt = std::min(dt, 0.5f * h / (alpha * c));
-  return dt;
+  return SolverInfoOf(m_scene.method).stableDt(StableDtInput{m_scene, speed, accel});
 }
 
 Status Solver::Step() {
@@ -391,16 +375,17 @@ Status Solver::Step() {
   m_last.solverDivergenceError = red.divergenceError;
   m_totals.densityIterations += red.densityIterations;
   m_totals.divergenceIterations += red.divergenceIterations;
-  if (physics.dfsph && red.densityIterations >= physics.maxIterations && red.densityError > physics.densityTolerance) {
+  if (SolverInfoOf(m_scene.method).iterationCap && red.densityIterations >= physics.maxIterations &&
+      red.densityError > physics.densityTolerance) {
     // The solve stopped short: the water is more compressed than asked this step. Named with the error
     // reached, at most once per simulated second (a hard impact hits the cap for many steps in a row).
     ++m_totals.iterationCapSteps;
     if (m_iterationWarnTime < 0.0 || m_last.time >= m_iterationWarnTime + 1.0) {
       m_iterationWarnTime = m_last.time;
-      SPHXR_LOG_WARN("dfsph: the density solve reached max_iterations = %d at t = %.4g s with a mean compression of "
+      SPHXR_LOG_WARN("%s: the density solve reached max_iterations = %d at t = %.4g s with a mean compression of "
                      "%.3g %% (density_tolerance %g %%; %lld such steps so far): raise solver.max_iterations or lower "
                      "solver.cfl",
-                     physics.maxIterations, m_last.time, 100.0 * red.densityError, 100.0 * physics.densityTolerance,
+                     SolverMethodName(m_scene.method), physics.maxIterations, m_last.time, 100.0 * red.densityError, 100.0 * physics.densityTolerance,
                      static_cast<long long>(m_totals.iterationCapSteps));
     }
   }

@@ -18,15 +18,9 @@
 #include "backend_guard.h"
 #include "surface_extractor.h"
 #include "surface_stages.h"
+#include "store/raw.h"
 
 namespace sphxr::sim {
-
-/// The raw pointer to a thrust vector's elements (host or device; const stays const), for the stages'
-/// plain views. Shared by the step's and the surface's launchers.
-template <class V>
-auto Raw(V& v) {
-  return thrust::raw_pointer_cast(v.data());
-}
 
 /// The particles as the field stage reads them: sorted positions and a neighbour grid built for them.
 struct SurfaceParticles {

@@ -197,14 +197,21 @@ struct Physics {
   float contactWidth;
   float contactStrength;
   bool closedTop;
-  // DFSPH (dfsph_solver.h); unused by WCSPH.
-  bool dfsph;                   // SolverMethod::kDfsph
   float volume;                 // m / rho0, each fluid particle's rest volume
+  // dfsph (solvers/dfsph.h)
   float densityTolerance;       // mean compression (fraction) at which the density solve stops
   float divergenceTolerance;    // mean compression per step (fraction) at which the divergence solve stops
   int minIterations;
   int maxIterations;
   int maxDivergenceIterations;  // 0: no divergence solve
+  // pbf (solvers/pbf.h)
+  int pbfIterations;
+  float pbfRelaxation;          // epsilon, absolute (the relative scene value times the rest lattice's sum)
+  float pbfCorrK;
+  int pbfCorrN;
+  float pbfInvCorrW;            // 1 / W(dq)
+  float pbfXsph;
+  float pbfMaxSpeed;
 };
 
 }  // namespace sphxr::sim

@@ -24,21 +24,32 @@ struct SolverParams {
   float cfl = 0.4f;                // CFL number for the adaptive time step
   float maxDt = 2e-3f;             // s, upper bound of the adaptive step
   float fixedDt = 0.0f;            // s, 0 = adaptive; a fixed step above the CFL limit is clamped
-  // DFSPH (Bender & Koschier 2017) stopping rules; SPlisHSPlasH's defaults. Unused by WCSPH.
+  // dfsph (Bender & Koschier 2017): the solves' stopping rules; SPlisHSPlasH's defaults.
   float densityTolerance = 0.01f;    // %, mean compression at which the density solve stops
   float divergenceTolerance = 0.1f;  // %, mean compression rate (per step) at which the divergence solve stops
   float minIterations = 2.0f;        // density solve iterations at least
   float maxIterations = 100.0f;      // density solve iterations at most (then a warning)
   float maxDivergenceIterations = 100.0f;  // divergence solve iterations at most
+  // pbf (Macklin & Müller 2013): the constraint solve and its corrections; the paper's values.
+  float pbfIterations = 4.0f;    // Jacobi iterations of the density constraint per step
+  float pbfSubsteps = 1.0f;      // steps per solver.max_dt (per displayed frame in the window and headset)
+  float pbfRelaxation = 0.01f;   // constraint-force mixing epsilon, relative to the rest lattice's sum |grad C|^2
+  float pbfCorrK = 0.1f;         // artificial pressure s_corr = -k (W(r) / W(dq))^n
+  float pbfCorrN = 4.0f;
+  float pbfCorrDq = 0.2f;        // dq in kernel support radii
+  float pbfXsph = 0.01f;         // XSPH viscosity c
+  float pbfMaxSpeed = 20.0f;     // m/s, the velocity cap (a safety net)
 };
 
 /// The pressure solver (`solver.method` in a scene, a name, never a number).
 enum class SolverMethod {
   kWcsph,  // weakly compressible SPH, Tait equation of state (Becker & Teschner 2007): the paper's
   kDfsph,  // divergence-free SPH (Bender & Koschier 2015, 2017): a step set by the flow speed
+  kPbf,    // position-based fluids (Macklin & Müller 2013): a fixed cost per displayed frame
 };
+/// The method's name in its row of the solver table (sphxr/sim/solver_table.h).
 const char* SolverMethodName(SolverMethod method);
-/// Parses "wcsph" | "dfsph".
+/// Parses a row's name ("wcsph", "dfsph", "pbf").
 bool ParseSolverMethod(const std::string& text, SolverMethod* out);
 
 /// How WCSPH finds each particle's density (`solver.density`, a name). kSummation: rho_i = sum_j m W_ij
@@ -58,6 +69,9 @@ struct ParamInfo {
   double min, max;    // inclusive valid range
   float SolverParams::*member;
   bool integer = false;  // a count (iterations): whole numbers only
+  /// The solver it belongs to (its row of the solver table: the panel shows it with that method, the
+  /// scene check warns when it is set under another); nullptr: every solver reads it.
+  const char* method = nullptr;
 };
 
 /// The table of solver parameters (same order as SolverParams).
@@ -158,7 +172,7 @@ struct ParticleCounts {
   int64_t bodyParticles = 0;   // of the moving bodies (paddles)
   bool reuse = false;          // the compacted list of computing particles, the cells' crowding
   bool wallDensity = false;    // the walls' own pressure and the list of wall cells
-  bool dfsph = false;          // DFSPH's per-particle solve terms and kernel-gradient cache
+  int64_t solverBytesPerFluid = 0;  // the pressure solver's own arrays (SolverInfo::bytesPerFluid)
 };
 ParticleCounts CountParticles(const SceneSetup& scene);
 

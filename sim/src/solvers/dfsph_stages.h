@@ -1,42 +1,27 @@
 #pragma once
-// Divergence-free SPH (Bender & Koschier, "Divergence-free smoothed particle hydrodynamics", SCA 2015;
-// "Divergence-free SPH for incompressible and highly viscous fluids", TVCG 2017 [BK17]): the pressure
-// solver whose step follows the flow speed instead of the sound speed. One source for both backends:
-// the stages are host+device functors, DfsphSolver<Traits> launches them (backend_impl.h calls it).
+// The stages of divergence-free SPH (Bender & Koschier, "Divergence-free smoothed particle
+// hydrodynamics", SCA 2015; "Divergence-free SPH for incompressible and highly viscous fluids", TVCG 2017
+// [BK17]), host+device functors for both backends; their order is DfsphSolver::Step (solvers/dfsph.h).
 //
-// The step, after the shared cells, sort, grid and moving bodies (backend_impl.h):
-//   1. density      rho_i = sum_j m W_ij + sum_b Psi_b W_ib and the neighbour lists (DensityStage,
-//                   the same stage as WCSPH's; its Tait pressure is not used)            [BK17 eq. 1]
-//   2. factor       G_ij = V grad W_ij for every neighbour slot (cached: positions do not move
-//                   until the drift), the boundary terms gB_i = sum_b V_b grad W_ib and
-//                   sB_i = sum_b V_b v_b . grad W_ib, and alpha_i = 1 / ((sum_j G_ij + gB_i) .
-//                   (sum_j G_ij + 2 gB_i) + sum_j |G_ij|^2) (walls mirrored, below), in the
-//                   density-ratio form (rho^ = rho / rho0)                               [BK17 eq. 11]
-//   3. divergence   Jacobi iterations on D rho^_i/Dt = sum_j (v_i - v_j) . G_ij +
-//                   v_i . gB_i - sB_i until its mean over the fluid, times dt, is below
-//                   divergence_tolerance                                         [BK17 §4.2, alg. 2]
-//   4. forces       viscosity and gravity: the WCSPH force stage with every pressure zero, v* = v + dt a
-//   5. density      Jacobi iterations on rho^*_i = rho^_i + dt D rho^_i/Dt until the mean
-//                   compression max(0, rho^* - 1) is below density_tolerance       [BK17 §4.1, alg. 3]
-//   6. finish       pressure p_i = rho_i^2 (kappa_i + kappa^v_i) / rho0 for probes, haptics and the
-//                   paddles' reaction; acceleration = (v - v*) / dt + a; drift x += dt v, domain clamp
+//   factor       G_ij = V grad W_ij for every neighbour slot (cached: positions do not move until the
+//                drift), the boundary terms gB_i = sum_b V_b grad W_ib and sB_i = sum_b V_b v_b . grad W_ib,
+//                and alpha_i = 1 / ((sum_j G_ij + gB_i) . (sum_j G_ij + 2 gB_i) + sum_j |G_ij|^2), in the
+//                density-ratio form (rho^ = rho / rho0)                                  [BK17 eq. 11]
+//   divergence   Jacobi iterations on D rho^_i/Dt = sum_j (v_i - v_j) . G_ij + v_i . gB_i - sB_i until its
+//                mean over the fluid, times dt, is below divergence_tolerance    [BK17 §4.2, alg. 2]
+//   density      Jacobi iterations on rho^*_i = rho^_i + dt D rho^_i/Dt until the mean compression
+//                max(0, rho^* - 1) is below density_tolerance                    [BK17 §4.1, alg. 3]
+//   finish       pressure p_i = rho_i^2 (kappa_i + kappa^v_i) / rho0 for probes, haptics and the
+//                paddles' reaction; acceleration = (v - v*) / dt + a; the drift
 //
 // Each iteration is two passes: Predict (the residual of every particle and its stiffness increment
 // delta_i) and Correct (v_i -= c (sum_j (delta_i + delta_j) G_ij + 2 delta_i gB_i), c = 1/dt for the
 // density solve, 1 for the divergence solve; kappa_i += delta_i). As in the paper the residuals are
-// clamped at 0, so every increment pushes: the Jacobi iteration then cannot oscillate (a projected form
-// that let increments take pressure back diverged on the rest lattice, whose checkerboard mode an
-// undamped Jacobi step overshoots).
+// clamped at 0, so every increment pushes and the Jacobi iteration cannot oscillate.
 // Boundary particles (walls and paddles, Akinci et al. 2012) mirror the fluid particle's stiffness,
-// kappa_b = kappa_i, as the WCSPH walls mirror its pressure: the pair term is kappa_i + kappa_b =
-// 2 kappa_i, and alpha_i's diagonal follows it, (sum_j G_ij + gB_i) . (sum_j G_ij + 2 gB_i) +
-// sum_j |G_ij|^2. With kappa_i alone (SPlisHSPlasH's form) a flat wall gives half the push of the fluid
-// it replaces, and the first layer slid into the walls at rest density: still water put 12 % of its
-// particles on the domain clamp every step, and its pressure came out 7-12 % above hydrostatic.
-// The paddles enter the divergence through their velocities (sB_i).
-// There is no warm start: the clamped increments cannot take back a stiffness that a warm start
-// over-applies, so it ratchets up (still water after 1 s: pressure 2.3-4.2x hydrostatic and 4 cm/s of
-// motion starting from the last step's stiffness, 0.8-1.6x with half of it, within 1.12x without).
+// kappa_b = kappa_i, as the WCSPH walls mirror its pressure: the pair term is 2 kappa_i, and alpha_i's
+// diagonal follows it. The paddles enter the divergence through their velocities (sB_i). The solves
+// start from zero stiffness each step (no warm start; docs/design/dfsph.md says why).
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -284,103 +269,6 @@ struct DfsphFinishStage {
       fluid.acceleration[i] = a;
     }
   }
-};
-
-/// Launches the DFSPH stages on a backend's system (Traits as in backend_impl.h) and owns their arrays.
-template <class Traits>
-class DfsphSolver {
-  template <class T>
-  using Vector = typename Traits::template Vector<T>;
-
- public:
-  /// What one solve reached.
-  struct Result {
-    int iterations = 0;
-    float error = 0.0f;  // mean residual (fraction) after the last correction
-  };
-
-  /// Sizes the arrays for n particles and computes the factor and boundary terms (after the density stage).
-  void Prepare(const GridView& grid, const FluidView& fluid, const NeighbourList& list, const Physics& ph) {
-    const size_t n = static_cast<size_t>(fluid.count);
-    const size_t slots = n * static_cast<size_t>(list.maxNeighbours);
-    if (m_grad.size() != slots) m_grad.resize(slots);
-    if (m_boundary.size() != n) {
-      m_boundary.resize(n);
-      m_factor.resize(n);
-      m_neighbours.resize(n);
-      m_delta.resize(n);
-      m_error.resize(n);
-      m_velocityStart.resize(n);
-      m_kappa.resize(n);
-      m_kappaV.resize(n);
-    }
-    ForEach(fluid.count, DfsphFactorStage{grid, fluid, list, ph, View()});
-  }
-
-  /// The divergence-free solve (BK17 alg. 2), on the velocities at the start of the step.
-  Result Divergence(const GridView& grid, const FluidView& fluid, const NeighbourList& list, const Physics& ph, float dt) {
-    if (ph.maxDivergenceIterations <= 0) return {};
-    return Solve(grid, fluid, list, ph, dt, false, 0, ph.maxDivergenceIterations, ph.divergenceTolerance);
-  }
-
-  /// v* = v + dt a after the force stage.
-  void Kick(const FluidView& fluid, float dt) { ForEach(fluid.count, DfsphKickStage{fluid, View(), dt}); }
-
-  /// The density-invariance solve (BK17 alg. 3), on v*.
-  Result Density(const GridView& grid, const FluidView& fluid, const NeighbourList& list, const Physics& ph, float dt) {
-    return Solve(grid, fluid, list, ph, dt, true, ph.minIterations, ph.maxIterations, ph.densityTolerance);
-  }
-
-  /// Pressure, acceleration and (with `drift`) the drift; without it DriftStage drifts later.
-  void Finish(const FluidView& fluid, const Physics& ph, float dt, float* bodyPressureTerm, bool drift) {
-    ForEach(fluid.count, DfsphFinishStage{fluid, ph, View(), dt, bodyPressureTerm, drift});
-  }
-
-  void ZeroPressure(const FluidView& fluid) { ForEach(fluid.count, DfsphZeroPressureStage{fluid}); }
-
- private:
-  Result Solve(const GridView& grid, const FluidView& fluid, const NeighbourList& list, const Physics& ph, float dt,
-               bool density, int minIterations, int maxIterations, float tolerance) {
-    const int n = fluid.count;
-    const DfsphView view = View();
-    const float scale = density ? 1.0f / dt : 1.0f;
-    auto& kappa = density ? m_kappa : m_kappaV;
-    thrust::fill(Traits::Policy(), kappa.begin(), kappa.end(), 0.0f);
-    Result result;
-    for (;;) {
-      ForEach(n, DfsphPredictStage{grid, fluid, list, ph, view, dt, density});
-      const uint64_t sum = thrust::reduce(Traits::Policy(), m_error.begin(), m_error.end(), uint64_t{0});
-      result.error = n > 0 ? static_cast<float>(static_cast<double>(sum) / kErrorScale / n) : 0.0f;
-      if ((result.error <= tolerance && result.iterations >= minIterations) || result.iterations >= maxIterations) break;
-      ForEach(n, DfsphCorrectStage{grid, fluid, list, ph, view, scale, density});
-      ++result.iterations;
-    }
-    return result;
-  }
-
-  template <class F>
-  void ForEach(int n, const F& f) {
-    if constexpr (Traits::kSimdStages) {  // the CPU: guided chunks (backend_cpu.cpp)
-      Traits::ForEachGuided(n, 64, f);
-    } else {
-      thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), n, f);
-    }
-  }
-
-  DfsphView View() {
-    auto raw = [](auto& v) { return thrust::raw_pointer_cast(v.data()); };
-    return DfsphView{raw(m_kappa), raw(m_kappaV), raw(m_grad), raw(m_boundary), raw(m_factor), raw(m_neighbours), raw(m_delta), raw(m_error),
-                     raw(m_velocityStart)};
-  }
-
-  Vector<Vec3> m_grad;
-  Vector<Vec4> m_boundary;
-  Vector<float> m_factor;
-  Vector<int32_t> m_neighbours;
-  Vector<float> m_delta;
-  Vector<uint64_t> m_error;
-  Vector<Vec4> m_velocityStart;
-  Vector<float> m_kappa, m_kappaV;
 };
 
 }  // namespace sphxr::sim

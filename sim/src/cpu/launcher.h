@@ -1,0 +1,79 @@
+#pragma once
+// The CPU backend's launcher (backend_cpu.cpp): the calls of launch/plain.h with the SIMD forms of the
+// density, force and wall-pressure stages (cpu/stages.h) and guided OpenMP chunks. The only place where
+// the CPU's stages differ from the ones CUDA runs.
+#include <thrust/copy.h>
+#include <thrust/iterator/counting_iterator.h>
+
+#include "cpu/stages.h"
+#include "reuse_lists.h"
+#include "store/fluid_store.h"
+
+namespace sphxr::sim {
+
+template <class Traits>
+class CpuLauncher {
+  template <class T>
+  using Vector = typename Traits::template Vector<T>;
+
+ public:
+  /// The SIMD stages' loop. thrust's OpenMP for_each gives each thread one equal slice; these stages'
+  /// items cost what their neighbours and walls cost, and with reuse the compacted list puts the calm
+  /// (skipped) water in one part of the index range, so one thread waited for the other at every stage.
+  /// Guided chunks (libgomp: the remaining items over the thread count, so half the range first on 2
+  /// threads, then a quarter, ... down to `chunk` items) let the thread that finishes first take over the
+  /// rest (4-10 % faster than the equal slices, docs/design/simd_stages.md). An item writes only its own
+  /// results, so the schedule changes no number.
+  template <class F>
+  void ForEach(int n, int chunk, const F& f) {
+#pragma omp parallel for schedule(guided, chunk)
+    for (int i = 0; i < n; ++i) f(i);
+  }
+  /// On the calling thread: a few dozen probes are tens of microseconds of work, and a parallel region
+  /// for them cost more than that on a loaded machine (sphxr_bench_probes).
+  template <class F>
+  void Few(int n, const F& f) {
+    for (int k = 0; k < n; ++k) f(k);
+  }
+  /// kLanes wall particles of a cell at once (cpu/walls.h).
+  void WallPressure(const WallPressureStage& stage, int cells) { ForEach(cells, 8, WallPressureBlockStage{stage}); }
+
+  /// Density in blocks of cells (cpu/density.h), drawn from every particle or, with reuse, from the
+  /// compacted list, so that the particles that reuse take no lane (cpu/blocks.h BlockSet). The
+  /// pairs-only layout (UsePairDensityBlocks) keeps the layout before both: every particle, the lanes
+  /// that reuse masked.
+  void Density(const DensityStage& density, FluidStore<Traits>& store, ReuseLists<Traits>& reuse, const Physics& ph,
+               int computing, const uint32_t* /*list*/) {
+    const int n = density.fluid.count;
+    BlockSet set{Raw(store.Keys()), n};
+    if (computing < n && !m_pairBlocks) set = reuse.template CompactedBlocks<BlockSet>(store.Keys(), density.fluid, ph, computing);
+    m_blockStart.resize(set.count);
+    const thrust::counting_iterator<int> first(0);
+    auto end = thrust::copy_if(Traits::Policy(), first, first + set.count, m_blockStart.begin(),
+                               DensityBlockStart{density.grid, set, m_pairBlocks});
+    const int blocks = static_cast<int>(end - m_blockStart.begin());
+    const bool masked = computing < n && m_pairBlocks;
+    ForEach(blocks, 8,
+            DensityBlockStage{density, set, Raw(m_blockStart), masked ? Raw(store.Idle()) : nullptr, ph.reuseIdle,
+                              m_pairBlocks});
+  }
+
+  /// Forces in SIMD over each neighbour list (cpu/forces.h).
+  void Forces(const ForceStage& forces, int computing, const uint32_t* list) {
+    const ForceListStage stage{forces};
+    if (computing < forces.fluid.count) {
+      ForEach(computing, 32, OverList<ForceListStage>{list, stage});
+    } else {
+      ForEach(computing, 32, stage);
+    }
+  }
+
+  /// The density blocks from pairs of cells only (Backend::UsePairDensityBlocks).
+  void UsePairBlocks() { m_pairBlocks = true; }
+
+ private:
+  Vector<uint32_t> m_blockStart;  // the density blocks: first entry of each (cpu/blocks.h)
+  bool m_pairBlocks = false;
+};
+
+}  // namespace sphxr::sim
