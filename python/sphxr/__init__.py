@@ -18,7 +18,7 @@ import numpy as np
 from . import _sphxr
 from ._sphxr import Error, read_state, set_log_level
 
-__all__ = ["Run", "Error", "read_state", "set_log_level", "find_scene", "scene_dirs", "parameter_names",
+__all__ = ["Run", "Error", "read_state", "set_log_level", "find_scene", "scene_dirs", "parameter_names", "scene_info",
            "data_dir"]
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
@@ -42,6 +42,12 @@ def find_scene(name):
     """The file a scene name stands for: NAME or NAME.json in the current directory, the installed scenes,
     then the build's (a path is returned as it is)."""
     return _sphxr.find_scene(os.fspath(name), _INSTALL_DIR)
+
+
+def scene_info(scene, set=None):
+    """A scene file read (not run): path, name, run_time, run_steps, run_settle, probe_columns (the
+    --probes header, or None), dam_break_column_width (or None), parameters (with the overrides)."""
+    return _sphxr.scene_info(os.fspath(scene), _INSTALL_DIR, _assignments(set))
 
 
 def scene_dirs():

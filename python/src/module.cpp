@@ -213,6 +213,23 @@ PYBIND11_MODULE(_sphxr, m) {
       });
 
   m.def("read_state", &ReadState, py::arg("path"));
+  m.def("scene_info", [](const std::string& name, const std::string& installDir, const std::vector<std::string>& sets) {
+    sphxr::app::SceneFile scene;
+    std::string path;
+    Check(sphxr::app::FindScene(name, &path, installDir));
+    Check(sphxr::app::LoadScene(path, &scene));
+    for (const std::string& set : sets) Check(sphxr::app::SetSolverParam(&scene.setup, set));
+    py::dict d;
+    d["path"] = path;
+    d["name"] = scene.name;
+    d["run_time"] = scene.runTime;
+    d["run_steps"] = scene.runSteps;
+    d["run_settle"] = scene.runSettle;
+    d["probe_columns"] = scene.probes ? py::cast(sphxr::app::ProbeCsvHeader(scene.probes->set)) : py::none();
+    d["dam_break_column_width"] = scene.damBreak ? py::cast(scene.damBreak->columnWidth) : py::none();
+    d["parameters"] = Parameters(scene.setup);
+    return d;
+  }, py::arg("name"), py::arg("install_dir") = "", py::arg("sets") = std::vector<std::string>{});
   m.def("find_scene", [](const std::string& name, const std::string& installDir) {
     std::string path;
     Check(sphxr::app::FindScene(name, &path, installDir));
