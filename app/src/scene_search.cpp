@@ -29,10 +29,14 @@ std::string InstalledScenes() {
 }  // namespace
 
 std::vector<std::string> SceneSearchDirs(const std::string& installDir) {
-  std::vector<std::string> candidates = {".", installDir.empty() ? InstalledScenes() : installDir, SPHXR_SCENES_DIR};
+  const std::string installed = installDir.empty() ? InstalledScenes() : installDir;
+  std::error_code ec;
+  // An installed program has its own scenes: the build's source tree (compiled in, perhaps on another
+  // machine, the one a .deb was made on) is only for a program run from its build tree.
+  const bool isInstalled = !installed.empty() && fs::is_directory(installed, ec);
+  std::vector<std::string> candidates = {".", installed, isInstalled ? "" : SPHXR_SCENES_DIR};
   std::vector<std::string> dirs;
   for (const std::string& d : candidates) {
-    std::error_code ec;
     if (d.empty() || !fs::is_directory(d, ec)) continue;
     bool seen = false;
     for (const std::string& e : dirs) seen = seen || fs::equivalent(e, d, ec);
