@@ -16,7 +16,7 @@ import os
 import numpy as np
 
 from . import _sphxr
-from ._sphxr import Error, read_state, set_log_level
+from ._sphxr import Error, set_log_level
 
 __all__ = ["Run", "Error", "read_state", "set_log_level", "find_scene", "scene_dirs", "parameter_names", "scene_info",
            "data_dir"]
@@ -36,6 +36,13 @@ def data_dir():
     if os.path.isdir(installed):
         return installed
     return os.path.normpath(os.path.join(_sphxr.build_scenes_dir, "..", "tests", "data"))
+
+
+def read_state(path):
+    """A state file's contents (sphxr --save-state, Run.save_state) without running it: path, scene,
+    method, time, step, spacing, fluid, boundary, and the fluid's positions, velocities, densities,
+    pressures and ids as NumPy arrays (in the file's order; `ids` gives each row's particle)."""
+    return _sphxr.read_state(os.fspath(path))
 
 
 def find_scene(name):
