@@ -30,7 +30,7 @@ EPILOG = """grid axes:
 
 bench's trade table (docs/dev/tradeoff.md) as a sweep:
   python3 -m sphxr.sweep dam_break --time 0.19 \\
-    --grid spacing=0.004082143,0.0028575,0.002198077 \\
+    --grid spacing=0.00408214286,0.0028575,0.00219807692 \\
     --grid method,stiffness,density_tolerance=wcsph:16000:0.1,wcsph:32000:0.1,wcsph:128000:0.1,dfsph:32000:1,dfsph:32000:0.1,dfsph:32000:0.01 \\
     --out tradeoff_sweep.csv
 """
