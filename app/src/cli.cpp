@@ -300,8 +300,12 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     }
   }
 
-  // A scene by name: the current directory, the installed scenes, the build's (scene_search.cpp).
-  return FindScene(out->scenePath.empty() ? "dam_break" : out->scenePath, &out->scenePath);
+  // A scene by name: the current directory, the installed scenes, the build's (scene_search.cpp). The
+  // command line only names it: a name found nowhere stays as given, and reading it says where it was
+  // looked for (LoadSceneWithOptions).
+  const std::string name = out->scenePath.empty() ? "dam_break" : out->scenePath;
+  if (!FindScene(name, &out->scenePath)) out->scenePath = name;
+  return Status::Ok();
 }
 
 namespace {
@@ -362,7 +366,11 @@ Status CheckOutputsAreNotInputs(const Options& options, const SceneFile& scene) 
 }  // namespace
 
 Status LoadSceneWithOptions(const Options& options, SceneFile* scene) {
-  if (Status s = LoadScene(options.scenePath, scene); !s) return s;
+  if (Status s = LoadScene(options.scenePath, scene); !s) {
+    std::string path;
+    if (Status where = FindScene(options.scenePath, &path); !where) return where;  // a name found nowhere
+    return s;
+  }
   if (Status s = CheckOutputsAreNotInputs(options, *scene); !s) return s;
   // A preset from the command line replaces the scene's reuse parameters; --set reuse.* then overrides.
   if (!options.reusePreset.empty()) sim::ApplyReusePreset(options.reusePreset, &scene->setup.reuse);
