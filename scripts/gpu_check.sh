@@ -6,7 +6,10 @@
 # GPU, so this is where the CUDA backend first runs: it measures instead of setting up.
 #
 # Exit status: 0 all agreed; 1 a build failure, or an agreement test failed (a disagreement); 2 no GPU.
-# Environment: BUILD_DIR (default build-gpu), JOBS (default all cores).
+# Environment: BUILD_DIR (default build-gpu), JOBS (default all cores), PREBUILT=1 (use BUILD_DIR as it
+# is: a tree built elsewhere for this GPU's architecture, for a machine without the build's packages;
+# scripts/gpu_prebuilt.sh), LOGS (the logs' folder; default a fresh temporary one), PHASE_LIMIT_S (the
+# longest any one phase may run, default 1800 s: the agreement suite, each benchmark).
 set -u
 cd "$(dirname "$0")/.."
 
@@ -17,7 +20,9 @@ fi
 
 build=${BUILD_DIR:-build-gpu}
 jobs=${JOBS:-$(nproc)}
-logs=$(mktemp -d)
+logs=${LOGS:-$(mktemp -d)}
+mkdir -p "$logs"
+limit=${PHASE_LIMIT_S:-1800}
 gpu=$(nvidia-smi --query-gpu=name --format=csv,noheader | head -n 1)
 driver=$(nvidia-smi --query-gpu=driver_version --format=csv,noheader | head -n 1)
 arch=$(nvidia-smi --query-gpu=compute_cap --format=csv,noheader | head -n 1 | tr -d '.')
@@ -28,7 +33,12 @@ if command -v ccache >/dev/null 2>&1; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_CUDA_COMPILER_LAUNCHER=ccache)
 fi
 # This GPU's architecture only (the release preset builds five), with the CUDA backend required.
-if ! cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSPHXR_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES="$arch" \
+if [ "${PREBUILT:-0}" = 1 ]; then
+  for t in tests/sphxr_gpu_tests tests/sphxr_backend_tests bench/sphxr_bench_perf; do
+    if [ ! -x "$build/$t" ]; then echo "gpu_check: PREBUILT=1 but $build/$t is missing"; exit 1; fi
+  done
+  echo "gpu_check: using the prebuilt tree $build"
+elif ! cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSPHXR_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES="$arch" \
        "${launcher[@]}" >"$logs/configure.log" 2>&1 ||
    ! cmake --build "$build" -j "$jobs" --target sphxr sphxr_gpu_tests sphxr_backend_tests sphxr_bench_perf \
        sphxr_bench_surface sphxr_bench_frame >"$logs/build.log" 2>&1; then
@@ -37,14 +47,14 @@ if ! cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSPHXR_CUDA=ON 
 fi
 
 # 1. Agreement (the tests print one "[agreement] ..." line each with their worst differences).
-ctest --test-dir "$build" -L gpu -V --timeout 1800 >"$logs/agreement.log" 2>&1
+timeout "$limit" ctest --test-dir "$build" -L gpu -V --timeout "$limit" >"$logs/agreement.log" 2>&1
 agreement=$?
 skipped=$(grep -c "Skipped" "$logs/agreement.log" || true)
 
 # 2. Timings on CUDA (the benchmarks report; they never fail on a time).
-"$build/bench/sphxr_bench_perf" --device cuda --csv "$logs/perf.csv" >"$logs/perf.log" 2>&1 || echo "gpu_check: sphxr_bench_perf failed (see $logs/perf.log)"
-"$build/bench/sphxr_bench_surface" --device cuda --csv "$logs/surface.csv" >"$logs/surface.log" 2>&1 || echo "gpu_check: sphxr_bench_surface failed (see $logs/surface.log)"
-"$build/bench/sphxr_bench_frame" --device cuda >"$logs/frame.log" 2>&1 || echo "gpu_check: sphxr_bench_frame failed (see $logs/frame.log; it needs EGL)"
+timeout "$limit" "$build/bench/sphxr_bench_perf" --device cuda --csv "$logs/perf.csv" >"$logs/perf.log" 2>&1 || echo "gpu_check: sphxr_bench_perf failed (see $logs/perf.log)"
+timeout "$limit" "$build/bench/sphxr_bench_surface" --device cuda --csv "$logs/surface.csv" >"$logs/surface.log" 2>&1 || echo "gpu_check: sphxr_bench_surface failed (see $logs/surface.log)"
+timeout "$limit" "$build/bench/sphxr_bench_frame" --device cuda >"$logs/frame.log" 2>&1 || echo "gpu_check: sphxr_bench_frame failed (see $logs/frame.log; it needs EGL)"
 
 # 3. One table.
 python3 - "$logs" "$gpu" "$driver" "$agreement" "$skipped" <<'EOF'

@@ -115,6 +115,7 @@ class BackendImpl final : public Backend {
       clock = std::chrono::steady_clock::now();
       return s;
     };
+    m_solver->BeforeGrid(m_fluid.View(), physics, dt);
     // 1. the grid: cell codes, the Z-order sort of every field, the cells' ranges (Huang et al. 2013, §3.1)
     m_fluid.CellCodes(View());
     SPHXR_TRY(lap(Stage::kCells));

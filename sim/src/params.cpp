@@ -8,7 +8,7 @@
 namespace sphxr::sim {
 namespace {
 
-const std::array<ParamInfo, 23> kParams = {{
+const std::array<ParamInfo, 24> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
     {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
@@ -34,9 +34,11 @@ const std::array<ParamInfo, 23> kParams = {{
      &SolverParams::maxIterations, true, "dfsph"},
     {"max_divergence_iterations", "", "dfsph: divergence solve iterations at most (0 = no divergence solve)", 0.0,
      10000.0, &SolverParams::maxDivergenceIterations, true, "dfsph"},
+    {"pbf_frame", "s", "pbf: the displayed frame it advances by, in pbf_substeps steps (pbf ignores max_dt and cfl)",
+     1e-4, 0.1, &SolverParams::pbfFrame, false, "pbf"},
     {"pbf_iterations", "", "pbf: Jacobi iterations of the density constraint per step (the cost is fixed by it)", 1.0,
      100.0, &SolverParams::pbfIterations, true, "pbf"},
-    {"pbf_substeps", "", "pbf: steps per max_dt (in the window and the headset: per displayed frame)", 1.0, 16.0,
+    {"pbf_substeps", "", "pbf: steps per pbf_frame", 1.0, 16.0,
      &SolverParams::pbfSubsteps, true, "pbf"},
     {"pbf_relaxation", "", "pbf: constraint-force mixing epsilon, as a fraction of the rest lattice's sum of |grad C|^2",
      1e-6, 10.0, &SolverParams::pbfRelaxation, false, "pbf"},

@@ -79,11 +79,18 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.maxIterations = static_cast<int>(p.maxIterations);
   ph.maxDivergenceIterations = static_cast<int>(p.maxDivergenceIterations);
   ph.pbfIterations = static_cast<int>(p.pbfIterations);
-  ph.pbfRelaxation = p.pbfRelaxation * PbfRestGradientSum(ph.kernel, p.spacing, ph.volume);
-  ph.pbfCorrK = p.pbfCorrK;
+  // The constraint's scale D0 = sum_k |grad_k C_i|^2 of the rest lattice (1/m^2): epsilon and s_corr are
+  // given relative to it, so that they mean the same at every spacing (MM13's 600 and 0.1 are in its own
+  // units; s_corr enters beside lambda, whose scale is 1/D0).
+  const float d0 = PbfRestGradientSum(ph.kernel, p.spacing, ph.volume);
+  ph.pbfRelaxation = p.pbfRelaxation * d0;
+  ph.pbfCorrK = p.pbfCorrK / d0;
   ph.pbfCorrN = static_cast<int>(p.pbfCorrN);
   ph.pbfInvCorrW = 1.0f / ph.kernel.W(p.pbfCorrDq * support);
   ph.pbfXsph = p.pbfXsph;
+  // The collision response keeps a particle its radius (half a spacing, where the sampling puts the
+  // first layer) from a face: a quarter spacing beyond the clamp box's quarter-spacing inset.
+  ph.pbfContact = 0.25f * p.spacing;
   ph.pbfMaxSpeed = p.pbfMaxSpeed;
   return ph;
 }

@@ -44,18 +44,18 @@ float DfsphStableDt(const StableDtInput& in) {
   return std::min(dt, ViscosityDt(in.scene));
 }
 
-/// PBF: unconditionally stable (Macklin & Müller 2013): pbf_substeps steps per solver.max_dt (the
-/// window and the headset set max_dt to the displayed frame's period); the viscosity is XSPH's.
-float PbfStableDt(const StableDtInput& in) { return in.scene.params.maxDt / in.scene.params.pbfSubsteps; }
+/// PBF: no stability bound from the sound speed or the flow (Macklin & Müller 2013): pbf_substeps steps
+/// per pbf_frame, the displayed frame; the viscosity is XSPH's.
+float PbfStableDt(const StableDtInput& in) { return in.scene.params.pbfFrame / in.scene.params.pbfSubsteps; }
 
 int64_t NoBytes(int64_t) { return 0; }
 /// sim/src/solvers/dfsph.h: a kernel gradient per neighbour slot (12), the boundary terms (16), factor,
 /// increment, neighbour count and the two stiffnesses (20), the step's start velocity (16) and the
 /// error terms (8).
 int64_t DfsphBytes(int64_t slots) { return 12 * slots + 16 + 20 + 16 + 8; }
-/// sim/src/solvers/pbf.h: the step's start positions (16), lambda (4), the position corrections (16),
-/// the boundary's correction share (16) and the vorticity (16).
-int64_t PbfBytes(int64_t) { return 16 + 4 + 16 + 16 + 16; }
+/// sim/src/solvers/pbf.h: lambda and its sum over the step (8), the position corrections (16); the
+/// step's start positions live in the acceleration field.
+int64_t PbfBytes(int64_t) { return 4 + 4 + 16; }
 
 constexpr std::array<SolverStat, 4> kDfsphStats = {SolverStat::kDensityIterations, SolverStat::kDivergenceIterations,
                                                    SolverStat::kDensityError, SolverStat::kDivergenceError};

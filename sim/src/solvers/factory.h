@@ -3,7 +3,7 @@
 #include <memory>
 
 #include "solvers/dfsph.h"
-// #include "solvers/pbf.h"
+#include "solvers/pbf.h"
 #include "solvers/wcsph.h"
 
 namespace sphxr::sim {
@@ -13,7 +13,7 @@ std::unique_ptr<PressureSolver<Traits>> MakePressureSolver(SolverMethod method) 
   switch (method) {
     case SolverMethod::kWcsph: return std::make_unique<WcsphSolver<Traits>>();
     case SolverMethod::kDfsph: return std::make_unique<DfsphSolver<Traits>>();
-    case SolverMethod::kPbf: return nullptr;
+    case SolverMethod::kPbf: return std::make_unique<PbfSolver<Traits>>();
   }
   return nullptr;
 }

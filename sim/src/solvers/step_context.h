@@ -93,9 +93,11 @@ class StepContext {
   void Forces() { Forces(physics); }
   /// The fluid's force on every body particle, from BodyPressureTerm; `gradScale`: the flat-wall
   /// gradient correction of the body's term (WCSPH's; 1 for a solver consistent with its boundary).
-  void BodyReaction(float gradScale) {
+  /// `viscous`: with the artificial viscosity's wall term (the solvers whose force stage applied it).
+  void BodyReaction(float gradScale, bool viscous = true) {
     Physics reaction = physics;
     reaction.bodyGradScale = gradScale;
+    if (!viscous) reaction.soundSpeed = 0.0f;
     m_s.bodies.React(grid, fluid, reaction);
   }
   /// The pressure sensors and level gauges on the current state (probe_arrays.h).
@@ -131,6 +133,9 @@ class PressureSolver {
   /// One step of ctx.dt, after the grid and the bodies' placement; leaves every particle integrated
   /// (positions, velocities, accelerations with the clamp flags of stages/integrate.h).
   virtual Status Step(StepContext<Traits>& ctx) = 0;
+  /// Before the step's grid, on the particles in their last order: a solver that searches its
+  /// neighbours at predicted positions moves the particles there (PBF); the others do nothing.
+  virtual void BeforeGrid(const FluidView& /*fluid*/, const Physics& /*physics*/, float /*dt*/) {}
 };
 
 /// `if (Status s = expr; !s) return s;` for a solver's stage list.

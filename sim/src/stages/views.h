@@ -207,11 +207,13 @@ struct Physics {
   // pbf (solvers/pbf.h)
   int pbfIterations;
   float pbfRelaxation;          // epsilon, absolute (the relative scene value times the rest lattice's sum)
-  float pbfCorrK;
+  float pbfCorrK;               // m^2: k over the rest lattice's sum |grad C|^2 (s_corr enters beside lambda)
   int pbfCorrN;
   float pbfInvCorrW;            // 1 / W(dq)
   float pbfXsph;
   float pbfMaxSpeed;
+  float pbfContact;             // m: the collision response's distance beyond the clamp box (the
+                                // particle radius, half a spacing from a face, less the clamp's inset)
 };
 
 }  // namespace sphxr::sim

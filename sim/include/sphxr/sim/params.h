@@ -30,10 +30,12 @@ struct SolverParams {
   float minIterations = 2.0f;        // density solve iterations at least
   float maxIterations = 100.0f;      // density solve iterations at most (then a warning)
   float maxDivergenceIterations = 100.0f;  // divergence solve iterations at most
-  // pbf (Macklin & Müller 2013): the constraint solve and its corrections; the paper's values.
-  float pbfIterations = 4.0f;    // Jacobi iterations of the density constraint per step
-  float pbfSubsteps = 1.0f;      // steps per solver.max_dt (per displayed frame in the window and headset)
-  float pbfRelaxation = 0.01f;   // constraint-force mixing epsilon, relative to the rest lattice's sum |grad C|^2
+  // pbf (Macklin & Müller 2013): the constraint solve and its corrections (docs/design/pbf.md says why
+  // these values: the least work that holds a 20-spacing column at rest at 90 Hz).
+  float pbfFrame = 1.0f / 90.0f; // s: the displayed frame the solver advances by (max_dt is WCSPH's/DFSPH's)
+  float pbfIterations = 3.0f;    // Jacobi iterations of the density constraint per step
+  float pbfSubsteps = 3.0f;      // steps per pbf_frame
+  float pbfRelaxation = 1.0f;    // constraint-force mixing epsilon, relative to the rest lattice's sum |grad C|^2
   float pbfCorrK = 0.1f;         // artificial pressure s_corr = -k (W(r) / W(dq))^n
   float pbfCorrN = 4.0f;
   float pbfCorrDq = 0.2f;        // dq in kernel support radii

@@ -1,0 +1,89 @@
+#pragma once
+// Position-based fluids (Macklin & Müller, "Position Based Fluids", ACM TOG 32(4), SIGGRAPH 2013
+// [MM13]): the real-time solver. A fixed number of Jacobi iterations of the density constraint on
+// predicted positions per step, so a step costs the same at any speed and the water can advance by
+// one displayed frame per step (docs/design/pbf.md). The stages: solvers/pbf_stages.h.
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform_reduce.h>
+
+#include "solvers/pbf_stages.h"
+#include "solvers/step_context.h"
+
+namespace sphxr::sim {
+
+template <class Traits>
+class PbfSolver final : public PressureSolver<Traits> {
+  template <class T>
+  using Vector = typename Traits::template Vector<T>;
+
+ public:
+  /// 1. predict: v* = v + dt g, x* = x + dt v* (before the grid: it is built at x*)     [MM13 alg. 1]
+  void BeforeGrid(const FluidView& fluid, const Physics& ph, float dt) override {
+    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), fluid.count, PbfPredictStage{fluid, ph, dt});
+  }
+
+  Status Step(StepContext<Traits>& ctx) override {
+    const Physics& ph = ctx.physics;
+    ctx.computing = ctx.n;
+    Size(ctx.n);
+    // 2. the neighbour lists at x* (the density stage; its Tait pressure is not used)
+    ctx.Density();
+    SPHXR_TRY(ctx.Lap(Stage::kDensity));
+    // 3. pbf_iterations Jacobi iterations of the density constraint                 [MM13 eq. 9-13]
+    const NeighbourList list = ctx.Neighbours();
+    const PbfView view = View();
+    thrust::fill(Traits::Policy(), m_lambdaSum.begin(), m_lambdaSum.end(), 0.0f);
+    for (int k = 0; k < ph.pbfIterations; ++k) {
+      ctx.Launch().ForEach(ctx.n, 64, PbfLambdaStage{ctx.grid, ctx.fluid, list, ph, view});
+      ctx.Launch().ForEach(ctx.n, 64, PbfCorrectStage{ctx.grid, ctx.fluid, list, ph, view});
+      ctx.Map(PbfApplyStage{ctx.fluid, ph, view});
+    }
+    ctx.report.densityIterations = ph.pbfIterations;
+    const thrust::counting_iterator<int> first(0);
+    const double residual = thrust::transform_reduce(Traits::Policy(), first, first + ctx.n,
+                                                     PbfResidual{ctx.fluid, ph.invRestDensity}, 0.0, thrust::plus<double>());
+    ctx.report.densityError = ctx.n > 0 ? static_cast<float>(residual / ctx.n) : 0.0f;
+    SPHXR_TRY(ctx.Lap(Stage::kPressure));
+    // 4. velocities from the position change, the clamps, the pressure estimate            [MM13 alg. 1]
+    ctx.Map(PbfFinishStage{ctx.fluid, ph, view, ctx.dt, ctx.BodyPressureTerm()});
+    // 5. XSPH viscosity                                                                   [MM13 eq. 17]
+    if (ph.pbfXsph > 0.0f) {
+      ctx.Launch().ForEach(ctx.n, 64, PbfXsphStage{ctx.grid, ctx.fluid, list, ph, view});
+      ctx.Map(PbfXsphApplyStage{ctx.fluid, view});
+    }
+    SPHXR_TRY(ctx.Lap(Stage::kIntegrate));
+    // 6. the fluid's force on the paddles: the impulse of the corrections their particles caused
+    if (ctx.HasBodies()) {
+      ctx.BodyReaction(1.0f, /*viscous=*/false);
+      SPHXR_TRY(ctx.Lap(Stage::kBodies));
+    }
+    // 7. probes, on the state the step ends in
+    if (ctx.HasProbes()) {
+      ctx.Probes();
+      SPHXR_TRY(ctx.Lap(Stage::kProbes));
+    }
+    // 8. push the fluid out of the paddles at their end-of-step pose
+    if (ctx.HasBodies()) {
+      ctx.PushOut();
+      SPHXR_TRY(ctx.Lap(Stage::kBodies));
+    }
+    return Status::Ok();
+  }
+
+ private:
+  void Size(int n) {
+    const size_t count = static_cast<size_t>(n);
+    if (m_lambda.size() == count) return;
+    m_lambda.resize(count);
+    m_lambdaSum.resize(count);
+    m_delta.resize(count);
+  }
+  PbfView View() { return PbfView{Raw(m_lambda), Raw(m_lambdaSum), Raw(m_delta)}; }
+
+  Vector<float> m_lambda, m_lambdaSum;
+  Vector<Vec4> m_delta;
+};
+
+}  // namespace sphxr::sim

@@ -1,0 +1,280 @@
+#pragma once
+// The stages of position-based fluids (Macklin & Müller, "Position Based Fluids", ACM TOG 32(4), 2013
+// [MM13]), host+device functors for both backends; their order is PbfSolver::Step (solvers/pbf.h).
+//
+//   predict   v* = v + dt g (capped at pbf_max_speed), x* = x + dt v*; the step's start position x
+//             is kept in acceleration.xyz until the finish (the field list sorts it with the particle)
+//   lambda    rho_i = sum_j m W_ij + sum_b Psi_b W_ib at x*, C_i = max(rho_i / rho0 - 1, 0) and
+//             lambda_i = -C_i / (sum_k |grad_k C_i|^2 + eps)                   [MM13 eq. 1, 9, 11]
+//             with grad_j C_i = -V grad W_ij, grad_i C_i = V sum_j grad W_ij + sum_b (Psi_b / rho0) grad W_ib
+//             (the walls and paddles are Akinci et al. 2012's boundary particles, as everywhere)
+//   correct   dx_i = sum_j V (lambda_i + lambda_j + s_corr) grad W_ij + sum_b lambda_i (Psi_b / rho0) grad W_ib,
+//             s_corr = -k (W_ij / W(dq))^n against clumping where the kernel is cut  [MM13 eq. 12, 13]
+//   collide   x* out of the tank's faces and the obstacles by the particle's radius (half a spacing),
+//             in the prediction and after every iteration's correction                 [MM13 alg. 1]
+//   finish    v = (x* - x) / dt, the clamps, and the pressure estimate (below)           [MM13 alg. 1]
+//   xsph      v_i += c sum_j V (v_j - v_i) W_ij                                        [MM13 eq. 17]
+//
+// The pressure estimate: a step's corrections move particle i by sum over iterations of its lambda
+// terms, the displacement a pressure p_i would give in the WCSPH momentum equation over dt^2 when
+// p_i / rho_i^2 = -Lambda_i / (rho0 dt^2), Lambda_i = the sum of lambda_i over the step's iterations.
+// In still water the corrections hold each layer against gravity, so the estimate is rho0 g depth
+// there; the probes, the haptics and the paddles' reaction read it.
+#include "stages.h"
+
+namespace sphxr::sim {
+
+/// The solve's per-particle arrays (scratch of one step).
+struct PbfView {
+  float* lambda;     // this iteration's lambda_i
+  float* lambdaSum;  // Lambda_i, the step's sum
+  Vec4* delta;       // this iteration's position correction (xsph: the velocity change)
+};
+
+/// The collision response of MM13's solver loop: x* moved out of the tank's faces and the obstacles to
+/// the particle's radius from them (ph.pbfContact beyond the clamp box, whose inset is a quarter
+/// spacing). The walls' boundary particles alone are soft in the constraint: a particle pushed towards
+/// a sheet leaves its fluid neighbours behind as it nears the walls' ones, and its density rises by
+/// 2.5 % only at the clamp box (docs/design/pbf.md), too little against the corrections of a column
+/// above it. Returns whether it moved the particle (the step's clamp count does not include it).
+SPHXR_HD SPHXR_INLINE bool PbfCollide(const Physics& ph, Vec4* x) {
+  const float g = ph.pbfContact;
+  bool moved = false;
+  auto push = [&](float* c, float lo, float hi) {
+    if (*c < lo) *c = lo, moved = true;
+    if (*c > hi) *c = hi, moved = true;
+  };
+  push(&x->x, ph.domainMin.x + g, ph.domainMax.x - g);
+  push(&x->y, ph.domainMin.y + g, ph.closedTop ? ph.domainMax.y - g : ph.domainMax.y);
+  push(&x->z, ph.domainMin.z + g, ph.domainMax.z - g);
+  for (int k = 0; k < ph.obstacleCount; ++k) {
+    const Vec3 lo{ph.obstacleMin[k].x - g, ph.obstacleMin[k].y - g, ph.obstacleMin[k].z - g};
+    const Vec3 hi{ph.obstacleMax[k].x + g, ph.obstacleMax[k].y + g, ph.obstacleMax[k].z + g};
+    if (!(x->x > lo.x && x->x < hi.x && x->y > lo.y && x->y < hi.y && x->z > lo.z && x->z < hi.z)) continue;
+    const float depth[6] = {x->x - lo.x, hi.x - x->x, x->y - lo.y, hi.y - x->y, x->z - lo.z, hi.z - x->z};
+    int face = 0;
+    for (int f = 1; f < 6; ++f) {
+      if (depth[f] < depth[face]) face = f;
+    }
+    float* c = face < 2 ? &x->x : face < 4 ? &x->y : &x->z;
+    const Vec3 bound = (face & 1) ? hi : lo;
+    *c = face < 2 ? bound.x : face < 4 ? bound.y : bound.z;
+    moved = true;
+  }
+  return moved;
+}
+
+/// x* = x + dt (v + dt g) and its collision response, the start position in acceleration.xyz.
+/// Before the grid: the neighbour grid is built once per step, at the predicted positions.
+struct PbfPredictStage {
+  FluidView fluid;
+  Physics ph;
+  float dt;
+  SPHXR_HD void operator()(int i) const {
+    Vec4 x = fluid.position[i];
+    Vec4 v = fluid.velocity[i];
+    v.x += dt * ph.gravity.x;
+    v.y += dt * ph.gravity.y;
+    v.z += dt * ph.gravity.z;
+    const float speed2 = v.x * v.x + v.y * v.y + v.z * v.z;
+    const float cap = ph.pbfMaxSpeed;
+    if (speed2 > cap * cap) {
+      const float s = cap / sqrtf(speed2);
+      v.x *= s, v.y *= s, v.z *= s;
+    }
+    fluid.acceleration[i] = Vec4{x.x, x.y, x.z, 0.0f};
+    x.x += dt * v.x;
+    x.y += dt * v.y;
+    x.z += dt * v.z;
+    PbfCollide(ph, &x);
+    fluid.position[i] = x;
+    fluid.velocity[i] = v;
+  }
+};
+
+/// f(Psi_b, x_i - x_b) for every wall and paddle particle within the support of xi.
+template <class F>
+SPHXR_HD SPHXR_INLINE void ForEachBoundaryNear(const GridView& grid, Vec3 xi, float h2, F&& f) {
+  int cx, cy, cz;
+  grid.CellOf(xi, &cx, &cy, &cz);
+  if (grid.boundaryNear[grid.Linear(cx, cy, cz)]) {
+    ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t b, Vec3 d) {
+      if (Dot(d, d) < h2) f(grid.boundary[b].w, d);
+    });
+  }
+  if (grid.MovingNear(xi)) {
+    ForEachInCells(grid, grid.bodyStart, grid.bodyEnd, grid.body, xi, [&](uint32_t b, Vec3 d) {
+      if (Dot(d, d) < h2) f(grid.body[b].w, d);
+    });
+  }
+}
+
+/// f(j, x_i - x_j) for every other fluid particle in particle i's list (or cells, where it overflowed).
+template <class F>
+SPHXR_HD SPHXR_INLINE void ForEachOther(const GridView& grid, const FluidView& fluid, const NeighbourList& list, int i,
+                                        Vec3 xi, F&& f) {
+  const uint32_t self = static_cast<uint32_t>(i);
+  ForEachFluidNeighbour(grid, fluid, list, i, xi, [&](uint32_t j, Vec3 d) {
+    if (j != self) f(j, d);
+  });
+}
+
+struct PbfLambdaStage {
+  GridView grid;
+  FluidView fluid;
+  NeighbourList list;
+  Physics ph;
+  PbfView view;
+  SPHXR_HD void operator()(int i) const {
+    const CubicSpline k = ph.kernel;
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const float volume = ph.volume;
+    float sumW = k.W(0.0f);
+    float sum2 = 0.0f;
+    Vec3 gradI{0.0f, 0.0f, 0.0f};
+    ForEachOther(grid, fluid, list, i, xi, [&](uint32_t, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 >= k.H2) return;
+      const float r = sqrtf(r2);
+      sumW += k.W(r);
+      const Vec3 g = d * (volume * k.GradFactor(r));
+      gradI += g;
+      sum2 += Dot(g, g);
+    });
+    float sumBoundary = 0.0f;
+    const float invRho0 = ph.invRestDensity;
+    ForEachBoundaryNear(grid, xi, k.H2, [&](float psi, Vec3 d) {
+      const float r = sqrtf(Dot(d, d));
+      sumBoundary += psi * k.W(r);
+      gradI += d * (psi * invRho0 * k.GradFactor(r));
+    });
+    const float rho = ph.mass * sumW + sumBoundary;
+    fluid.density[i] = rho;
+    const float c = AtLeast(rho * invRho0 - 1.0f, 0.0f);
+    const float lambda = -c / (sum2 + Dot(gradI, gradI) + ph.pbfRelaxation);
+    view.lambda[i] = lambda;
+    view.lambdaSum[i] += lambda;
+  }
+};
+
+struct PbfCorrectStage {
+  GridView grid;
+  FluidView fluid;
+  NeighbourList list;
+  Physics ph;
+  PbfView view;
+  SPHXR_HD void operator()(int i) const {
+    const CubicSpline k = ph.kernel;
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const float li = view.lambda[i];
+    const float volume = ph.volume;
+    Vec3 dx{0.0f, 0.0f, 0.0f};
+    ForEachOther(grid, fluid, list, i, xi, [&](uint32_t j, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 >= k.H2) return;
+      const float r = sqrtf(r2);
+      float corr = 0.0f;
+      if (ph.pbfCorrK > 0.0f) {
+        const float w = k.W(r) * ph.pbfInvCorrW;
+        float p = w;
+        for (int e = 1; e < ph.pbfCorrN; ++e) p *= w;
+        corr = -ph.pbfCorrK * p;
+      }
+      dx += d * ((li + view.lambda[j] + corr) * volume * k.GradFactor(r));
+    });
+    const float invRho0 = ph.invRestDensity;
+    ForEachBoundaryNear(grid, xi, k.H2, [&](float psi, Vec3 d) {
+      dx += d * (li * psi * invRho0 * k.GradFactor(sqrtf(Dot(d, d))));
+    });
+    view.delta[i] = MakeVec4(dx);
+  }
+};
+
+/// x* += dx (after every particle's correction is known: Jacobi), then the collision response.
+struct PbfApplyStage {
+  FluidView fluid;
+  Physics ph;
+  PbfView view;
+  SPHXR_HD void operator()(int i) const {
+    Vec4 x = fluid.position[i];
+    const Vec4 d = view.delta[i];
+    x.x += d.x;
+    x.y += d.y;
+    x.z += d.z;
+    PbfCollide(ph, &x);
+    fluid.position[i] = x;
+  }
+};
+
+/// v = (x* - x) / dt after the clamps, the acceleration (v - v^n) / dt with its clamp flag, and the
+/// pressure estimate (top of the file) into pressure, pressureTerm and the bodies' reaction term.
+struct PbfFinishStage {
+  FluidView fluid;
+  Physics ph;
+  PbfView view;
+  float dt;
+  float* bodyPressureTerm;  // nullptr without bodies
+  SPHXR_HD void operator()(int i) const {
+    Vec4 x = fluid.position[i];
+    const Vec4 start = fluid.acceleration[i];
+    const Vec4 vStar = fluid.velocity[i];
+    const float inv = 1.0f / dt;
+    Vec4 v{(x.x - start.x) * inv, (x.y - start.y) * inv, (x.z - start.z) * inv, vStar.w};
+    bool clamped = ph.obstacleCount > 0 && ClampOutOfObstacles(ph, &x, &v);
+    clamped = ClampToDomain(ph, &x, &v) || clamped;
+    // v* = v^n + dt g: the step's acceleration is (v - v^n) / dt = (v - v*) / dt + g.
+    const Vec4 a{(v.x - vStar.x) * inv + ph.gravity.x, (v.y - vStar.y) * inv + ph.gravity.y,
+                 (v.z - vStar.z) * inv + ph.gravity.z, clamped ? 1.0f : 0.0f};
+    fluid.position[i] = x;
+    fluid.velocity[i] = v;
+    fluid.acceleration[i] = a;
+    const float term = -view.lambdaSum[i] * ph.invRestDensity * inv * inv;  // p_i / rho_i^2
+    const float rho = fluid.density[i];
+    fluid.pressure[i] = term * rho * rho;
+    fluid.pressureTerm[i] = term;
+    if (bodyPressureTerm) bodyPressureTerm[i] = term;
+  }
+};
+
+/// XSPH viscosity [MM13 eq. 17]: the velocity change into view.delta (applied by PbfXsphApplyStage).
+struct PbfXsphStage {
+  GridView grid;
+  FluidView fluid;
+  NeighbourList list;
+  Physics ph;
+  PbfView view;
+  SPHXR_HD void operator()(int i) const {
+    const CubicSpline k = ph.kernel;
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const Vec3 vi = Xyz(fluid.velocity[i]);
+    Vec3 dv{0.0f, 0.0f, 0.0f};
+    ForEachOther(grid, fluid, list, i, xi, [&](uint32_t j, Vec3 d) {
+      const float r2 = Dot(d, d);
+      if (r2 >= k.H2) return;
+      dv += (Xyz(fluid.velocity[j]) - vi) * k.W(sqrtf(r2));
+    });
+    view.delta[i] = MakeVec4(dv * (ph.pbfXsph * ph.volume));
+  }
+};
+
+struct PbfXsphApplyStage {
+  FluidView fluid;
+  PbfView view;
+  SPHXR_HD void operator()(int i) const {
+    Vec4 v = fluid.velocity[i];
+    const Vec4 d = view.delta[i];
+    v.x += d.x;
+    v.y += d.y;
+    v.z += d.z;
+    fluid.velocity[i] = v;
+  }
+};
+
+/// max(0, rho_i / rho0 - 1): the constraint's residual (the solve's density error).
+struct PbfResidual {
+  FluidView fluid;
+  float invRestDensity;
+  SPHXR_HD double operator()(int i) const { return AtLeast(fluid.density[i] * invRestDensity - 1.0f, 0.0f); }
+};
+
+}  // namespace sphxr::sim

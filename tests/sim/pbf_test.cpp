@@ -1,0 +1,306 @@
+// Position-based fluids (sim/src/solvers/pbf.h, Macklin & Müller 2013): one step against the paper's
+// algorithm written out here by brute force over every particle pair, in double; still water from the
+// lattice; the extremes of the iteration count; the same bits at every thread count. (cpu against
+// cpu-reference and CUDA: tests/backend/agreement_test.cpp.)
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <cstring>
+#include <unordered_map>
+
+#include "kernel.h"
+#include "sphxr/sim/solver.h"
+#include "support.h"
+
+namespace sphxr {
+namespace {
+
+using sim::SceneSetup;
+using sim::Vec3;
+using sim::Vec4;
+
+SceneSetup PbfBox(Vec3 tank, Vec3 fluid, float spacing) {
+  SceneSetup s = test::TankScene({0, 0, 0}, tank, spacing);
+  s.method = sim::SolverMethod::kPbf;
+  s.openTop = false;
+  s.fluid.push_back(test::Block({0, 0, 0}, fluid));
+  return s;
+}
+
+struct D3 {
+  double x = 0, y = 0, z = 0;
+  D3 operator+(D3 o) const { return {x + o.x, y + o.y, z + o.z}; }
+  D3 operator-(D3 o) const { return {x - o.x, y - o.y, z - o.z}; }
+  D3 operator*(double s) const { return {x * s, y * s, z * s}; }
+  double Dot(D3 o) const { return x * o.x + y * o.y + z * o.z; }
+};
+D3 Of(Vec4 v) { return {v.x, v.y, v.z}; }
+
+/// The cubic spline of sim/src/kernel.h, in double: W(r) and grad W(d) = d W'(r) / r.
+struct Spline {
+  double H;
+  double sigma = 8.0 / (M_PI * H * H * H);
+  double W(double r) const {
+    const double q = r / H;
+    if (q >= 1.0) return 0.0;
+    if (q <= 0.5) return sigma * (6.0 * (q * q * q - q * q) + 1.0);
+    return sigma * 2.0 * (1.0 - q) * (1.0 - q) * (1.0 - q);
+  }
+  D3 Grad(D3 d) const {
+    const double r = std::sqrt(d.Dot(d));
+    const double q = r / H;
+    if (q >= 1.0 || r == 0.0) return {};
+    const double dw = q <= 0.5 ? sigma * 6.0 * (3.0 * q * q - 2.0 * q) / H : -sigma * 6.0 * (1.0 - q) * (1.0 - q) / H;
+    return d * (dw / r);
+  }
+};
+
+/// MM13's Algorithm 1 for one step of dt, every sum over all pairs: predict, the neighbour sets at x*,
+/// `iterations` Jacobi iterations of lambda (eq. 11, with epsilon) and the correction (eq. 12, with
+/// s_corr, eq. 13), each followed by the collision response (a particle kept half a spacing from every
+/// face of the closed box), v = (x* - x) / dt, XSPH (eq. 17). The walls are Akinci's boundary particles
+/// (w = Psi_b) in the density, in grad_i C_i and in the correction with lambda_i.
+struct Reference {
+  const SceneSetup& scene;
+  std::vector<Vec4> boundary;
+  std::vector<D3> x, v;
+  std::vector<double> density;
+
+  /// sum_k |grad_k C_i|^2 over a particle's neighbours in the rest lattice (epsilon's and s_corr's scale).
+  double RestSum(const Spline& k, double dx, double volume) const {
+    double sum = 0.0;
+    const int reach = static_cast<int>(std::ceil(k.H / dx));
+    for (int a = -reach; a <= reach; ++a)
+      for (int b = -reach; b <= reach; ++b)
+        for (int c = -reach; c <= reach; ++c) {
+          const D3 g = k.Grad(D3{a * dx, b * dx, c * dx}) * volume;
+          sum += g.Dot(g);
+        }
+    return sum;
+  }
+
+  void Step(double dt) {
+    const auto& p = scene.params;
+    const Spline k{p.spacing * p.supportFactor};
+    const double dx = p.spacing, rho0 = p.restDensity, volume = dx * dx * dx, mass = rho0 * volume;
+    const double d0 = RestSum(k, dx, volume);
+    const double eps = p.pbfRelaxation * d0, corrK = p.pbfCorrK / d0, wdq = k.W(p.pbfCorrDq * k.H);
+    const D3 lo{scene.tank.min.x + 0.5 * dx, scene.tank.min.y + 0.5 * dx, scene.tank.min.z + 0.5 * dx};
+    const D3 hi{scene.tank.max.x - 0.5 * dx, scene.tank.max.y - 0.5 * dx, scene.tank.max.z - 0.5 * dx};
+    auto collide = [&](D3* q) {
+      q->x = std::clamp(q->x, lo.x, hi.x);
+      q->y = std::clamp(q->y, lo.y, hi.y);
+      q->z = std::clamp(q->z, lo.z, hi.z);
+    };
+    const size_t n = x.size();
+    const D3 g{scene.gravity.x, scene.gravity.y, scene.gravity.z};
+    std::vector<D3> start = x;
+    for (size_t i = 0; i < n; ++i) {
+      v[i] = v[i] + g * dt;
+      x[i] = x[i] + v[i] * dt;
+      collide(&x[i]);
+    }
+    std::vector<std::vector<size_t>> near(n);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j) {
+        const D3 d = x[i] - x[j];
+        if (j != i && d.Dot(d) < k.H * k.H) near[i].push_back(j);
+      }
+    std::vector<double> lambda(n);
+    density.assign(n, 0.0);
+    for (int it = 0; it < static_cast<int>(p.pbfIterations); ++it) {
+      for (size_t i = 0; i < n; ++i) {
+        double sumW = k.W(0.0), sum2 = 0.0, walls = 0.0;
+        D3 gradI;
+        for (size_t j : near[i]) {
+          const D3 d = x[i] - x[j];
+          sumW += k.W(std::sqrt(d.Dot(d)));
+          const D3 gj = k.Grad(d) * volume;
+          gradI = gradI + gj;
+          sum2 += gj.Dot(gj);
+        }
+        for (const Vec4& b : boundary) {
+          const D3 d = x[i] - Of(b);
+          walls += b.w * k.W(std::sqrt(d.Dot(d)));
+          gradI = gradI + k.Grad(d) * (b.w / rho0);
+        }
+        density[i] = mass * sumW + walls;
+        const double c = std::max(density[i] / rho0 - 1.0, 0.0);
+        lambda[i] = -c / (sum2 + gradI.Dot(gradI) + eps);
+      }
+      std::vector<D3> delta(n);
+      for (size_t i = 0; i < n; ++i) {
+        for (size_t j : near[i]) {
+          const D3 d = x[i] - x[j];
+          const double corr = -corrK * std::pow(k.W(std::sqrt(d.Dot(d))) / wdq, p.pbfCorrN);
+          delta[i] = delta[i] + k.Grad(d) * ((lambda[i] + lambda[j] + corr) * volume);
+        }
+        for (const Vec4& b : boundary) delta[i] = delta[i] + k.Grad(x[i] - Of(b)) * (lambda[i] * b.w / rho0);
+      }
+      for (size_t i = 0; i < n; ++i) {
+        x[i] = x[i] + delta[i];
+        collide(&x[i]);
+      }
+    }
+    for (size_t i = 0; i < n; ++i) v[i] = (x[i] - start[i]) * (1.0 / dt);
+    std::vector<D3> dv(n);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j : near[i]) {
+        const D3 d = x[i] - x[j];
+        dv[i] = dv[i] + (v[j] - v[i]) * (k.W(std::sqrt(d.Dot(d))) * p.pbfXsph * volume);
+      }
+    for (size_t i = 0; i < n; ++i) v[i] = v[i] + dv[i];
+  }
+};
+
+TEST(Pbf, AStepIsMacklinAndMullersAlgorithmOne) {
+  // 6 x 6 x 6 particles in a closed 8-spacing box, jittered and moving, under gravity: every term of
+  // the step is exercised (walls on all sides, the collision response, s_corr, XSPH).
+  SceneSetup scene = PbfBox({0.08f, 0.08f, 0.08f}, {0.06f, 0.06f, 0.06f}, 0.01f);
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  sim::HostFluid fluid = test::DownloadFluid(*solver);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (size_t i = 0; i < fluid.size(); ++i) {
+    fluid.position[i].x += 0.1f * scene.params.spacing * u(rng);
+    fluid.position[i].y += 0.1f * scene.params.spacing * u(rng);
+    fluid.position[i].z += 0.1f * scene.params.spacing * u(rng);
+    fluid.velocity[i] = Vec4{0.2f * u(rng), 0.2f * u(rng), 0.2f * u(rng), 0.0f};
+  }
+  ASSERT_TRUE(solver->Upload(fluid).ok());
+  sim::HostBoundary boundary;
+  solver->DownloadBoundary(&boundary);
+  Reference ref{scene, boundary.position, {}, {}, {}};
+  for (size_t i = 0; i < fluid.size(); ++i) {
+    ref.x.push_back(Of(fluid.position[i]));
+    ref.v.push_back(Of(fluid.velocity[i]));
+  }
+  std::unordered_map<uint32_t, size_t> index;
+  for (size_t i = 0; i < fluid.size(); ++i) index[fluid.id[i]] = i;
+
+  ASSERT_TRUE(solver->Step().ok());
+  const double dt = solver->LastStep().dt;
+  EXPECT_NEAR(dt, scene.params.pbfFrame / scene.params.pbfSubsteps, 1e-9) << "a step is a frame over the substeps";
+  ref.Step(dt);
+  const sim::HostFluid after = test::DownloadFluid(*solver);
+  // Float against double: each sum of ~30 terms is good to ~1e-6 of its size; three iterations and
+  // the division by dt keep the differences under 1e-4 of a spacing (and of a spacing per step).
+  const double dx = scene.params.spacing, posTol = 1e-4 * dx, velTol = posTol / dt, rhoTol = 1e-4 * 1000.0;
+  double worstX = 0, worstV = 0, moved = 0;
+  for (size_t i = 0; i < after.size(); ++i) {
+    const size_t r = index.at(after.id[i]);
+    const D3 dxv = Of(after.position[i]) - ref.x[r], dvv = Of(after.velocity[i]) - ref.v[r];
+    worstX = std::max(worstX, std::sqrt(dxv.Dot(dxv)));
+    worstV = std::max(worstV, std::sqrt(dvv.Dot(dvv)));
+    const D3 m = ref.x[r] - Of(fluid.position[index.at(after.id[i])]);
+    moved = std::max(moved, std::sqrt(m.Dot(m)));
+    EXPECT_NEAR(after.density[i], ref.density[r], rhoTol) << "particle " << after.id[i];
+  }
+  EXPECT_LT(worstX, posTol);
+  EXPECT_LT(worstV, velTol);
+  EXPECT_GT(moved, 100.0 * posTol) << "the step must move the particles for the comparison to mean anything";
+}
+
+double MeanSpeed(const sim::HostFluid& f) {
+  double sum = 0.0;
+  for (const Vec4& v : f.velocity) sum += std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  return f.size() ? sum / static_cast<double>(f.size()) : 0.0;
+}
+
+/// tank_rest: 20 x 20 x 10 particles of 1 cm at rest in a closed 0.2 x 0.3 x 0.1 m box.
+SceneSetup StillWater() { return PbfBox({0.2f, 0.3f, 0.1f}, {0.2f, 0.2f, 0.1f}, 0.01f); }
+
+void RunFor(sim::Solver& solver, double seconds) {
+  while (solver.Time() < seconds - 1e-9) ASSERT_TRUE(solver.Step().ok());
+}
+
+TEST(Pbf, StillWaterHoldsItsHydrostaticPressureAndCalms) {
+  SceneSetup scene = StillWater();
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  RunFor(*solver, 1.0);
+  const double speed1 = MeanSpeed(test::DownloadFluid(*solver));
+  RunFor(*solver, 2.0);
+  const sim::HostFluid f = test::DownloadFluid(*solver);
+  ASSERT_EQ(test::FirstNonFinite(f), "");
+  EXPECT_EQ(solver->GetTotals().clampedEvents, 0) << "the collision response, not the clamp, holds the water";
+  // The kinetic energy the lattice's start gave is being dissipated (the solve is first order in time).
+  const double speed2 = MeanSpeed(f);
+  EXPECT_LT(speed2, speed1);
+  // The pressure estimate (p / rho^2 = -Lambda / (rho0 dt^2)) against rho0 g depth in 2-cm bands over the
+  // lower 80 % of the depth: 10 % (the issue's bound).
+  float top = 0.0f;
+  for (const Vec4& x : f.position) top = std::max(top, x.y);
+  const double surface = top + 0.5 * scene.params.spacing, g = 9.81, rho0 = scene.params.restDensity;
+  for (double y = 0.02; y <= 0.8 * surface; y += 0.02) {
+    double sum = 0.0;
+    int count = 0;
+    for (size_t i = 0; i < f.size(); ++i) {
+      if (std::fabs(f.position[i].y - y) < 0.01) sum += f.pressure[i], ++count;
+    }
+    ASSERT_GT(count, 0);
+    const double expected = rho0 * g * (surface - y);
+    EXPECT_NEAR(sum / count, expected, 0.1 * expected) << "at y = " << y << " m";
+  }
+}
+
+// The issue's still-water targets at the defaults (3 substeps of 3 iterations a 90 Hz frame): not met.
+// Measured: mean speed 9.7 mm/s at 1 s (4.2 at 2 s), mean compression 3.6 % (docs/design/pbf.md).
+TEST(Pbf, DISABLED_StillWaterMeetsTheRealTimeIssuesTargets) {
+  SceneSetup scene = StillWater();
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  RunFor(*solver, 1.0);
+  EXPECT_LT(MeanSpeed(test::DownloadFluid(*solver)), 0.005);
+  EXPECT_LT(solver->LastStep().meanDensityError, 0.01f);
+}
+
+// 1 and 20 iterations on a dam break (1 s): no NaN, nothing lost or clamped, and no particle faster
+// than the column's free fall from its top, sqrt(2 g H), with a factor 2 for the splash.
+class PbfIterations : public ::testing::TestWithParam<int> {};
+
+TEST_P(PbfIterations, ADamBreakStaysStable) {
+  SceneSetup scene = test::SmallDamBreak(0.01f);
+  scene.method = sim::SolverMethod::kPbf;
+  scene.params.pbfIterations = static_cast<float>(GetParam());
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  const int count = solver->FluidCount();
+  const double bound = 2.0 * std::sqrt(2.0 * 9.81 * 0.15);
+  while (solver->Time() < 1.0) {
+    ASSERT_TRUE(solver->Step().ok());
+    ASSERT_LT(solver->LastStep().maxSpeed, bound) << "at t = " << solver->Time() << " s";
+  }
+  const sim::HostFluid f = test::DownloadFluid(*solver);
+  EXPECT_EQ(test::FirstNonFinite(f), "");
+  EXPECT_EQ(static_cast<int>(f.size()), count);
+  EXPECT_EQ(solver->GetTotals().clampedEvents, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Extremes, PbfIterations, ::testing::Values(1, 20));
+
+TEST(Pbf, TheSameBitsAtEveryThreadCount) {
+  SceneSetup scene = test::SmallDamBreak(0.01f);
+  scene.method = sim::SolverMethod::kPbf;
+  sim::HostFluid out[2];
+  for (int t = 0; t < 2; ++t) {
+    sim::SolverConfig config = test::TestConfig();
+    config.threads = t + 1;
+    auto solver = test::CreateOrFail(scene, config);
+    ASSERT_TRUE(solver);
+    for (int s = 0; s < 60; ++s) ASSERT_TRUE(solver->Step().ok());
+    solver->Download(&out[t]);
+  }
+  ASSERT_EQ(out[0].size(), out[1].size());
+  for (size_t i = 0; i < out[0].size(); ++i) {
+    ASSERT_EQ(out[0].id[i], out[1].id[i]);
+    ASSERT_EQ(std::memcmp(&out[0].position[i], &out[1].position[i], sizeof(Vec4)), 0) << "particle " << i;
+    ASSERT_EQ(std::memcmp(&out[0].velocity[i], &out[1].velocity[i], sizeof(Vec4)), 0) << "particle " << i;
+  }
+}
+
+}  // namespace
+}  // namespace sphxr
