@@ -8,7 +8,11 @@ packages=(build-essential cmake ninja-build pkg-config libthrust-dev nlohmann-js
           python3 python3-matplotlib libepoxy-dev libglm-dev libglfw3-dev libimgui-dev libstb-dev libegl-dev
           libegl-mesa0 libgl1-mesa-dri xvfb xauth
           libopenxr-dev libopenxr-loader1 openxr-layer-corevalidation libgl-dev libx11-dev libpng-dev
+          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-distributed python3-dask python3-pytest
           clang-14 libclang-rt-14-dev libomp-14-dev)  # the last three: scripts/sanitize.sh and fuzz.sh
+# (The fifth line: the Python module (python3-dev: Python's headers, which pybind11-dev does not bring
+# in), its sweeps on Dask distributed and their tests, for Debian's /usr/bin/python3, which CMake builds
+# the module for; docs/user/python.md.)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

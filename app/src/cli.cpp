@@ -11,10 +11,6 @@
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
 
-#ifndef SPHXR_SCENES_DIR
-#define SPHXR_SCENES_DIR "scenes"
-#endif
-
 namespace sphxr::app {
 namespace {
 
@@ -66,7 +62,9 @@ std::string UsageText() {
          "                    the step in progress, keeping the summary, whole CSV rows and a last export\n"
          "  --quality Q       auto: measure this machine and pick the spacing that runs in real time\n"
          "                    (the window's default); scene: the scene's spacing (the headless default)\n"
-         "  --scene FILE      JSON scene (default: " SPHXR_SCENES_DIR "/dam_break.json)\n"
+         "  --scene FILE      JSON scene: a file, or a scene's name (stir) looked for in the current\n"
+         "                    directory, then the installed scenes (PREFIX/share/sphxr/scenes) or, run\n"
+         "                    from the build tree, the source tree's scenes/ (default: dam_break)\n"
          "  --time S          simulated seconds to run (default: the scene's run.time)\n"
          "  --steps N         number of steps instead of a time\n"
          "  --settle S        before the run, relax the water to rest for S simulated seconds (energy\n"
@@ -302,7 +300,11 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     }
   }
 
-  if (out->scenePath.empty()) out->scenePath = SPHXR_SCENES_DIR "/dam_break.json";
+  // A scene by name: the current directory, the installed scenes, the build's (scene_search.cpp). The
+  // command line only names it: a name found nowhere stays as given, and reading it says where it was
+  // looked for (LoadSceneWithOptions).
+  const std::string name = out->scenePath.empty() ? "dam_break" : out->scenePath;
+  if (!FindScene(name, &out->scenePath)) out->scenePath = name;
   return Status::Ok();
 }
 
@@ -364,7 +366,11 @@ Status CheckOutputsAreNotInputs(const Options& options, const SceneFile& scene) 
 }  // namespace
 
 Status LoadSceneWithOptions(const Options& options, SceneFile* scene) {
-  if (Status s = LoadScene(options.scenePath, scene); !s) return s;
+  if (Status s = LoadScene(options.scenePath, scene); !s) {
+    std::string path;
+    if (Status where = FindScene(options.scenePath, &path); !where) return where;  // a name found nowhere
+    return s;
+  }
   if (Status s = CheckOutputsAreNotInputs(options, *scene); !s) return s;
   // A preset from the command line replaces the scene's reuse parameters; --set reuse.* then overrides.
   if (!options.reusePreset.empty()) sim::ApplyReusePreset(options.reusePreset, &scene->setup.reuse);

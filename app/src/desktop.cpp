@@ -28,9 +28,6 @@
 #include "sphxr/common/log.h"
 #include "sphxr/render/renderer.h"
 
-#ifndef SPHXR_SCENES_DIR
-#define SPHXR_SCENES_DIR "scenes"
-#endif
 
 namespace sphxr::app {
 
@@ -92,9 +89,15 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
   InitImGui(m.window);
   m.imguiReady = true;
 
+  // The panel's scene list: the installed scenes, or the build's (the current directory's JSON files
+  // need not be scenes).
   std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(SPHXR_SCENES_DIR, ec)) {
-    if (entry.path().extension() == ".json") m.sceneFiles.push_back(entry.path().string());
+  for (const std::string& dir : SceneSearchDirs()) {
+    if (dir == ".") continue;
+    for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+      if (entry.path().extension() == ".json") m.sceneFiles.push_back(entry.path().string());
+    }
+    break;
   }
   std::sort(m.sceneFiles.begin(), m.sceneFiles.end());
   for (size_t i = 0; i < m.sceneFiles.size(); ++i) {

@@ -128,6 +128,28 @@ TEST(CommandLineTest, DefaultsWhenNothingIsGiven) {
   EXPECT_TRUE(std::filesystem::exists(o.scenePath)) << o.scenePath;
 }
 
+TEST(CommandLineTest, AScenesNameIsFoundAndANameFoundNowhereIsRefusedWhenRead) {
+  Options o;
+  ASSERT_TRUE(Parse({"--scene", "stir"}, &o).ok());
+  EXPECT_EQ(std::filesystem::path(o.scenePath), std::filesystem::path(SPHXR_SCENES_DIR) / "stir.json");
+  // The command line names the scene; reading it says where a name was looked for.
+  ASSERT_TRUE(Parse({"--scene", "no_such_scene"}, &o).ok());
+  EXPECT_EQ(o.scenePath, "no_such_scene");
+  SceneFile scene;
+  const Status s = LoadSceneWithOptions(o, &scene);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("--scene no_such_scene: no scene no_such_scene or no_such_scene.json in the current "
+                             "directory, " SPHXR_SCENES_DIR),
+            std::string::npos)
+      << s.message();
+  // A path is read as it is: the loader's own message.
+  ASSERT_TRUE(Parse({"--scene", "/nonexistent/scene.json"}, &o).ok());
+  const Status path = LoadSceneWithOptions(o, &scene);
+  ASSERT_FALSE(path.ok());
+  EXPECT_NE(path.message().find("/nonexistent/scene.json"), std::string::npos) << path.message();
+  EXPECT_EQ(path.message().find("no scene"), std::string::npos) << path.message();
+}
+
 TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
   // Values for the documented flags that take one; a flag missing here and taking a value fails below.
   const std::map<std::string, std::string> values = {

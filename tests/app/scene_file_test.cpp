@@ -487,5 +487,42 @@ TEST(SceneFileTest, LoadSceneOfAMissingFileNamesIt) {
   EXPECT_NE(s.message().find("/nonexistent/dir/scene.json"), std::string::npos) << s.message();
 }
 
+// Scenes by name (app/src/scene_search.cpp, docs/user/install.md): the current directory first, then
+// the installed scenes, or, for a program without installed scenes beside it, the build's.
+TEST(SceneSearchTest, AShippedSceneByNameFromTheBuildTree) {
+  std::string path;
+  ASSERT_TRUE(FindScene("stir", &path));
+  EXPECT_EQ(std::filesystem::path(path), std::filesystem::path(SPHXR_SCENES_DIR) / "stir.json");
+  ASSERT_TRUE(FindScene("stir.json", &path));
+  EXPECT_EQ(std::filesystem::path(path), std::filesystem::path(SPHXR_SCENES_DIR) / "stir.json");
+  // A path is the caller's, found or not.
+  ASSERT_TRUE(FindScene("some/where/else.json", &path));
+  EXPECT_EQ(path, "some/where/else.json");
+}
+
+TEST(SceneSearchTest, InstalledScenesReplaceTheBuildsAndTheCurrentDirectoryComesFirst) {
+  test::TempDir installed("installed_scenes");
+  installed.Write("mine.json", kMinimal);
+  std::string path;
+  ASSERT_TRUE(FindScene("mine", &path, installed.path().string()));
+  EXPECT_EQ(path, installed.File("mine.json"));
+  // The build's scenes are not an installed program's: a name only they have is not found.
+  const Status s = FindScene("stir", &path, installed.path().string());
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("no scene stir or stir.json in the current directory, " + installed.path().string()),
+            std::string::npos)
+      << s.message();
+  EXPECT_EQ(s.message().find(SPHXR_SCENES_DIR), std::string::npos) << s.message();
+
+  test::TempDir here("current_dir");
+  here.Write("mine.json", kMinimal);
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(here.path());
+  const Status found = FindScene("mine", &path, installed.path().string());
+  std::filesystem::current_path(before);
+  ASSERT_TRUE(found) << found.message();
+  EXPECT_EQ(path, "mine.json");
+}
+
 }  // namespace
 }  // namespace sphxr::app

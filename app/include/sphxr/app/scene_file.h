@@ -54,4 +54,14 @@ Status LoadScene(const std::string& path, SceneFile* out);
 /// Applies "key=value" to a solver parameter (the same names as the scene's "solver" section).
 Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment);
 
+/// The folders a scene given by name (`sphxr --scene stir`) is looked for in, in order: the current
+/// directory, the installed scenes (<prefix>/share/sphxr/scenes beside <prefix>/bin/sphxr, found from
+/// the running executable; `installDir` instead when given: the Python module's own prefix), or, when
+/// there are none (a program run from its build tree), the source tree's scenes/ of the build. Those
+/// that exist.
+std::vector<std::string> SceneSearchDirs(const std::string& installDir = "");
+/// `name` itself when it is a file or holds a '/'; else NAME or NAME.json in the first folder of
+/// SceneSearchDirs(installDir) that has one. A bare name found nowhere is an error naming the folders.
+Status FindScene(const std::string& name, std::string* path, const std::string& installDir = "");
+
 }  // namespace sphxr::app
