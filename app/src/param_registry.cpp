@@ -88,7 +88,11 @@ namespace {
 // A number of the reference as a scene file would write it: %g, without "+" and leading zeros in the
 // exponent (1e+10 is 1e10).
 std::string Number(double v) {
+  // The fewest significant digits (6 at least) that read back as the same float: 1/90 s is 0.011111111.
   std::string text = Format("%g", v);
+  for (int digits = 7; digits <= 9 && static_cast<float>(std::stod(text)) != static_cast<float>(v); ++digits) {
+    text = Format("%.*g", digits, v);
+  }
   const size_t e = text.find('e');
   if (e == std::string::npos) return text;
   std::string exponent = text.substr(e + 1);
