@@ -39,27 +39,14 @@ struct PbfView {
 /// above it. Returns whether it moved the particle (the step's clamp count does not include it).
 SPHXR_HD SPHXR_INLINE bool PbfCollide(const Physics& ph, Vec4* x) {
   const float g = ph.pbfContact;
-  bool moved = false;
-  auto push = [&](float* c, float lo, float hi) {
-    if (*c < lo) *c = lo, moved = true;
-    if (*c > hi) *c = hi, moved = true;
-  };
-  push(&x->x, ph.domainMin.x + g, ph.domainMax.x - g);
-  push(&x->y, ph.domainMin.y + g, ph.closedTop ? ph.domainMax.y - g : ph.domainMax.y);
-  push(&x->z, ph.domainMin.z + g, ph.domainMax.z - g);
+  Vec4 unused{};  // the velocity follows from the positions at the step's end
+  const Vec3 lo{ph.domainMin.x + g, ph.domainMin.y + g, ph.domainMin.z + g};
+  const Vec3 hi{ph.domainMax.x - g, ph.closedTop ? ph.domainMax.y - g : ph.domainMax.y, ph.domainMax.z - g};
+  bool moved = ClampIntoBox(lo, hi, x, &unused);
   for (int k = 0; k < ph.obstacleCount; ++k) {
-    const Vec3 lo{ph.obstacleMin[k].x - g, ph.obstacleMin[k].y - g, ph.obstacleMin[k].z - g};
-    const Vec3 hi{ph.obstacleMax[k].x + g, ph.obstacleMax[k].y + g, ph.obstacleMax[k].z + g};
-    if (!(x->x > lo.x && x->x < hi.x && x->y > lo.y && x->y < hi.y && x->z > lo.z && x->z < hi.z)) continue;
-    const float depth[6] = {x->x - lo.x, hi.x - x->x, x->y - lo.y, hi.y - x->y, x->z - lo.z, hi.z - x->z};
-    int face = 0;
-    for (int f = 1; f < 6; ++f) {
-      if (depth[f] < depth[face]) face = f;
-    }
-    float* c = face < 2 ? &x->x : face < 4 ? &x->y : &x->z;
-    const Vec3 bound = (face & 1) ? hi : lo;
-    *c = face < 2 ? bound.x : face < 4 ? bound.y : bound.z;
-    moved = true;
+    const Vec3 olo{ph.obstacleMin[k].x - g, ph.obstacleMin[k].y - g, ph.obstacleMin[k].z - g};
+    const Vec3 ohi{ph.obstacleMax[k].x + g, ph.obstacleMax[k].y + g, ph.obstacleMax[k].z + g};
+    moved = PushOutOfBox(olo, ohi, x, &unused) || moved;
   }
   return moved;
 }
@@ -119,6 +106,16 @@ SPHXR_HD SPHXR_INLINE void ForEachOther(const GridView& grid, const FluidView& f
   });
 }
 
+/// f(j, x_i - x_j, r) for every other fluid particle in particle i's list within the kernel's support.
+template <class F>
+SPHXR_HD SPHXR_INLINE void ForEachWithin(const GridView& grid, const FluidView& fluid, const NeighbourList& list, int i,
+                                         Vec3 xi, const CubicSpline& k, F&& f) {
+  ForEachOther(grid, fluid, list, i, xi, [&](uint32_t j, Vec3 d) {
+    const float r2 = Dot(d, d);
+    if (r2 < k.H2) f(j, d, sqrtf(r2));
+  });
+}
+
 struct PbfLambdaStage {
   GridView grid;
   FluidView fluid;
@@ -132,10 +129,7 @@ struct PbfLambdaStage {
     float sumW = k.W(0.0f);
     float sum2 = 0.0f;
     Vec3 gradI{0.0f, 0.0f, 0.0f};
-    ForEachOther(grid, fluid, list, i, xi, [&](uint32_t, Vec3 d) {
-      const float r2 = Dot(d, d);
-      if (r2 >= k.H2) return;
-      const float r = sqrtf(r2);
+    ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t, Vec3 d, float r) {
       sumW += k.W(r);
       const Vec3 g = d * (volume * k.GradFactor(r));
       gradI += g;
@@ -169,10 +163,7 @@ struct PbfCorrectStage {
     const float li = view.lambda[i];
     const float volume = ph.volume;
     Vec3 dx{0.0f, 0.0f, 0.0f};
-    ForEachOther(grid, fluid, list, i, xi, [&](uint32_t j, Vec3 d) {
-      const float r2 = Dot(d, d);
-      if (r2 >= k.H2) return;
-      const float r = sqrtf(r2);
+    ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t j, Vec3 d, float r) {
       float corr = 0.0f;
       if (ph.pbfCorrK > 0.0f) {
         const float w = k.W(r) * ph.pbfInvCorrW;
@@ -248,10 +239,8 @@ struct PbfXsphStage {
     const Vec3 xi = Xyz(fluid.position[i]);
     const Vec3 vi = Xyz(fluid.velocity[i]);
     Vec3 dv{0.0f, 0.0f, 0.0f};
-    ForEachOther(grid, fluid, list, i, xi, [&](uint32_t j, Vec3 d) {
-      const float r2 = Dot(d, d);
-      if (r2 >= k.H2) return;
-      dv += (Xyz(fluid.velocity[j]) - vi) * k.W(sqrtf(r2));
+    ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t j, Vec3, float r) {
+      dv += (Xyz(fluid.velocity[j]) - vi) * k.W(r);
     });
     view.delta[i] = MakeVec4(dv * (ph.pbfXsph * ph.volume));
   }
