@@ -14,6 +14,7 @@
 #include "sphxr/app/simulation.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
+#include "sphxr/sim/openmp_wait.h"
 
 namespace sphxr::app {
 namespace {
@@ -80,7 +81,12 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
   const interaction::PaddleSystem* paddles = simulation.Paddles();
   std::printf("sphxr summary: %s\n", scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str());
   std::printf("  particles       %d fluid, %d boundary\n", summary->fluid, summary->boundary);
-  std::printf("  device          %s\n", sim::DeviceName(simulation.Solver().ActiveDevice()));
+  const sim::Device device = simulation.Solver().ActiveDevice();
+  if (device == sim::Device::kCuda) {
+    std::printf("  device          %s\n", sim::DeviceName(device));
+  } else {  // how its OpenMP threads wait (docs/design/contention.md)
+    std::printf("  device          %s (OpenMP wait: %s)\n", sim::DeviceName(device), sim::OpenMpWaitSetting());
+  }
   std::printf("  steps           %lld (%lld with dt clamped to the stability limit)%s\n",
               static_cast<long long>(summary->steps), static_cast<long long>(totals.dtClampedSteps),
               summary->stepsBefore > 0 && summary->steps > 0 ? Format("; steps %lld to %lld of the whole run",

@@ -15,6 +15,7 @@
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/xr_mode.h"
 #include "sphxr/common/log.h"
+#include "sphxr/sim/openmp_wait.h"
 
 namespace {
 
@@ -124,6 +125,7 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  sphxr::sim::BoundOpenMpSpin(argv);  // first: it may re-execute the program (docs/design/contention.md)
   // The memory check before allocating (sim's Solver::Create) counts what the particles need; what it
   // cannot see (other processes, fragmentation) ends here as one line instead of an abort.
   try {

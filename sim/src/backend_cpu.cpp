@@ -5,6 +5,8 @@
 
 #include "backend_impl.h"
 #include "cpu/launcher.h"
+#include "sphxr/common/log.h"
+#include "sphxr/sim/openmp_wait.h"
 
 namespace sphxr::sim {
 namespace {
@@ -25,6 +27,8 @@ struct OmpTraits {
 std::unique_ptr<Backend> MakeCpuBackend(int threads) {
   // 0 = all cores, also after an earlier solver in this process asked for fewer.
   omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
+  SPHXR_LOG_DEBUG("cpu backend: %d OpenMP threads, waiting with %s", threads > 0 ? threads : omp_get_num_procs(),
+                  OpenMpWaitSetting());
   return std::make_unique<BackendImpl<OmpTraits>>();
 }
 
