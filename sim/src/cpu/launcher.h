@@ -24,10 +24,14 @@ class CpuLauncher {
   /// threads, then a quarter, ... down to `chunk` items) let the thread that finishes first take over the
   /// rest (4-10 % faster than the equal slices, docs/design/simd_stages.md). An item writes only its own
   /// results, so the schedule changes no number.
+  /// A stage with a SIMD form (SimdForm, cpu/pbf.h) runs that form.
   template <class F>
   void ForEach(int n, int chunk, const F& f) {
-#pragma omp parallel for schedule(guided, chunk)
-    for (int i = 0; i < n; ++i) f(i);
+    if constexpr (requires { typename SimdForm<F>::type; }) {
+      Loop(n, chunk, typename SimdForm<F>::type{f});
+    } else {
+      Loop(n, chunk, f);
+    }
   }
   /// On the calling thread: a few dozen probes are tens of microseconds of work, and a parallel region
   /// for them cost more than that on a loaded machine (sphxr_bench_probes).
@@ -72,6 +76,12 @@ class CpuLauncher {
   void UsePairBlocks() { m_pairBlocks = true; }
 
  private:
+  template <class F>
+  void Loop(int n, int chunk, const F& f) {
+#pragma omp parallel for schedule(guided, chunk)
+    for (int i = 0; i < n; ++i) f(i);
+  }
+
   Vector<uint32_t> m_blockStart;  // the density blocks: first entry of each (cpu/blocks.h)
   bool m_pairBlocks = false;
 };

@@ -213,6 +213,11 @@ SPHXR_INLINE void GatherXyz(const float* base, LaneInts index, Lanes* x, Lanes* 
   GatherXyzw(base, index, x, y, z, nullptr);
 }
 
+/// SimdForm<Stage>::type: the SIMD form CpuLauncher::ForEach runs in place of a scalar stage (where
+/// one is declared, beside the form: cpu/pbf.h).
+template <class Stage>
+struct SimdForm {};
+
 /// The sum of the lanes, in lane order.
 inline float SumLanes(Lanes v) {
   float s = 0.0f;

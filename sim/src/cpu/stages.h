@@ -28,6 +28,8 @@
 // layout), so reuse off and reuse with IDLE = 0 stay bit-identical. tests/sim/cpu_stages_test.cpp compares each with the per-particle stages and with
 // brute force.
 //
+// PBF (cpu/pbf.h): its three neighbour passes as the forces', per particle over the list kLanes at a time.
+//
 // One header per stage, beside the stage it implements (stages/):
 #include "../stages.h"    // the stages these implement (sim/src/stages.h, not this file)
 #include "cpu/simd.h"     // Lanes, kLanes, the tier's intrinsics
@@ -35,3 +37,4 @@
 #include "cpu/density.h"  // DensityBlockStage
 #include "cpu/forces.h"   // ForceListStage
 #include "cpu/walls.h"    // WallPressureBlockStage
+#include "cpu/pbf.h"      // position-based fluids' lambda, correction and XSPH passes

@@ -142,10 +142,13 @@ struct PbfLambdaStage {
       sumBoundary += psi * k.W(r);
       gradI += d * (psi * invRho0 * k.GradFactor(r));
     });
-    const float rho = ph.mass * sumW + sumBoundary;
+    Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
+  }
+  /// rho_i, and lambda_i from it and sum_k |grad_k C_i|^2 (also the CPU's SIMD form's end, cpu/pbf.h).
+  SPHXR_HD SPHXR_INLINE void Finish(int i, float rho, float gradSum2) const {
     fluid.density[i] = rho;
-    const float c = AtLeast(rho * invRho0 - 1.0f, 0.0f);
-    const float lambda = -c / (sum2 + Dot(gradI, gradI) + ph.pbfRelaxation);
+    const float c = AtLeast(rho * ph.invRestDensity - 1.0f, 0.0f);
+    const float lambda = -c / (gradSum2 + ph.pbfRelaxation);
     view.lambda[i] = lambda;
     view.lambdaSum[i] += lambda;
   }
