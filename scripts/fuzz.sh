@@ -19,6 +19,7 @@ artifacts="$build/fuzz-artifacts"
 mkdir -p "$work" "$artifacts"
 for t in scene state trajectory; do mkdir -p "$work/corpus_$t" "$work/seeds_$t"; done
 cp scenes/*.json "$work/seeds_scene/"
+cp fuzz/seeds/scene/*.json "$work/seeds_scene/"  # names and keys with control and bidi characters
 cp scenes/*.csv "$work/seeds_trajectory/"
 cp scenes/*.csv "$work/"  # the trajectories the seed scenes name, relative to the working directory
 # A state file to start from: a few steps of the small stirring scene, at a coarse spacing.
@@ -33,7 +34,9 @@ for t in scene state trajectory; do
   echo "fuzz.sh: sphxr_fuzz_$t for $seconds s"
   # Run in the work directory: a fuzzed scene reads trajectory files relative to it.
   # -rss_limit_mb: the scene and state readers must never need much memory for a small input.
-  if ! (cd "$work" && "$root/$build/fuzz/sphxr_fuzz_$t" -max_total_time="$seconds" -max_len=65536 -timeout=10 \
+  dict=()
+  if [ -f "fuzz/$t.dict" ]; then dict=(-dict="$root/fuzz/$t.dict"); fi
+  if ! (cd "$work" && "$root/$build/fuzz/sphxr_fuzz_$t" "${dict[@]}" -max_total_time="$seconds" -max_len=65536 -timeout=10 \
           -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$root/$artifacts/${t}_" \
           "corpus_$t" "seeds_$t" >"fuzz_$t.log" 2>&1); then
     echo "fuzz.sh: sphxr_fuzz_$t FAILED; its log: $work/fuzz_$t.log; the input: $artifacts/"

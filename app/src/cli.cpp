@@ -7,9 +7,11 @@
 #include <string_view>
 #include <thread>
 
+#include "sphxr/app/probe_csv.h"
 #include "sphxr/app/quality.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 
 namespace sphxr::app {
 namespace {
@@ -18,11 +20,12 @@ Status ParseDouble(const std::string& flag, const char* text, double lo, double 
   char* end = nullptr;
   // Decimal only: strtod also reads hexadecimal ("0x10" was 16 s) and "inf".
   const std::string_view t(text);
-  if (t.find_first_of("xXpP") != std::string_view::npos) return Status::Error(flag + " " + text + ": not a decimal number");
+  const std::string shown = ShowText(text);
+  if (t.find_first_of("xXpP") != std::string_view::npos) return Status::Error(flag + " " + shown + ": not a decimal number");
   const double v = std::strtod(text, &end);
-  if (!*text || *end != '\0') return Status::Error(flag + " " + text + ": not a number");
-  if (!std::isfinite(v)) return Status::Error(flag + " " + text + ": not a finite number");
-  if (v < lo || v > hi) return Status::Error(Format("%s %s: must be from %g to %g", flag.c_str(), text, lo, hi));
+  if (!*text || *end != '\0') return Status::Error(flag + " " + shown + ": not a number");
+  if (!std::isfinite(v)) return Status::Error(flag + " " + shown + ": not a finite number");
+  if (v < lo || v > hi) return Status::Error(Format("%s %s: must be from %g to %g", flag.c_str(), shown.c_str(), lo, hi));
   *out = v;
   return Status::Ok();
 }
@@ -30,12 +33,43 @@ Status ParseDouble(const std::string& flag, const char* text, double lo, double 
 Status ParseInt(const std::string& flag, const char* text, int64_t lo, int64_t hi, int64_t* out) {
   char* end = nullptr;
   const long long v = std::strtoll(text, &end, 10);
-  if (!*text || *end != '\0') return Status::Error(flag + " " + text + ": not an integer");
+  const std::string shown = ShowText(text);
+  if (!*text || *end != '\0') return Status::Error(flag + " " + shown + ": not an integer");
   if (v < lo || v > hi) {
-    return Status::Error(Format("%s %s: must be from %lld to %lld", flag.c_str(), text, static_cast<long long>(lo),
+    return Status::Error(Format("%s %s: must be from %lld to %lld", flag.c_str(), shown.c_str(), static_cast<long long>(lo),
                                 static_cast<long long>(hi)));
   }
   *out = v;
+  return Status::Ok();
+}
+
+// An option that does nothing in the run asked for is refused in one line, naming what it needs (each
+// of these was silently ignored).
+Status CheckOptionsTakeEffect(const Options& o, const std::vector<std::string>& seen) {
+  auto given = [&](const char* flag) {
+    for (const std::string& s : seen) {
+      if (s.substr(s.find(' ') + 1) == flag) return true;
+    }
+    return false;
+  };
+  if (given("--checkpoint-keep") && !given("--checkpoint-every")) {
+    return Status::Error("--checkpoint-keep: only with --checkpoint-every S (it keeps the last N checkpoints)");
+  }
+  if (given("--fps") && o.framesDir.empty()) return Status::Error("--fps: only with --frames DIR (the pictures' rate)");
+  if (given("--surface-format") && o.exportSurfaceEvery <= 0 && o.exportSurfaceInterval <= 0.0) {
+    return Status::Error("--surface-format: only with --export-surface-every K or --export-surface-interval S");
+  }
+  if (given("--export-format") && o.exportEvery <= 0 && o.exportInterval <= 0.0) {
+    return Status::Error("--export-format: only with --export-every K or --export-interval S");
+  }
+  if (o.mode == Mode::kHeadless) {
+    for (const char* flag : {"--window-size", "--frame-limit", "--no-vsync"}) {
+      if (given(flag)) return Status::Error(std::string(flag) + ": --headless has no window (it is for --desktop and --xr)");
+    }
+    if (given("--render") && o.screenshotPath.empty() && o.framesDir.empty()) {
+      return Status::Error("--render: --headless makes no picture without --screenshot FILE.png or --frames DIR");
+    }
+  }
   return Status::Ok();
 }
 
@@ -126,13 +160,20 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       for (const std::string& earlier : seen) {
         if (earlier.substr(0, earlier.find(' ')) != group) continue;
         const std::string first = earlier.substr(earlier.find(' ') + 1);
-        if (first == arg) return Status::Error(arg + " is given twice: give it once");
+        if (first == arg) return Status::Error(ShowText(arg) + " is given twice: give it once");
         return Status::Error(first + " and " + arg + ": give one of them");
       }
       seen.push_back(group + " " + arg);
     }
     auto value = [&](const char** v) -> Status {
       if (i + 1 >= argc) return Status::Error(arg + ": missing value (see --help)");
+      // An option is never another option's value (--stats --validate wrote a file named --validate); a
+      // file whose name starts with "--" is given as ./--name.
+      const std::string next = argv[i + 1];
+      if (next.size() > 2 && next.rfind("--", 0) == 0) {
+        return Status::Error(arg + ": missing value before " + ShowText(next) + " (a value that starts with -- is "
+                                   "written ./" + ShowText(next) + " for a file)");
+      }
       *v = argv[++i];
       return Status::Ok();
     };
@@ -152,7 +193,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       const std::string r = v;
       sim::ReuseParams probe;
       if (r != "on" && r != "off" && !sim::ApplyReusePreset(r, &probe)) {
-        return Status::Error("--reuse " + r + ": must be on, off or a preset (" + sim::ReusePresetNames() + ")");
+        return Status::Error("--reuse " + ShowText(r) + ": must be on, off or a preset (" + sim::ReusePresetNames() + ")");
       }
       out->reuse = r == "off" ? 0 : 1;
       out->reusePreset = (r == "on" || r == "off") ? "" : r;
@@ -181,7 +222,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->steps); !s) return s;
     } else if (arg == "--device") {
       if (Status s = value(&v); !s) return s;
-      if (!sim::ParseDevice(v, &out->device)) return Status::Error(arg + " " + v + ": must be auto, cpu or cuda (or cpu-reference)");
+      if (!sim::ParseDevice(v, &out->device)) return Status::Error(arg + " " + ShowText(v) + ": must be auto, cpu or cuda (or cpu-reference)");
     } else if (arg == "--threads") {
       if (Status s = value(&v); !s) return s;
       int64_t t;
@@ -206,7 +247,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       if (Status s = value(&v); !s) return s;
       out->exportFormat = v;
       if (out->exportFormat != "ply" && out->exportFormat != "vtk") {
-        return Status::Error(arg + " " + v + ": must be ply or vtk");
+        return Status::Error(arg + " " + ShowText(v) + ": must be ply or vtk");
       }
     } else if (arg == "--export-surface-every") {
       if (Status s = value(&v); !s) return s;
@@ -215,13 +256,15 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       if (Status s = value(&v); !s) return s;
       out->surfaceFormat = v;
       if (out->surfaceFormat != "ply" && out->surfaceFormat != "obj") {
-        return Status::Error(arg + " " + v + ": must be ply or obj");
+        return Status::Error(arg + " " + ShowText(v) + ": must be ply or obj");
       }
     } else if (arg == "--screenshot") {
       if (Status s = value(&v); !s) return s;
+      if (*v == '\0') return Status::Error("--screenshot: give a file name (without --screenshot: no picture)");
       out->screenshotPath = v;
     } else if (arg == "--frames") {
       if (Status s = value(&v); !s) return s;
+      if (*v == '\0') return Status::Error("--frames: give a folder name");
       out->framesDir = v;
     } else if (arg == "--fps") {
       if (Status s = value(&v); !s) return s;
@@ -231,7 +274,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       int w = 0, h = 0;
       char tail = 0;
       if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192) {
-        return Status::Error(arg + " " + v + ": must be WIDTHxHEIGHT, each from 16 to 8192 (e.g. 1280x720)");
+        return Status::Error(arg + " " + ShowText(v) + ": must be WIDTHxHEIGHT, each from 16 to 8192 (e.g. 1280x720)");
       }
       out->imageWidth = w;
       out->imageHeight = h;
@@ -240,7 +283,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       int w = 0, h = 0;
       char tail = 0;
       if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 8192 || h > 8192) {
-        return Status::Error(arg + " " + v + ": must be WIDTHxHEIGHT, each from 64 to 8192 (e.g. 1280x720)");
+        return Status::Error(arg + " " + ShowText(v) + ": must be WIDTHxHEIGHT, each from 64 to 8192 (e.g. 1280x720)");
       }
       out->windowWidth = w;
       out->windowHeight = h;
@@ -252,7 +295,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     } else if (arg == "--quality") {
       if (Status s = value(&v); !s) return s;
       const std::string q = v;
-      if (q != "auto" && q != "scene") return Status::Error("--quality " + q + ": must be auto or scene");
+      if (q != "auto" && q != "scene") return Status::Error("--quality " + ShowText(q) + ": must be auto or scene");
       out->quality = q == "auto" ? 1 : 0;
     } else if (arg == "--gl-debug") {
       out->glDebug = true;
@@ -261,7 +304,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     } else if (arg == "--render") {
       if (Status s = value(&v); !s) return s;
       const std::string r = v;
-      if (r != "water" && r != "particles") return Status::Error("--render " + r + ": must be water or particles");
+      if (r != "water" && r != "particles") return Status::Error("--render " + ShowText(r) + ": must be water or particles");
       out->particleImages = r == "particles";
     } else if (arg == "--checkpoint-every") {
       if (Status s = value(&v); !s) return s;
@@ -274,7 +317,8 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
     } else if (arg == "--export-interval" || arg == "--export-surface-interval") {
       if (Status s = value(&v); !s) return s;
       double* target = arg == "--export-interval" ? &out->exportInterval : &out->exportSurfaceInterval;
-      if (Status s = ParseDouble(arg, v, 1e-9, 1e6, target); !s) return s;
+      // (As probes.every: an interval below a microsecond exports every step of any run.)
+      if (Status s = ParseDouble(arg, v, kMinProbeInterval, 1e6, target); !s) return s;
     } else if (arg == "--probes") {
       if (Status s = value(&v); !s) return s;
       if (v[0] == '\0') return Status::Error("--probes: needs a file name");
@@ -284,7 +328,7 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       if (v[0] == '\0') return Status::Error("--stats: needs a file name");
       out->statsPath = v;
     } else {
-      return Status::Error("unknown argument '" + arg + "' (see --help)");
+      return Status::Error("unknown argument '" + ShowText(arg) + "' (see --help)");
     }
   }
   if (out->time > 0.0 && out->steps > 0) return Status::Error("--time and --steps: give one, not both");
@@ -296,9 +340,10 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
   }
   for (const std::string& set : out->sets) {
     if (out->spacing > 0.0f && set.rfind("spacing=", 0) == 0) {
-      return Status::Error("--spacing and --set " + set.substr(0, 40) + ": give one of them");
+      return Status::Error("--spacing and --set " + ShowText(set, 40) + ": give one of them");
     }
   }
+  if (Status s = CheckOptionsTakeEffect(*out, seen); !s) return s;
 
   // A scene by name: the current directory, the installed scenes, the build's (scene_search.cpp). The
   // command line only names it: a name found nowhere stays as given, and reading it says where it was
@@ -349,14 +394,14 @@ Status CheckOutputsAreNotInputs(const Options& options, const SceneFile& scene) 
     for (const auto& [what, input] : inputs) {
       if (std::string(flag) == "--save-state" && what == "--load-state") continue;
       if (SameFile(path, input)) {
-        return Status::Error(Format("%s %s is %s (%s): it would be overwritten; give another file", flag, path.c_str(),
-                                    what.c_str(), input.c_str()));
+        return Status::Error(Format("%s %s is %s (%s): it would be overwritten; give another file", flag,
+                                    ShowText(path).c_str(), what.c_str(), ShowText(input).c_str()));
       }
     }
     for (size_t j = 0; j < k; ++j) {
       if (!outputs[j].second.empty() && SameFile(path, outputs[j].second)) {
         return Status::Error(Format("%s %s is also %s's file: one would overwrite the other; give another file", flag,
-                                    path.c_str(), outputs[j].first));
+                                    ShowText(path).c_str(), outputs[j].first));
       }
     }
   }

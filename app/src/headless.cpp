@@ -13,7 +13,9 @@
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/simulation.h"
 #include "sphxr/app/state_file.h"
+#include "sphxr/common/host_memory.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 #include "sphxr/sim/openmp_wait.h"
 
 namespace sphxr::app {
@@ -24,8 +26,9 @@ volatile std::sig_atomic_t g_interrupt = 0;
 extern "C" void OnInterrupt(int signal) { g_interrupt = signal; }
 
 /// SIGINT, SIGTERM and SIGHUP (a closed terminal, a dropped ssh session: long runs are started that
-/// way) set g_interrupt while a run steps; SA_RESETHAND makes a second signal act as if we had never
-/// caught the first (the process ends). The previous handlers come back afterwards.
+/// way) set g_interrupt while a run steps, however many arrive: a second Ctrl-C 5 ms after the first
+/// ended the run by the default action, without its summary, cutting a row and leaving FILE.state.tmp.
+/// (SIGQUIT, Ctrl-\, still ends it at once.) The previous handlers come back afterwards.
 class InterruptScope {
  public:
   InterruptScope() {
@@ -33,18 +36,14 @@ class InterruptScope {
     struct sigaction action {};
     action.sa_handler = OnInterrupt;
     sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;
+    action.sa_flags = 0;
     sigaction(SIGINT, nullptr, &m_int);
     sigaction(SIGTERM, nullptr, &m_term);
     sigaction(SIGHUP, nullptr, &m_hup);
     // A signal ignored on entry (a background job of a script, nohup) stays ignored.
     if (m_int.sa_handler != SIG_IGN) sigaction(SIGINT, &action, nullptr);
     if (m_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &action, nullptr);
-    // SIGHUP without the one-shot reset: a closing terminal's shell and kernel may send it twice in a
-    // moment, and the second must not end the run before its state is saved.
-    struct sigaction hangUp = action;
-    hangUp.sa_flags = 0;
-    if (m_hup.sa_handler != SIG_IGN) sigaction(SIGHUP, &hangUp, nullptr);
+    if (m_hup.sa_handler != SIG_IGN) sigaction(SIGHUP, &action, nullptr);
   }
   ~InterruptScope() {
     sigaction(SIGINT, &m_int, nullptr);
@@ -79,13 +78,13 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
   const RunSummary* summary = &s;
   const sim::Totals& totals = simulation.Solver().GetTotals();
   const interaction::PaddleSystem* paddles = simulation.Paddles();
-  std::printf("sphxr summary: %s\n", scene.name.empty() ? options.scenePath.c_str() : scene.name.c_str());
+  std::printf("sphxr summary: %s\n", scene.name.empty() ? ShowText(options.scenePath, std::string::npos).c_str() : ShowText(scene.name).c_str());
   std::printf("  particles       %d fluid, %d boundary\n", summary->fluid, summary->boundary);
   const sim::Device device = simulation.Solver().ActiveDevice();
   if (device == sim::Device::kCuda) {
     std::printf("  device          %s\n", sim::DeviceName(device));
   } else {  // how its OpenMP threads wait (docs/design/contention.md)
-    std::printf("  device          %s (OpenMP wait: %s)\n", sim::DeviceName(device), sim::OpenMpWaitSetting());
+    std::printf("  device          %s (OpenMP wait: %s)\n", sim::DeviceName(device), ShowText(sim::OpenMpWaitSetting()).c_str());
   }
   std::printf("  steps           %lld (%lld with dt clamped to the stability limit)%s\n",
               static_cast<long long>(summary->steps), static_cast<long long>(totals.dtClampedSteps),
@@ -154,22 +153,22 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
   }
   if (summary->surfaceExports > 0) {
     std::printf("  surface         %lld meshes to %s, %.2f ms per extraction; the last %lld triangles\n",
-                static_cast<long long>(summary->surfaceExports), options.outDir.c_str(), summary->surfaceMs,
+                static_cast<long long>(summary->surfaceExports), ShowText(options.outDir, std::string::npos).c_str(), summary->surfaceMs,
                 static_cast<long long>(summary->surfaceTriangles));
   }
   if (summary->frames > 0) {
     std::printf("  frames          %lld PNG files in %s%s%s\n", static_cast<long long>(summary->frames),
-                options.framesDir.c_str(), movie.empty() ? "" : ", movie ", movie.c_str());
+                ShowText(options.framesDir, std::string::npos).c_str(), movie.empty() ? "" : ", movie ", movie.c_str());
   }
   if (picture) {
-    std::printf("  picture         %s (%dx%d)\n", options.screenshotPath.c_str(), options.imageWidth, options.imageHeight);
+    std::printf("  picture         %s (%dx%d)\n", ShowText(options.screenshotPath, std::string::npos).c_str(), options.imageWidth, options.imageHeight);
   }
   if (summary->exports > 0) {
-    std::printf("  exported        %lld files to %s\n", static_cast<long long>(summary->exports), options.outDir.c_str());
+    std::printf("  exported        %lld files to %s\n", static_cast<long long>(summary->exports), ShowText(options.outDir, std::string::npos).c_str());
   }
   if (summary->checkpoints > 0) {
     std::printf("  checkpoints     %lld, the last at t = %.6g s in %s%s\n", static_cast<long long>(summary->checkpoints),
-                summary->checkpointTime, options.saveState.c_str(),
+                summary->checkpointTime, ShowText(options.saveState, std::string::npos).c_str(),
                 summary->stateSaved.empty() ? "" : " (then replaced by the state at the end; older ones: .1, .2, ...)");
   }
   if (!summary->stateSaved.empty()) {
@@ -308,7 +307,10 @@ void Summarise(const SceneFile& scene, const sim::Solver& solver, const SummaryS
 Status RunHeadless(const Options& options, RunSummary* summary) {
   *summary = RunSummary{};
   SceneFile scene;
-  if (Status s = LoadSceneWithOptions(options, &scene); !s) return s;
+  {
+    MemoryUse use("reading the scene (its file is at most 16 MiB)");
+    if (Status s = LoadSceneWithOptions(options, &scene); !s) return s;
+  }
   // A state file is read before anything is allocated; it fixes the spacing (ReadStartState refuses a
   // --spacing that differs) and replaces the settle.
   if (options.checkpointEvery > 0.0 && options.saveState.empty()) {
@@ -355,7 +357,10 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   SimScene simScene = SimSceneFromFile(scene);
   simScene.start = state;
   std::unique_ptr<Simulation> simulation;
-  if (Status s = Simulation::Create(simScene, config, &simulation); !s) return s;
+  {
+    MemoryUse use("the particles and the grid (use a larger --spacing or a smaller scene)");
+    if (Status s = Simulation::Create(simScene, config, &simulation); !s) return s;
+  }
   sim::Solver& solver = simulation->Solver();
   LogStart(options, scene, state.get(), *simulation, summary);
   state.reset();  // the solver and the paddles have it now

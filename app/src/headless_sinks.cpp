@@ -13,6 +13,7 @@
 
 #include "sphxr/app/export.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 #include "sphxr/sim/measure.h"
 
 namespace sphxr::app {
@@ -115,15 +116,15 @@ Status MakeOutputDirectory(const std::string& flag, const std::string& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(dir, ec)) return Status::Ok();
-  if (fs::exists(dir, ec)) return Status::Error(flag + " " + dir + ": exists and is not a directory");
+  if (fs::exists(dir, ec)) return Status::Error(flag + " " + ShowText(dir) + ": exists and is not a directory");
   fs::path normal = fs::path(dir).lexically_normal();
   if (!normal.has_filename()) normal = normal.parent_path();  // "out/"
   const fs::path parent = normal.parent_path();
   if (!parent.empty() && !fs::is_directory(parent, ec)) {
-    return Status::Error(flag + " " + dir + ": " + parent.string() + " does not exist; make it first");
+    return Status::Error(flag + " " + ShowText(dir) + ": " + ShowText(parent.string()) + " does not exist; make it first");
   }
   fs::create_directory(dir, ec);
-  if (ec) return Status::Error(flag + " " + dir + ": cannot create the directory: " + ec.message());
+  if (ec) return Status::Error(flag + " " + ShowText(dir) + ": cannot create the directory: " + ec.message());
   return Status::Ok();
 }
 
@@ -148,10 +149,10 @@ Status StatsSink::Open() {
   const std::filesystem::path parent = std::filesystem::path(m_path).parent_path();
   std::error_code ec;
   if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
-    return Status::Error("--stats " + m_path + ": " + parent.string() + " does not exist; make it first");
+    return Status::Error("--stats " + ShowText(m_path) + ": " + ShowText(parent.string()) + " does not exist; make it first");
   }
   m_out.open(m_path, std::ios::app);
-  if (!m_out) return Status::Error("--stats " + m_path + ": cannot open for writing");
+  if (!m_out) return Status::Error("--stats " + ShowText(m_path) + ": cannot open for writing");
   return Status::Ok();
 }
 
@@ -177,7 +178,7 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
     m_out.close();
     if (dropped > 0) std::filesystem::resize_file(m_path, static_cast<uintmax_t>(keep), ec);
     if (!ec) m_out.open(m_path, std::ios::app);
-    if (ec || !m_out) return Status::Error("--stats " + m_path + ": cannot continue the file: " + ec.message());
+    if (ec || !m_out) return Status::Error("--stats " + ShowText(m_path) + ": cannot continue the file: " + ec.message());
     SPHXR_LOG_INFO("--stats %s: the rows continue the earlier run's (its steps up to %lld kept%s)", m_path.c_str(),
                    static_cast<long long>(stepsBefore),
                    dropped > 0 ? Format(", %lld rows after it replaced", static_cast<long long>(dropped)).c_str() : "");
@@ -185,7 +186,7 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
     if (std::filesystem::is_regular_file(m_path, ec)) {
       m_out.close();
       m_out.open(m_path, std::ios::trunc);
-      if (!m_out) return Status::Error("--stats " + m_path + ": cannot open for writing");
+      if (!m_out) return Status::Error("--stats " + ShowText(m_path) + ": cannot open for writing");
     }
     m_out << header << "\n";
   }
@@ -215,7 +216,7 @@ Status StatsSink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
   m_pending += row.str();
   const bool due = m_pending.size() > (size_t{1} << 20) || std::chrono::steady_clock::now() - m_last >= std::chrono::seconds(1);
   if (due && !Flush()) {
-    return Status::Error("--stats " + m_path + ": write failed (disk full?) at step " + std::to_string(wholeStep));
+    return Status::Error("--stats " + ShowText(m_path) + ": write failed (disk full?) at step " + std::to_string(wholeStep));
   }
   return Status::Ok();
 }
@@ -226,7 +227,7 @@ Status StatsSink::Flush() {
   m_out.write(m_pending.data(), static_cast<std::streamsize>(m_pending.size()));
   m_out.flush();
   m_pending.clear();
-  if (!m_out) return Status::Error("--stats " + m_path + ": write failed (disk full?)");
+  if (!m_out) return Status::Error("--stats " + ShowText(m_path) + ": write failed (disk full?)");
   return Status::Ok();
 }
 
@@ -234,7 +235,7 @@ Status StatsSink::Finish(Simulation&, bool) {
   if (Status s = Flush(); !s) return s;
   if (m_out.is_open()) {
     m_out.close();  // the last rows leave the buffer here
-    if (m_out.fail()) return Status::Error("--stats " + m_path + ": write failed (disk full?)");
+    if (m_out.fail()) return Status::Error("--stats " + ShowText(m_path) + ": write failed (disk full?)");
   }
   return Status::Ok();
 }

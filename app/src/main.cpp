@@ -14,7 +14,9 @@
 #include "sphxr/app/param_registry.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/xr_mode.h"
+#include "sphxr/common/host_memory.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 #include "sphxr/sim/openmp_wait.h"
 
 namespace {
@@ -23,7 +25,7 @@ int Main(int argc, char** argv) {
   using sphxr::app::Mode;
   sphxr::app::Options options;
   if (sphxr::Status s = sphxr::app::ParseCommandLine(argc, argv, &options); !s) {
-    std::fprintf(stderr, "sphxr: %s\n", s.message().c_str());
+    std::fprintf(stderr, "sphxr: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
     return 2;
   }
   if (options.help) {
@@ -45,7 +47,7 @@ int Main(int argc, char** argv) {
     const sphxr::Status s = sphxr::app::LoadSceneWithOptions(options, &scene);
     sphxr::SetLogLevel(level);
     if (!s) {
-      std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
+      std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
       return 1;
     }
   }
@@ -68,7 +70,7 @@ int Main(int argc, char** argv) {
     const bool display = sphxr::app::DisplayAvailable();
     if (s && !outcome.lost) return 0;
     if (!s && !outcome.fallback) {
-      std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
+      std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
       return 1;
     }
     const std::string why = s ? "the XR session was lost (" + outcome.message + ")" : s.message();
@@ -116,7 +118,7 @@ int Main(int argc, char** argv) {
     run = sphxr::app::RunHeadless(options, &summary);
   }
   if (sphxr::Status s = run; !s) {
-    std::fprintf(stderr, "sphxr: error: %s\n", s.message().c_str());
+    std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
     return 1;
   }
   return summary.interrupted ? 128 + summary.interrupted : 0;  // the shell's convention: 130 after Ctrl-C
@@ -131,9 +133,12 @@ int main(int argc, char** argv) {
   try {
     return Main(argc, argv);
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "sphxr: error: out of memory: use a larger --spacing or a smaller scene\n");
+    // The stack is unwound here: what was being allocated is known only if it said so (MemoryUse).
+    const char* what = sphxr::CurrentMemoryUse();
+    std::fprintf(stderr, "sphxr: error: out of memory in %s\n",
+                 what ? what : "the particles (use a larger --spacing or a smaller scene)");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "sphxr: error: %s\n", e.what());
+    std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(e.what(), std::string::npos).c_str());
   }
   return 1;
 }

@@ -1,5 +1,7 @@
 #include "sphxr/app/param_registry.h"
 
+#include "sphxr/app/probe_csv.h"
+
 #include <cmath>
 #include <string>
 #include <vector>
@@ -136,6 +138,12 @@ std::string SceneParameterReference() {
   out += "Besides `enabled` (true or false) and `preset` (" + std::string(sim::ReusePresetNames()) +
          ": applied first, the section's other keys override it):\n\n";
   Table("reuse", &out);
+  out += "\n### Limits\n\n";
+  out += "What one scene may hold; a longer list is refused before any of it is read, and every check of a scene "
+         "takes time in proportion to these counts (or n log n).\n\n| list | at most | what |\n|---|---:|---|\n";
+  for (const sim::SceneLimitInfo& l : sim::SceneLimits()) out += Format("| `%s` | %d | %s |\n", l.key, l.limit, l.why);
+  out += Format("| `probes.every` | at least %s s | and at most %lld rows in one step: every row is written |\n",
+                Number(kMinProbeInterval).c_str(), static_cast<long long>(kMaxProbeRowsPerStep));
   return out;
 }
 

@@ -8,7 +8,9 @@
 #include <filesystem>
 
 #include "csv_continue.h"
+#include "sphxr/common/host_memory.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 
 namespace sphxr::app {
 namespace {
@@ -55,8 +57,8 @@ std::string ProbeCsvHeader(const sim::ProbeSet& set) {
 
 Status ProbeCsv::Open(const std::string& path, const ProbeConfig& config, double start, std::unique_ptr<ProbeCsv>* out) {
   out->reset();
-  if (!(config.every > 0.0) || !std::isfinite(config.every)) {
-    return Status::Error(Format("probes.every = %g s: must be a positive time", config.every));
+  if (!(config.every >= kMinProbeInterval) || !std::isfinite(config.every)) {
+    return Status::Error(Format("probes.every = %g s: must be at least %g s", config.every, kMinProbeInterval));
   }
   std::unique_ptr<ProbeCsv> csv(new ProbeCsv());
   csv->m_path = path;
@@ -70,17 +72,17 @@ Status ProbeCsv::Open(const std::string& path, const ProbeConfig& config, double
   if (keep >= 0) {
     std::error_code ec;
     std::filesystem::resize_file(path, static_cast<uintmax_t>(keep), ec);
-    if (ec) return Status::Error("--probes " + path + ": cannot continue the file: " + ec.message());
+    if (ec) return Status::Error("--probes " + ShowText(path) + ": cannot continue the file: " + ec.message());
     csv->m_file = std::fopen(path.c_str(), "ab");
-    if (!csv->m_file) return Status::Error("--probes " + path + ": cannot open for writing: " + std::strerror(errno));
+    if (!csv->m_file) return Status::Error("--probes " + ShowText(path) + ": cannot open for writing: " + std::strerror(errno));
     SPHXR_LOG_INFO("--probes %s: the rows continue the earlier run's (its rows before t = %.6g s kept%s)", path.c_str(),
                    csv->NextTime(), dropped > 0 ? Format(", %lld after it replaced", static_cast<long long>(dropped)).c_str() : "");
   } else {
     csv->m_file = std::fopen(path.c_str(), "wb");
-    if (!csv->m_file) return Status::Error("--probes " + path + ": cannot open for writing: " + std::strerror(errno));
+    if (!csv->m_file) return Status::Error("--probes " + ShowText(path) + ": cannot open for writing: " + std::strerror(errno));
     const std::string line = header + "\n";
     if (std::fwrite(line.data(), 1, line.size(), csv->m_file) != line.size() || std::fflush(csv->m_file) != 0) {
-      return Status::Error("--probes " + path + ": write failed (disk full?)");
+      return Status::Error("--probes " + ShowText(path) + ": write failed (disk full?)");
     }
   }
   csv->m_lastFlush = WallSeconds();
@@ -117,10 +119,23 @@ void ProbeCsv::Row(double t, const sim::ProbeSample& a, const sim::ProbeSample* 
 }
 
 Status ProbeCsv::Add(const sim::ProbeSample& sample) {
-  // A row at a reading's own time is that reading; between two readings, their interpolation.
+  // A row at a reading's own time is that reading; between two readings, their interpolation. A step
+  // longer than kMaxProbeRowsPerStep intervals is refused before a row of it is made.
+  const double rows = std::floor(sample.time / m_every + 1e-9) - static_cast<double>(m_next) + 1.0;
+  if (rows > static_cast<double>(kMaxProbeRowsPerStep)) {
+    const double span = m_previous ? sample.time - m_previous->time : sample.time - NextTime();
+    return Status::Error(Format("--probes %s: probes.every = %g s asks for %.3g rows in one step of %g s; at most %lld "
+                                "rows a step are written: use probes.every >= %g s",
+                                ShowText(m_path).c_str(), m_every, rows, span, static_cast<long long>(kMaxProbeRowsPerStep),
+                                span / static_cast<double>(kMaxProbeRowsPerStep)));
+  }
+  MemoryUse use("the probe rows (--probes, probes.every)");
   for (;;) {
     const double t = static_cast<double>(m_next) * m_every;
     if (t > sample.time) break;
+    if (m_pending.size() > (size_t{1} << 20)) {
+      if (Status s = Flush(); !s) return s;
+    }
     if (m_previous && t >= m_previous->time) {
       Row(t, *m_previous, &sample);
     } else if (t == sample.time || !m_previous) {
@@ -140,7 +155,7 @@ Status ProbeCsv::Flush() {
   if (m_pending.empty()) return Status::Ok();
   const bool ok = std::fwrite(m_pending.data(), 1, m_pending.size(), m_file) == m_pending.size() && std::fflush(m_file) == 0;
   m_pending.clear();
-  if (!ok) return Status::Error("--probes " + m_path + ": write failed (disk full?)");
+  if (!ok) return Status::Error("--probes " + ShowText(m_path) + ": write failed (disk full?)");
   return Status::Ok();
 }
 
@@ -155,7 +170,7 @@ Status ProbeSink::Create(const std::string& path, const ProbeConfig& config, dou
 }
 
 Status ProbeSink::OnStart(Simulation& simulation) {
-  if (Status s = simulation.Solver().SetProbes(m_config.set); !s) return Status::Error("--probes " + m_path + ": " + s.message());
+  if (Status s = simulation.Solver().SetProbes(m_config.set); !s) return Status::Error("--probes " + ShowText(m_path) + ": " + s.message());
   m_csv->StartAt(simulation.Solver().Time());
   return Status::Ok();
 }

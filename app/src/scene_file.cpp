@@ -20,7 +20,10 @@ Status Reader::Parse(const json& root) {
   if (root.contains("name")) {
     if (!root["name"].is_string()) return Error("name", "must be a string");
     m_out->name = root["name"].get<std::string>();
-    if (!Printable(m_out->name)) return Error("name", "has control characters (terminal escapes?): use plain text");
+    if (!Printable(m_out->name)) {
+      return Error("name", ShowText(m_out->name) + ": has control, format or line-separator characters (terminal "
+                           "escapes?): use plain text");
+    }
   }
   if (root.contains("description") && root["description"].is_string()) {
     m_out->description = root["description"].get<std::string>();
@@ -249,44 +252,41 @@ Status LoadScene(const std::string& path, SceneFile* out) {
 
 Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
   const size_t eq = assignment.find('=');
-  if (eq == std::string::npos) return Status::Error("--set " + assignment + ": expected key=value");
+  if (eq == std::string::npos) return Status::Error("--set " + ShowText(assignment) + ": expected key=value");
   const std::string key = assignment.substr(0, eq);
   const std::string value = assignment.substr(eq + 1);
+  // What a message quotes: the key and the value escaped and cut (a value of 5,000 nines was echoed whole).
+  const std::string shown = "--set " + ShowText(key, 40) + "=" + ShowText(value, 40);
   if (key == "method" || key == "solver.method") {
-    if (!sim::ParseSolverMethod(value, &setup->method)) {
-      return Status::Error("--set " + key + "=" + value + ": must be wcsph or dfsph");
-    }
+    if (!sim::ParseSolverMethod(value, &setup->method)) return Status::Error(shown + ": must be wcsph, dfsph or pbf");
     return Status::Ok();
   }
   if (key == "density" || key == "solver.density") {
-    if (!sim::ParseDensityModel(value, &setup->density)) {
-      return Status::Error("--set " + key + "=" + value + ": must be summation or delta_sph");
-    }
+    if (!sim::ParseDensityModel(value, &setup->density)) return Status::Error(shown + ": must be summation or delta_sph");
     return Status::Ok();
   }
   const ParamDesc* desc = FindParam(key);
   if (desc && desc->group == "reuse") {  // reuse.* keys of the registry
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || *end != '\0') return Status::Error("--set " + key + "=" + value + ": not a finite number");
+    if (value.empty() || *end != '\0') return Status::Error(shown + ": not a finite number");
     return SetParam(*desc, v, "--set " + key, setup);
   }
   const sim::ParamInfo* info = sim::FindSolverParam(key);
   if (!info) {
-    std::string names;
-    for (const ParamDesc& p : ParamRegistry()) names += (names.empty() ? "" : ", ") + (p.group == "solver" ? p.name : p.key);
-    return Status::Error("--set " + key + ": unknown parameter (known: " + names + ")");
+    std::vector<std::string> solver, reuse;
+    for (const ParamDesc& p : ParamRegistry()) (p.group == "solver" ? solver : reuse).push_back(p.group == "solver" ? p.name : p.key);
+    return Status::Error("--set " + ShowText(key, 40) + ": unknown parameter (known: " + ShowList(solver, 6) + "; " +
+                         ShowList(reuse, 8) + "; docs/user/scenes.md lists them all)");
   }
   char* end = nullptr;
   const double v = std::strtod(value.c_str(), &end);
-  if (value.empty() || *end != '\0' || !std::isfinite(v)) {
-    return Status::Error("--set " + key + "=" + value + ": not a finite number");
-  }
+  if (value.empty() || *end != '\0' || !std::isfinite(v)) return Status::Error(shown + ": not a finite number");
   if (v < info->min || v > info->max) {
-    return Status::Error(Format("--set %s=%s: out of range, must be from %g to %g%s%s", key.c_str(), value.c_str(),
-                                info->min, info->max, *info->unit ? " " : "", info->unit));
+    return Status::Error(Format("%s: out of range, must be from %g to %g%s%s", shown.c_str(), info->min, info->max,
+                                *info->unit ? " " : "", info->unit));
   }
-  if (info->integer && v != std::floor(v)) return Status::Error("--set " + key + "=" + value + ": must be a whole number");
+  if (info->integer && v != std::floor(v)) return Status::Error(shown + ": must be a whole number");
   setup->params.*(info->member) = static_cast<float>(v);
   return Status::Ok();
 }

@@ -6,6 +6,7 @@
 
 #include "scene_reader.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 
 namespace sphxr::app::scene {
 
@@ -15,20 +16,9 @@ std::string Brief(const json& j) {
   return text;
 }
 
-std::string Shown(const std::string& key) {
-  std::string out = key.size() > kMaxEcho ? key.substr(0, kMaxEcho - 3) + "..." : key;
-  for (char& c : out) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  }
-  return out;
-}
+std::string Shown(const std::string& key) { return ShowText(key, kMaxEcho); }
 
-bool Printable(const std::string& text) {
-  for (const char c : text) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return false;
-  }
-  return true;
-}
+bool Printable(const std::string& text) { return IsPlainText(text); }
 
 Status StructureScan::Run(const std::string& origin) {
   struct Frame {

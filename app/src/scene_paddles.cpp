@@ -55,6 +55,9 @@ Status Reader::Paddles(const json& j) {
   }
   if (!j.contains("list") || !j["list"].is_array()) return Error("paddles.list", "must be an array of paddles");
   const json& list = j["list"];
+  if (list.size() > static_cast<size_t>(sim::kMaxBodies)) {
+    return Error("paddles.list", Format("%zu paddles, at most %d (docs/user/scenes.md#limits)", list.size(), sim::kMaxBodies));
+  }
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string key = "paddles.list[" + std::to_string(i) + "]";
     const json& p = list[i];
@@ -65,7 +68,10 @@ Status Reader::Paddles(const json& j) {
     if (p.contains("name")) {
       if (!p["name"].is_string()) return Error(key + ".name", "must be a string");
       d.name = p["name"].get<std::string>();
-      if (!Printable(d.name)) return Error(key + ".name", "has control characters (terminal escapes?): use plain text");
+      if (!Printable(d.name)) {
+        return Error(key + ".name", ShowText(d.name) + ": has control, format or line-separator characters (terminal "
+                                    "escapes?): use plain text");
+      }
     }
     const std::string hand = p.contains("hand") && p["hand"].is_string() ? p["hand"].get<std::string>() : "";
     if (hand == "left") d.holder = interaction::Holder::kLeftHand;
@@ -77,6 +83,11 @@ Status Reader::Paddles(const json& j) {
     if (shapes.is_string() && shapes.get<std::string>() == "blade_on_handle") {
       d.shapes = interaction::BladeOnHandle();
     } else if (shapes.is_array() && !shapes.empty()) {
+      if (shapes.size() > static_cast<size_t>(sim::kMaxBodyShapes)) {
+        return Error(key + ".shapes", Format("%zu shapes, at most %d (every step's contact test loops over them; "
+                                             "docs/user/scenes.md#limits)",
+                                             shapes.size(), sim::kMaxBodyShapes));
+      }
       for (size_t k = 0; k < shapes.size(); ++k) {
         sim::ShapePrimitive prim;
         if (Status st = Shape(shapes[k], key + ".shapes[" + std::to_string(k) + "]", &prim); !st) return st;

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 
 namespace sphxr::app {
 namespace {
@@ -23,7 +24,7 @@ class ProbeReader {
   void CheckKeys(const json& obj, const std::string& prefix, std::initializer_list<const char*> known) const {
     const std::set<std::string> names(known.begin(), known.end());
     for (auto it = obj.begin(); it != obj.end(); ++it) {
-      if (!names.count(it.key())) m_unknown(prefix + "." + it.key());
+      if (!names.count(it.key())) m_unknown(prefix + "." + ShowText(it.key()));
     }
   }
 
@@ -50,12 +51,11 @@ class ProbeReader {
     if (!p.contains("name") || !p["name"].is_string()) return Error(key + ".name", "every probe needs a name (a string)");
     *name = p["name"].get<std::string>();
     if (name->empty() || name->size() > 64) return Error(key + ".name", "must have 1 to 64 characters");
-    for (const char c : *name) {
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == ',' || c == '"') {
-        return Error(key + ".name", "'" + *name + "' has a comma, a quote or a control character: it heads a CSV column");
-      }
+    if (!IsPlainText(*name) || name->find_first_of(",\"") != std::string::npos) {
+      return Error(key + ".name", "'" + ShowText(*name) + "' has a comma, a quote or a control, format or line-separator "
+                                  "character: it heads a CSV column");
     }
-    if (!m_names.insert(*name).second) return Error(key + ".name", "'" + *name + "' names another probe too");
+    if (!m_names.insert(*name).second) return Error(key + ".name", "'" + ShowText(*name) + "' names another probe too");
     return Status::Ok();
   }
 
@@ -133,8 +133,21 @@ Status ParseProbes(const json& j, const std::string& path, const sim::SceneSetup
     float check;
     if (Status s = r.Number(j["every"], "probes.every", &check); !s) return s;
     const double every = j["every"].get<double>();
-    if (!(every > 0.0)) return r.Error("probes.every", Format("%g: must be above 0 (s of simulated time between rows)", every));
+    if (!(every >= kMinProbeInterval)) {
+      return r.Error("probes.every", Format("%g: must be at least %g s of simulated time between rows (every row is "
+                                            "written; 1e-9 s wrote 1.28 million rows in 3 steps)",
+                                            every, kMinProbeInterval));
+    }
     out->every = every;
+  }
+  // The probes together, counted before one is read (10,000 gauges were read and sampled every step).
+  size_t probes = 0;
+  for (const char* name : {"pressure", "level", "force"}) {
+    if (j.contains(name) && j[name].is_array()) probes += j[name].size();
+  }
+  if (probes > static_cast<size_t>(sim::kMaxProbes)) {
+    return r.Error("probes", Format("%zu probes, at most %d together (a CSV column each; docs/user/scenes.md#limits)",
+                                    probes, sim::kMaxProbes));
   }
   auto list = [&](const char* name, auto&& each) -> Status {
     if (!j.contains(name)) return Status::Ok();
@@ -170,13 +183,14 @@ Status ParseProbes(const json& j, const std::string& path, const sim::SceneSetup
         if (Status st = r.Name(f, key, &probe.name); !st) return st;
         if (!f.contains("body") || !f["body"].is_string()) return r.Error(key + ".body", "must name a paddle (a string)");
         const std::string body = f["body"].get<std::string>();
-        std::string names;
+        std::vector<std::string> all;
         for (size_t k = 0; k < paddles.size(); ++k) {
           if (paddles[k].name == body) probe.body = static_cast<int>(k);
-          names += (k ? ", " : "") + paddles[k].name;
+          all.push_back(paddles[k].name);
         }
+        const std::string names = ShowList(all);
         if (probe.body < 0) {
-          return r.Error(key + ".body", "'" + body + "' is no paddle of the scene (" +
+          return r.Error(key + ".body", "'" + ShowText(body) + "' is no paddle of the scene (" +
                                             (names.empty() ? std::string("it has none") : "its paddles: " + names) +
                                             "; static obstacles have no force probe)");
         }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sphxr/app/scene_file.h"
+#include "sphxr/common/shown_text.h"
 #include "sphxr/common/status.h"
 
 namespace sphxr::app::scene {
@@ -21,9 +22,9 @@ constexpr size_t kMaxEcho = 80;      // characters of a bad value quoted in a me
 // terminal escapes are escaped by dump's ensure_ascii), so a message stays one short line whatever the
 // file holds. (Depth is capped at parse time, so dump's recursion is bounded.)
 std::string Brief(const json& j);
-// A key from the file in a message or warning: at most kMaxEcho characters, control characters as '?'.
+// A key from the file in a message or warning: ShowText (escaped, at most kMaxEcho bytes).
 std::string Shown(const std::string& key);
-// Text from the file shown on a terminal (names): printable ASCII and UTF-8, no control characters.
+// Text from the file shown on a terminal (names): UTF-8 without Unicode's Cc, Cf, Zl and Zp (IsPlainText).
 bool Printable(const std::string& text);
 
 // What nlohmann's parser does not say: nesting deeper than kMaxDepth, and a key given twice in one

@@ -1,4 +1,5 @@
 #include "scene_reader.h"
+#include "sphxr/common/log.h"
 
 namespace sphxr::app::scene {
 
@@ -43,6 +44,11 @@ Status Reader::Fluid(const json& root) {
   sim::SceneSetup& s = m_out->setup;
   const json& fluid = root["fluid"];
   if (!fluid.is_array()) return Error("fluid", "must be an array of blocks");
+  if (fluid.size() > static_cast<size_t>(sim::kMaxFluidBlocks)) {
+    return Error("fluid", Format("%zu blocks, at most %d (docs/user/scenes.md#limits): merge blocks that touch",
+                                 fluid.size(), sim::kMaxFluidBlocks));
+  }
+  s.fluid.reserve(fluid.size());
   for (size_t i = 0; i < fluid.size(); ++i) {
     const std::string key = "fluid[" + std::to_string(i) + "]";
     if (!fluid[i].is_object()) return Error(key, "must be an object with min and max");
@@ -65,6 +71,11 @@ Status Reader::Obstacles(const json& root) {
   sim::SceneSetup& s = m_out->setup;
   const json& obstacles = root["obstacles"];
   if (!obstacles.is_array()) return Error("obstacles", "must be an array of boxes");
+  if (obstacles.size() > static_cast<size_t>(sim::kMaxObstacles)) {
+    return Error("obstacles", Format("%zu boxes, at most %d (each is checked for fluid inside it every step; "
+                                     "docs/user/scenes.md#limits): merge touching boxes",
+                                     obstacles.size(), sim::kMaxObstacles));
+  }
   for (size_t i = 0; i < obstacles.size(); ++i) {
     const std::string key = "obstacles[" + std::to_string(i) + "]";
     if (!obstacles[i].is_object()) return Error(key, "must be an object with min and max");

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 #include "sphxr/sim/params.h"
 
 namespace sphxr::app {
@@ -89,7 +90,26 @@ class Reader {
 // 3.5e9 m/s in its first step, and particles with one id are not one particle's history.
 constexpr double kMaxFluidSpeed = 1000.0;  // m/s: a scene's fluid block may start at most this fast
 
+// The smallest step a state may ask for: the smallest solver.max_dt a scene may set.
+constexpr double kMinResolvedStep = 1e-7;  // s
+
 Status CheckAgainstScene(const StateFile& state, const sim::SceneSetup& scene) {
+  // The clock's last maxima set the first step (its CFL and force conditions): a saved maximum speed of
+  // 1e30 m/s or |a| of 3.4e38 m/s^2 was restored, and the run then stopped with "the time step
+  // collapsed to 4e-33 s", naming neither the file nor the value.
+  const double speed = state.clock.lastMaxSpeed, accel = state.clock.lastMaxAccel;
+  if (!(speed <= kMaxFluidSpeed)) {
+    return Status::Error(Format("the clock's last maximum speed %g m/s is beyond the %g m/s a fluid may have: damaged",
+                                speed, kMaxFluidSpeed));
+  }
+  // WCSPH's force condition, dt = 0.25 sqrt(h / a), with the state's smoothing length h.
+  const double h = 0.5 * scene.params.spacing * scene.params.supportFactor;
+  const double maxAccel = h * std::pow(0.25 / kMinResolvedStep, 2.0);
+  if (!(accel <= maxAccel)) {
+    return Status::Error(Format("the clock's last maximum acceleration %g m/s^2 asks for a step below %g s (at most "
+                                "%.3g m/s^2 at spacing %g m): damaged",
+                                accel, kMinResolvedStep, maxAccel, scene.params.spacing));
+  }
   const sim::HostFluid& f = state.fluid;
   const float slack = scene.params.spacing;  // the domain clamp keeps particles inside the walls
   const sim::Aabb& t = scene.tank;
@@ -437,7 +457,7 @@ Status ReadStartState(const std::string& path, float spacingOption, const std::s
   if (state->scene != sceneName) {
     SPHXR_LOG_WARN("--load-state %s was saved from scene '%s', this scene is '%s': it is used if its particle counts "
                    "and spacing match",
-                   path.c_str(), state->scene.c_str(), sceneName.c_str());
+                   path.c_str(), ShowText(state->scene).c_str(), sceneName.c_str());
   }
   setup->params.spacing = state->spacing;
   if (state->method != setup->method) {
@@ -456,7 +476,7 @@ Status RestoreState(const StateFile& state, sim::Solver* solver) {
       state.spacing != spacing) {
     return Status::Error(Format("%s: saved from '%s' with %d fluid and %d boundary particles at spacing %g m; this scene "
                                 "has %d and %d at %g m (another scene, or another --spacing)",
-                                path.c_str(), state.scene.c_str(), state.fluidCount, state.boundaryCount, state.spacing,
+                                path.c_str(), ShowText(state.scene).c_str(), state.fluidCount, state.boundaryCount, state.spacing,
                                 solver->FluidCount(), solver->BoundaryCount(), spacing));
   }
   if (Status s = CheckAgainstScene(state, solver->Scene()); !s) return Status::Error(path + ": " + s.message());

@@ -1,5 +1,7 @@
 #include "sphxr/common/host_memory.h"
 
+#include <exception>
+
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -42,5 +44,19 @@ int64_t AvailableHostBytes() {
   }
   return have;
 }
+
+namespace {
+thread_local const char* g_memoryUse = nullptr;
+thread_local const char* g_unwound = nullptr;  // the innermost use an exception left through
+}  // namespace
+
+MemoryUse::MemoryUse(const char* what) : m_previous(g_memoryUse), m_exceptions(std::uncaught_exceptions()) {
+  g_memoryUse = what;
+}
+MemoryUse::~MemoryUse() {
+  if (std::uncaught_exceptions() > m_exceptions && !g_unwound) g_unwound = g_memoryUse;
+  g_memoryUse = m_previous;
+}
+const char* CurrentMemoryUse() { return g_memoryUse ? g_memoryUse : g_unwound; }
 
 }  // namespace sphxr

@@ -1,5 +1,7 @@
 #include "sphxr/common/log.h"
 
+#include "sphxr/common/shown_text.h"
+
 #include <cstdio>
 #include <mutex>
 #include <set>
@@ -34,8 +36,11 @@ std::string VFormat(const char* fmt, va_list args) {
   return std::string(buf.data(), static_cast<size_t>(n));
 }
 
-void Emit(LogLevel level, const std::string& text) {
+// Every line leaves through ShowText: whatever a message quotes, it cannot move the cursor, retitle the
+// terminal, turn the text around or start a line of its own.
+void Emit(LogLevel level, const std::string& raw) {
   if (level < g_level) return;
+  const std::string text = ShowText(raw, std::string::npos);
   if (g_sink) {
     g_sink(level, text);
     return;

@@ -67,6 +67,17 @@ const std::array<ReuseParamInfo, 6> kReuseParams = {{
 }  // namespace
 
 std::span<const ParamInfo> SolverParamInfos() { return kParams; }
+
+std::span<const SceneLimitInfo> SceneLimits() {
+  static constexpr SceneLimitInfo kLimits[] = {
+      {"fluid", kMaxFluidBlocks, "blocks; overlaps are found on a grid of about one cell per block"},
+      {"obstacles", kMaxObstacles, "boxes; every step checks each fluid particle against each"},
+      {"paddles.list", kMaxBodies, "paddles (moving bodies)"},
+      {"paddles.list[].shapes", kMaxBodyShapes, "boxes and capsules of one paddle; every step's contact test loops over them"},
+      {"probes", kMaxProbes, "pressure, level and force probes together (a CSV column each, six for a force)"},
+  };
+  return kLimits;
+}
 std::span<const ReuseParamInfo> ReuseParamInfos() { return kReuseParams; }
 
 const char* DensityModelName(DensityModel model) {

@@ -80,6 +80,7 @@ bool InsideBody(const RigidBodySetup& body, Vec3 p, float margin) {
 int LogCutBlocks(const SceneSetup& scene) {
   const float dx = scene.params.spacing;
   int cut = 0;
+  std::string first;
   for (size_t b = 0; b < scene.fluid.size(); ++b) {
     const Aabb& box = scene.fluid[b].box;
     const float asked[3] = {box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z};
@@ -91,10 +92,14 @@ int LogCutBlocks(const SceneSetup& scene) {
       whole = whole && static_cast<double>(asked[a]) - filled[a] <= 1e-6 * static_cast<double>(asked[a]) + 1e-7 * dx;
     }
     if (whole) continue;
-    ++cut;
-    SPHXR_LOG_INFO("fluid[%zu]: filled %g x %g x %g m of the %g x %g x %g m asked for (whole layers of the spacing %g m)",
-                   b, filled[0], filled[1], filled[2], asked[0], asked[1], asked[2], dx);
+    if (cut++ == 0) {
+      first = Format("fluid[%zu]: filled %g x %g x %g m of the %g x %g x %g m asked for (whole layers of the spacing %g m)",
+                     b, filled[0], filled[1], filled[2], asked[0], asked[1], asked[2], dx);
+    }
   }
+  // One line for the scene, however many blocks (97,336 blocks printed a line each).
+  if (cut == 1) SPHXR_LOG_INFO("%s", first.c_str());
+  if (cut > 1) SPHXR_LOG_INFO("%s; and %d more blocks of the %zu are cut to whole layers", first.c_str(), cut - 1, scene.fluid.size());
   return cut;
 }
 

@@ -99,7 +99,7 @@ TEST(Hardening, AHundredThousandKeysParseAtOnceWithFewWarnings) {
 TEST(Hardening, NamesWithTerminalEscapesAreRefused) {
   SceneFile scene;
   ExpectBriefRefusal(Parse("{\"name\": \"\\u001b[31mred\", \"tank\": {\"min\": [0,0,0], \"max\": [1,1,1]}}", &scene),
-                     "name: has control characters");
+                     "name: \\x1B[31mred: has control, format or line-separator characters");
 }
 
 TEST(Hardening, TrajectoryValuesBeyondAFloatNameTheFileAndLine) {

@@ -169,9 +169,14 @@ TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
     flags.insert(it->str());
   }
   EXPECT_GE(flags.size(), 14u) << usage;
+  // The options that act only with another (CheckOptionsTakeEffect) are given with it.
+  const std::map<std::string, std::vector<std::string>> with = {
+      {"--checkpoint-keep", {"--checkpoint-every", "0.1"}}, {"--export-format", {"--export-every", "3"}},
+      {"--fps", {"--frames", "d"}}, {"--surface-format", {"--export-surface-every", "3"}}};
   for (const std::string& f : flags) {
     std::vector<std::string> args = {f};
     if (values.count(f)) args.push_back(values.at(f));
+    if (with.count(f)) args.insert(args.end(), with.at(f).begin(), with.at(f).end());
     Options o;
     const Status s = Parse(args, &o);
     EXPECT_TRUE(s.ok()) << "documented flag " << f << " refused: " << s.message();

@@ -64,7 +64,7 @@ void ExpectRefused(const std::string& probes, std::initializer_list<std::string>
 }
 
 TEST(ProbeScene, RefusesBadProbesNamingTheKey) {
-  ExpectRefused(R"({ "every": 0 })", {"probes.every", "above 0"});
+  ExpectRefused(R"({ "every": 0 })", {"probes.every", "at least 1e-06 s"});
   ExpectRefused(R"({ "every": -1 })", {"probes.every"});
   ExpectRefused(R"({ "pressure": [ { "name": "P", "at": [0.5, 0.1, 0.03] } ] })", {"probes.pressure[0].at", "outside the tank"});
   ExpectRefused(R"({ "pressure": [ { "name": "P", "at": [0.3, 0.1, 0.03], "normal": [-1, 0, 0] } ] })",

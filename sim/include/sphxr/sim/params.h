@@ -86,6 +86,20 @@ inline constexpr int kTankFaces = 6;
 inline constexpr int kMaxObstacles = 16;
 inline constexpr int kClampSites = kTankFaces + kMaxObstacles;
 
+/// The counts a scene may hold. The scene reader refuses a list longer than its limit before it reads
+/// one item of it, and every check of a scene is linear (or n log n) up to these counts.
+inline constexpr int kMaxFluidBlocks = 100000;  // checked for overlaps on a grid, in linear time
+inline constexpr int kMaxBodies = 64;           // moving bodies (paddles): each is a solid the step integrates
+inline constexpr int kMaxBodyShapes = 256;      // a body's boxes and capsules: each step's contact tests loop over them
+inline constexpr int kMaxProbes = 1024;         // pressure, level and force probes together: a CSV column each
+/// A row of limits for the scene reference (docs/user/scenes.md "Limits").
+struct SceneLimitInfo {
+  const char* key;
+  int limit;
+  const char* why;
+};
+std::span<const SceneLimitInfo> SceneLimits();
+
 struct FluidBlock {
   Aabb box;
   Vec3 velocity;  // initial velocity, m/s
