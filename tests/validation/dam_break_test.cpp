@@ -48,7 +48,8 @@ double Interpolate(const std::vector<Point>& series, double t) {
   return series.back().value;
 }
 
-// The same bounds with reuse off (the core solver), with the `balanced` reuse preset, and under DFSPH.
+// The same bounds with reuse off (the core solver), with the `balanced` reuse preset, under DFSPH, and
+// under PBF at its defaults (3 substeps of 3 iterations a 90 Hz frame, XSPH c = 0.01).
 class DamBreak : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(DamBreak, MatchesMartinMoyce1952) {
@@ -60,6 +61,8 @@ TEST_P(DamBreak, MatchesMartinMoyce1952) {
   const std::string preset = GetParam();
   if (preset == "dfsph") {
     scene.setup.method = sim::SolverMethod::kDfsph;  // the same bounds under the divergence-free solver
+  } else if (preset == "pbf") {
+    scene.setup.method = sim::SolverMethod::kPbf;  // and under position-based fluids
   } else if (preset != "off") {
     ASSERT_TRUE(sim::ApplyReusePreset(preset, &scene.setup.reuse));
   }
@@ -124,6 +127,14 @@ TEST_P(DamBreak, MatchesMartinMoyce1952) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Reuse, DamBreak, ::testing::Values("off", "balanced", "dfsph"),
+                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
+
+// PBF at its defaults misses every bound (docs/dev/physics.md, PBF). Measured: front +15.3 % at T = 1.19
+// (RMS 10.6 %), column height +87 % at tau = 2.45; the water gains energy (1.54 E0 at tau = 1.46, a sheet
+// jetting up the back wall to the tank's top). With 30 iterations no energy is gained and the front is
+// +20 % (RMS 11.3 %), the height +67 %: a one-particle film clings to the back wall, held by s_corr
+// (+17 % with k = 0), and the front runs ahead on a floor without friction (PBF's only viscosity is XSPH).
+INSTANTIATE_TEST_SUITE_P(DISABLED_Pbf, DamBreak, ::testing::Values("pbf"),
                          [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
 }  // namespace
