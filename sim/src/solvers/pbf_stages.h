@@ -12,7 +12,7 @@
 //             s_corr = -k (W_ij / W(dq))^n against clumping where the kernel is cut  [MM13 eq. 12, 13]
 //   collide   x* out of the tank's faces and the obstacles by the particle's radius (half a spacing),
 //             in the prediction and after every iteration's correction                 [MM13 alg. 1]
-//   finish    v = (x* - x) / dt, the clamps, and the pressure estimate (below)           [MM13 alg. 1]
+//   finish    v = (x* - x) / dt (capped at pbf_max_speed), the clamps, the pressure estimate (below)
 //   xsph      v_i += c sum_j V (v_j - v_i) W_ij                                        [MM13 eq. 17]
 //
 // The pressure estimate: a step's corrections move particle i by sum over iterations of its lambda
@@ -214,6 +214,12 @@ struct PbfFinishStage {
     const Vec4 vStar = fluid.velocity[i];
     const float inv = 1.0f / dt;
     Vec4 v{(x.x - start.x) * inv, (x.y - start.y) * inv, (x.z - start.z) * inv, vStar.w};
+    // The safety net holds for the velocity the corrections give too, not only the predicted one.
+    const float speed2 = v.x * v.x + v.y * v.y + v.z * v.z;
+    if (speed2 > ph.pbfMaxSpeed * ph.pbfMaxSpeed) {
+      const float s = ph.pbfMaxSpeed / sqrtf(speed2);
+      v.x *= s, v.y *= s, v.z *= s;
+    }
     bool clamped = ph.obstacleCount > 0 && ClampOutOfObstacles(ph, &x, &v);
     clamped = ClampToDomain(ph, &x, &v) || clamped;
     // v* = v^n + dt g: the step's acceleration is (v - v^n) / dt = (v - v*) / dt + g.
