@@ -26,7 +26,6 @@
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/params.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR "scenes"
@@ -225,7 +224,4 @@ int Main(int argc, char** argv) {
 }  // namespace
 }  // namespace sphxr::bench
 
-int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);
-  return sphxr::bench::Main(argc, argv);
-}
+int main(int argc, char** argv) { return sphxr::bench::Main(argc, argv); }

@@ -4,12 +4,12 @@
 # neighbour a second sweep, a compiler or a compositor is), at 1 thread and at every core, by turns in
 # one invocation (compare rows of one run only; the median of --rounds runs per row).
 #   bench/contention.sh [--time S] [--rounds R] [--csv FILE]   (default 0.1 s, 3 rounds, bench/results/contention.csv)
-# The rows:
-#   spin=default      sphxr as it starts: its bounded spin (sim/src/cpu/omp_wait.cpp, docs/design/contention.md)
-#   spin=libgomp      GOMP_SPINCOUNT=300000, libgomp's own default (what sphxr did before the bounded spin)
-#   spin=passive      OMP_WAIT_POLICY=passive (sleep at once at every barrier)
-# The targets (issue 47): beside one busy process, the all-core step at spin=default <= 1.3x the 1-thread
-# step alone; alone, the all-core step at spin=default within 5 % of spin=libgomp.
+# The rows: threads 1 and N (every core) are fixed teams (--threads 1, --threads N); threads auto is sphxr's
+# default (--threads 0: the team measured step by step, sim/src/cpu/team.h, docs/design/contention.md).
+#   wait=default   the OpenMP runtime's own (libgomp: a spin of 300,000 rounds before sleeping)
+#   wait=passive   OMP_WAIT_POLICY=passive (sleep at once at every barrier), for comparison
+# The targets (issue 47): beside one busy process, the threads=auto step <= 1.3x the 1-thread step alone;
+# alone, the threads=auto step within 5 % of the fixed N-thread step (what sphxr did before).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 time_s=0.1 rounds=3 csv=bench/results/contention.csv
@@ -32,13 +32,10 @@ stop_busy() { if [ -n "$busy_pid" ]; then kill "$busy_pid" 2>/dev/null || true; 
 trap 'stop_busy; rm -rf "$tmp"' EXIT
 
 # one run: prints its ms per step (the headless summary's total)
-run() {  # threads spin
-  local threads=$1 spin=$2 envs=()
-  case "$spin" in
-    default) envs=(env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT) ;;
-    libgomp) envs=(env -u OMP_WAIT_POLICY GOMP_SPINCOUNT=300000) ;;
-    passive) envs=(env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=passive) ;;
-  esac
+run() {  # threads wait
+  local threads=$1 wait=$2 envs=(env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT -u KMP_BLOCKTIME)
+  [ "$wait" = passive ] && envs+=(OMP_WAIT_POLICY=passive)
+  [ "$threads" = auto ] && threads=0
   "${envs[@]}" "$bin" --headless --scene scenes/stir.json --time "$time_s" --threads "$threads" --no-progress \
     > "$tmp/summary.txt" 2> "$tmp/log.txt" || { cat "$tmp/log.txt" >&2; exit 1; }
   sed -n 's/^ *ms per step *\([0-9.]*\) total.*/\1/p' "$tmp/summary.txt"
@@ -47,25 +44,24 @@ median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2
 
 rows=()
 for neighbour in alone busy; do
-  for threads in 1 "$cores"; do
-    for spin in default libgomp passive; do rows+=("$neighbour $threads $spin"); done
-  done
+  for threads in 1 "$cores" auto; do rows+=("$neighbour $threads default"); done
+  rows+=("$neighbour $cores passive")
 done
 declare -A samples
 for ((r = 0; r < rounds; ++r)); do
   for row in "${rows[@]}"; do
-    read -r neighbour threads spin <<< "$row"
+    read -r neighbour threads wait <<< "$row"
     if [ "$neighbour" = busy ]; then (while :; do :; done) & busy_pid=$!; sleep 0.2; fi
-    samples[$row]+="$(run "$threads" "$spin") "
+    samples[$row]+="$(run "$threads" "$wait") "
     stop_busy
   done
 done
 
-echo "machine,cores,load_avg_start,scene,simulated_s,neighbour,threads,spin,ms_per_step,runs" > "$csv"
-printf '%-8s %-8s %-8s %12s\n' neighbour threads spin "ms/step"
+echo "machine,cores,load_avg_start,scene,simulated_s,neighbour,threads,wait,ms_per_step,runs" > "$csv"
+printf '%-8s %-8s %-8s %12s\n' neighbour threads wait "ms/step"
 for row in "${rows[@]}"; do
-  read -r neighbour threads spin <<< "$row"
+  read -r neighbour threads wait <<< "$row"
   ms=$(tr ' ' '\n' <<< "${samples[$row]}" | grep . | median)
-  echo "$machine,$cores,$load,stir,$time_s,$neighbour,$threads,$spin,$ms,$(tr ' ' ';' <<< "${samples[$row]% }")" >> "$csv"
-  printf '%-8s %-8s %-8s %12s\n' "$neighbour" "$threads" "$spin" "$ms"
+  echo "$machine,$cores,$load,stir,$time_s,$neighbour,$threads,$wait,$ms,$(tr ' ' ';' <<< "${samples[$row]% }")" >> "$csv"
+  printf '%-8s %-8s %-8s %12s\n' "$neighbour" "$threads" "$wait" "$ms"
 done

@@ -14,7 +14,6 @@
 
 #include "sphxr/common/log.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 namespace {
 
@@ -105,7 +104,6 @@ int Run(const std::string& model) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);  // the CPU backend's bounded spin, as sphxr starts
   std::vector<std::string> models;
   for (int i = 1; i < argc; ++i) models.push_back(argv[i]);
   if (models.empty()) models = {"summation", "delta_sph"};

@@ -19,7 +19,6 @@
 #include "sphxr/render/gl_context.h"
 #include "sphxr/render/renderer.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 namespace {
 
@@ -31,7 +30,6 @@ const char* kUsage = "usage: sphxr_bench_frame [--steps N] [--frames M] [--threa
 }  // namespace
 
 int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);  // the CPU backend's bounded spin, as sphxr starts
   using namespace sphxr;
   int steps = 30, frames = 10, threads = 0;  // threads 0: all cores
   sim::Device device = sim::Device::kCpu;

@@ -27,7 +27,6 @@
 #include "sphxr/sim/host_grid.h"
 #include "sphxr/sim/params.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR "scenes"
@@ -303,7 +302,6 @@ std::string Thousands(int64_t v) {
 }  // namespace sphxr::bench
 
 int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);  // the CPU backend's bounded spin, as sphxr starts
   using namespace sphxr;
   using namespace sphxr::bench;
   Args args;

@@ -19,7 +19,6 @@
 #include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR "scenes"
@@ -149,7 +148,4 @@ int Main(int argc, char** argv) {
 }  // namespace
 }  // namespace sphxr::bench
 
-int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);
-  return sphxr::bench::Main(argc, argv);
-}
+int main(int argc, char** argv) { return sphxr::bench::Main(argc, argv); }

@@ -20,7 +20,6 @@
 #include "sphxr/app/scene_file.h"
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 namespace {
 
@@ -57,7 +56,6 @@ bool ParsePositive(const char* text, double* out) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);  // the CPU backend's bounded spin, as sphxr starts
   std::string scenePath = std::string(SPHXR_SCENES_DIR) + "/tank_rest.json";
   double windows = 6, window = 0.5, threads = 0;
   double dampFrom = -1.0, dampUntil = -1.0, dampRate = 0.0;  // --damp: no damping unless asked

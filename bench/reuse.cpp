@@ -45,7 +45,6 @@
 #include "sphxr/common/log.h"
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR "scenes"
@@ -432,7 +431,6 @@ void Compare(const Result& ref, Result* r, float dx) {
 }  // namespace sphxr::bench
 
 int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);  // the CPU backend's bounded spin, as sphxr starts
   using namespace sphxr;
   using namespace sphxr::bench;
   Args args;

@@ -23,7 +23,6 @@
 #include "bench_util.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/sim/solver.h"
-#include "sphxr/sim/openmp_wait.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR "scenes"
@@ -57,7 +56,6 @@ bool Fail(const sphxr::Status& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);  // the CPU backend's bounded spin, as sphxr starts
   std::string scenePath = std::string(SPHXR_SCENES_DIR) + "/deep_tank.json";
   double settle = 2.0, settleViscosity = 0.5, runTime = 0.3, fixedDt = 0.0;
   std::string preset = "balanced";

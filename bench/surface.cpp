@@ -32,7 +32,6 @@
 #include "sphxr/common/log.h"
 #include "sphxr/sim/solver.h"
 #include "sphxr/sim/surface.h"
-#include "sphxr/sim/openmp_wait.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR "scenes"
@@ -275,7 +274,4 @@ int Run(int argc, char** argv) {
 }  // namespace
 }  // namespace sphxr::bench
 
-int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);
-  return sphxr::bench::Run(argc, argv);
-}
+int main(int argc, char** argv) { return sphxr::bench::Run(argc, argv); }

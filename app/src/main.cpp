@@ -17,7 +17,6 @@
 #include "sphxr/common/host_memory.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
-#include "sphxr/sim/openmp_wait.h"
 
 namespace {
 
@@ -127,7 +126,6 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  sphxr::sim::BoundOpenMpSpin(argv);  // first: it may re-execute the program (docs/design/contention.md)
   // The memory check before allocating (sim's Solver::Create) counts what the particles need; what it
   // cannot see (other processes, fragmentation) ends here as one line instead of an abort.
   try {

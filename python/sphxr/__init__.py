@@ -13,13 +13,6 @@ Sweeps over a grid of parameters on Dask distributed: `python3 -m sphxr.sweep --
 import json
 import os
 
-# The CPU backend's bounded OpenMP spin, as the sphxr program starts with (docs/design/contention.md):
-# libgomp reads it once, when the extension below loads it, so it is set before the import, and only where
-# the user set none of the runtime's wait settings. (Where libgomp was loaded earlier, by another module,
-# it keeps its default.)
-if not any(os.environ.get(k) for k in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "KMP_BLOCKTIME")):
-    os.environ["GOMP_SPINCOUNT"] = "10000"
-
 import numpy as np
 
 from . import _sphxr

@@ -10,7 +10,6 @@
 #include <stdexcept>
 
 #include "run.h"
-#include "sphxr/sim/openmp_wait.h"
 #include "sphxr/app/param_registry.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
@@ -119,7 +118,6 @@ PYBIND11_MODULE(_sphxr, m) {
   m.doc() = "sphxr: SPH water runs from Python (docs/user/python.md); use the sphxr package, not _sphxr";
   py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
   m.attr("build_scenes_dir") = SPHXR_SCENES_DIR;
-  m.attr("openmp_spin_rounds") = sphxr::sim::kOpenMpSpinRounds;  // what sphxr/__init__.py sets before loading this
 
   py::class_<RunOptions>(m, "RunOptions")
       .def(py::init<>())

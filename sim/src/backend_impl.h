@@ -28,7 +28,7 @@ namespace sphxr::sim {
 /// kOnDevice` (where the surface mesh lives), `static int kTraversalRun` (the surface traversal's
 /// vertices per work item).
 template <class Traits>
-class BackendImpl final : public Backend {
+class BackendImpl : public Backend {  // (the CPU backend adds its team, backend_cpu.cpp)
   template <class T>
   using Vector = typename Traits::template Vector<T>;
 

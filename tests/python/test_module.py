@@ -25,18 +25,6 @@ def test_the_module_is_debians_build_and_loads_no_graphics_library():
             assert not lib.startswith(banned), needed
 
 
-def test_the_cpu_backend_waits_with_the_programs_bounded_spin():
-    # sphxr/__init__.py sets libgomp's spin before the extension loads libgomp (docs/design/contention.md),
-    # unless the user set a wait setting: a fresh interpreter without one (ctest sets OMP_WAIT_POLICY) and one with.
-    probe = "import os, sphxr; print(os.environ.get('GOMP_SPINCOUNT'), sphxr._sphxr.openmp_spin_rounds)"
-    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "KMP_BLOCKTIME")}
-    got = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, check=True).stdout.split()
-    assert got[0] == got[1] and int(got[1]) > 0, got
-    env["OMP_WAIT_POLICY"] = "passive"
-    got = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, check=True).stdout.split()
-    assert got[0] == "None", got
-
-
 def test_a_scene_by_name_as_the_program_finds_it():
     path = sphxr.find_scene("stir")
     assert os.path.basename(path) == "stir.json" and os.path.isfile(path)
