@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Where each method runs in real time: scenes/stir.json (a tank 0.15 m deep stirred by a scripted paddle,
 # no rendering) for 1 simulated second at a sweep of spacings, WCSPH as the scene is and DFSPH with
-# --set method=dfsph --set fixed_dt=0, by turns in one invocation (compare rows of one run only).
+# --set method=dfsph --set fixed_dt=0, PBF with --set method=pbf (one step per 1/90 s frame, its substeps and
+# iterations at their defaults), by turns in one invocation (compare rows of one run only).
 # For each run: fluid particles, simulated seconds per wall second inside the run (the headless summary),
 # steps, the time-averaged mean compression max(0, rho/rho0 - 1) and DFSPH's mean iterations.
 #   bench/realtime.sh [--threads T] [--spacings "0.02 0.016 ..."] [--csv FILE]   (default bench/results/realtime.csv)
@@ -25,9 +26,10 @@ machine=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/,/
 load=$(cut -d' ' -f1 /proc/loadavg)
 echo "machine,threads,load_avg_start,scene,method,spacing_m,fluid,simulated_s,wall_s,sim_per_wall,steps,mean_compression_pct,density_iterations,divergence_iterations" > "$csv"
 for spacing in $spacings; do
-  for method in wcsph dfsph; do
+  for method in wcsph dfsph pbf; do
     extra=(); [ "$method" = dfsph ] && extra=(--set method=dfsph --set fixed_dt=0)
-    OMP_WAIT_POLICY=active "$bin" --headless --scene scenes/stir.json --spacing "$spacing" --time 1 --threads "$threads" \
+    [ "$method" = pbf ] && extra=(--set method=pbf)
+    env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT "$bin" --headless --scene scenes/stir.json --spacing "$spacing" --time 1 --threads "$threads" \
       --no-progress --stats "$tmp/stats.csv" "${extra[@]}" > "$tmp/summary.txt" 2> "$tmp/log.txt"
     /usr/bin/python3 - "$tmp/summary.txt" "$tmp/stats.csv" "$machine" "$threads" "$load" "$method" "$spacing" >> "$csv" <<'PY'
 import csv, re, sys
@@ -39,8 +41,9 @@ rows = list(csv.DictReader(open(stats)))
 dt = [float(r["dt"]) for r in rows]
 comp = sum(float(r["mean_density_error"]) * d for r, d in zip(rows, dt)) / sum(dt)
 iters = divs = ""
-if method == "dfsph":
+if method in ("dfsph", "pbf"):
     iters = "%.2f" % (sum(float(r["density_iterations"]) for r in rows) / len(rows))
+if method == "dfsph":
     divs = "%.2f" % (sum(float(r["divergence_iterations"]) for r in rows) / len(rows))
 print(",".join([machine, threads, load, "stir", method, spacing, fluid, sim, wall, "%.3f" % (float(sim) / float(wall)),
                 str(len(rows)), "%.4f" % (100 * comp), iters, divs]))

@@ -1,5 +1,6 @@
 #include "sphxr/app/scene_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -208,6 +209,28 @@ using scene::json;
 using scene::kMaxDepth;
 using scene::kMaxEcho;
 
+namespace {
+
+/// The deepest nesting of [ and { outside strings (a bound on the parser's depth: one pass, no allocation).
+int BracketDepth(const std::string& text) {
+  int depth = 0, deepest = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '"') {
+      for (++i; i < text.size() && text[i] != '"'; ++i) {
+        if (text[i] == '\\') ++i;
+      }
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+}  // namespace
+
 Status ParseScene(const std::string& text, const std::string& origin, SceneFile* out) {
   *out = SceneFile{};
   out->path = origin;
@@ -216,12 +239,18 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
   try {
     // The parser is not recursive, but dump (the messages) and a json's copies are: deeper values are
     // dropped as they are read, and the scene refused.
+    // The callback parser is several times slower than the plain one (a 13 MB scene of 97,336 blocks:
+    // 10 s), so it runs only where the brackets come near the cap.
     int deepest = 0;
-    json::parser_callback_t depthCap = [&](int depth, json::parse_event_t, json&) {
-      if (depth > kMaxDepth) deepest = depth;
-      return depth <= kMaxDepth;
-    };
-    root = json::parse(text, depthCap);
+    if (BracketDepth(text) < kMaxDepth - 2) {
+      root = json::parse(text);
+    } else {
+      json::parser_callback_t depthCap = [&](int depth, json::parse_event_t, json&) {
+        if (depth > kMaxDepth) deepest = depth;
+        return depth <= kMaxDepth;
+      };
+      root = json::parse(text, depthCap);
+    }
     if (deepest > 0) {
       if (Status s = scan.Run(origin); !s) return s;  // names the line
       return Status::Error(Format("%s: nested more than %d levels deep: not a scene", origin.c_str(), kMaxDepth));
