@@ -27,6 +27,7 @@ int Main(int argc, char** argv) {
     std::fprintf(stderr, "sphxr: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
     return 2;
   }
+  const bool headlessAsked = options.mode == Mode::kHeadless;
   if (options.help) {
     std::fputs(sphxr::app::UsageText().c_str(), stdout);
     return 0;
@@ -108,6 +109,17 @@ int Main(int argc, char** argv) {
     // A headless run starts from the scene (or the user's --load-state), not from a lost headset's water:
     // its --time and --settle mean the scene's run; the saved file stays for --load-state.
     if (lostStateFor) options.loadState = *lostStateFor;
+  }
+  // An explicit --headless refuses the window's options (cli.cpp); a headless run that sphxr chose (no
+  // display, no runtime, a lost window) says in one line which of them it cannot honour.
+  if (!headlessAsked) {
+    const sphxr::app::Options defaults;
+    std::string unused;
+    if (options.windowWidth != defaults.windowWidth || options.windowHeight != defaults.windowHeight) unused += " --window-size";
+    if (options.frameLimit != defaults.frameLimit) unused += " --frame-limit";
+    if (options.vsync != defaults.vsync) unused += " --no-vsync";
+    if (!unused.empty()) SPHXR_LOG_WARN("running headless: no window, so%s %s no effect", unused.c_str(),
+                                        unused.find(' ', 1) == std::string::npos ? "has" : "have");
   }
   sphxr::app::RunSummary summary;
   sphxr::Status run = sphxr::app::RunHeadless(options, &summary);
