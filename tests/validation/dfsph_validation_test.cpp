@@ -57,6 +57,7 @@ TEST(DfsphStillWater, PressureIsHydrostaticOverTheLowerEightyPercent) {
   // centre plus half a spacing), against rho0 g depth at the layer's mean depth.
   const float dx = scene.setup.params.spacing;
   std::map<int, std::pair<double, double>> layers;  // layer -> (sum of pressure, sum of depth)
+  std::map<int, double> heights;                    // layer -> sum of y
   std::map<int, int> counts;
   for (int s = 0; s < 50; ++s) {
     ASSERT_TRUE(test::StepN(*solver, 1));
@@ -69,19 +70,27 @@ TEST(DfsphStillWater, PressureIsHydrostaticOverTheLowerEightyPercent) {
       const int layer = static_cast<int>(depth / dx);
       layers[layer].first += f.pressure[i];
       layers[layer].second += depth;
+      heights[layer] += f.position[i].y;
       ++counts[layer];
     }
   }
-  // The lower 80 % of the depth, less the layers within one support radius of the floor, whose kernel
-  // sums are cut by the wall (the boundary model's own error: recorded, not held to the interior's 5 %).
+  // The lower 80 % of the depth, less the layers within one support radius of the floor's boundary
+  // particles (a sheet half a spacing below the floor, sampling.cpp), whose kernel sums are cut by the
+  // wall (the boundary model's own error: recorded, not held to the interior's 5 %). The distance is the
+  // layer's measured mean height, not the lattice's: DFSPH's first layer sinks into the wall's zone
+  // (issue 47), and the layer above it then reaches within the support too.
   const int deepest = layers.rbegin()->first;
-  const int wallLayers = static_cast<int>(std::ceil(scene.setup.params.supportFactor)) - 1;
+  const double sheet = scene.setup.tank.min.y - 0.5 * dx;
+  const double support = scene.setup.params.supportFactor * dx;
   int checked = 0;
   for (const auto& [layer, sums] : layers) {
     if (layer < deepest / 5) continue;
-    if (layer > deepest - wallLayers) {
+    if (heights[layer] / counts[layer] - sheet < support) {
       const double p = sums.first / counts[layer];
-      RecordProperty("floor_layer_ratio", std::to_string(p / (scene.setup.params.restDensity * 9.81 * sums.second / counts[layer])));
+      RecordProperty("floor_layer_" + std::to_string(layer) + "_ratio",
+                     std::to_string(p / (scene.setup.params.restDensity * 9.81 * sums.second / counts[layer])));
+      RecordProperty("floor_layer_" + std::to_string(layer) + "_height_over_support",
+                     std::to_string((heights[layer] / counts[layer] - sheet) / support));
       continue;
     }
     const double p = sums.first / counts[layer];
