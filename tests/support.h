@@ -1,6 +1,8 @@
 #pragma once
 // Shared helpers for the unit tests: small scenes built in code, solver creation with a readable
 // failure, log capture, temporary directories, and per-particle lookups by id.
+#include <system_error>
+#include <thread>
 #include <gtest/gtest.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -283,6 +285,20 @@ inline std::vector<std::string> Lines(const std::string& text) {
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   return lines;
+}
+
+/// Waits until the file at `path` holds at least `bytes` (a run's CSV buffer has reached it), polling every
+/// `poll`, for at most `limit`. Returns whether it did.
+inline bool WaitForFileSize(const std::string& path, uintmax_t bytes, std::chrono::milliseconds poll,
+                            std::chrono::seconds limit = std::chrono::seconds(120)) {
+  const auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    if (!ec && size >= bytes) return true;
+    if (std::chrono::steady_clock::now() - start >= limit) return false;
+    std::this_thread::sleep_for(poll);
+  }
 }
 
 #ifdef SPHXR_BINARY

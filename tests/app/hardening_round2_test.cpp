@@ -331,15 +331,7 @@ TEST(HardeningRound2Process, TwoInterruptsFiveMillisecondsApartLeaveTheSummaryAn
                                       "--checkpoint-every", "0.001"},
                                      outPath, errPath);
   ASSERT_GE(pid, 0);
-  const auto start = std::chrono::steady_clock::now();
-  auto written = [&]() {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(csv, ec);
-    return ec ? 0 : size;
-  };
-  while (written() < 4096 && std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  test::WaitForFileSize(csv, 4096, std::chrono::milliseconds(20));
   ASSERT_EQ(kill(pid, SIGINT), 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
   kill(pid, SIGINT);

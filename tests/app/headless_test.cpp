@@ -631,14 +631,7 @@ void InterruptRun(int signal, const char* name, bool repeat = false) {
   ASSERT_GE(pid, 0);
   // Signal once the run is under way (the CSV's buffer has reached the file).
   const auto start = std::chrono::steady_clock::now();
-  auto written = [&]() {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(csv, ec);
-    return ec ? 0 : size;
-  };
-  while (written() < 4096 && std::chrono::steady_clock::now() - start < std::chrono::seconds(120)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  test::WaitForFileSize(csv, 4096, std::chrono::milliseconds(50));
   ASSERT_EQ(kill(pid, signal), 0);
   int status = 0;
   bool reaped = false;

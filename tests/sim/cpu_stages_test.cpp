@@ -372,6 +372,18 @@ std::vector<Vec3> Random(size_t n, float lo, float hi, unsigned seed, float hiX 
   return p;
 }
 
+/// 2,000 points in a Gaussian cluster (sigma 8 mm) at the grid's middle: lists that overflow 24 slots.
+std::vector<Vec3> Clustered() {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> nd(0.0f, 0.008f);
+  std::vector<Vec3> p;
+  for (int i = 0; i < 2000; ++i) {
+    p.push_back(Vec3{std::clamp(0.08f + nd(rng), 0.0f, 0.179f), std::clamp(0.08f + nd(rng), 0.0f, 0.159f),
+                     std::clamp(0.08f + nd(rng), 0.0f, 0.159f)});
+  }
+  return p;
+}
+
 /// ForceListStage against ForceStage and against the pair terms summed in double, on the densities
 /// and lists the blocked density stage left (no gravity; the particles away from walls against the
 /// fluid pair terms alone in double, those near walls against ForceStage only).
@@ -518,14 +530,7 @@ TEST(CpuStages, ForcesMatchPerParticleAndBruteForce) {
 }
 
 TEST(CpuStages, ForcesOfOverflowingListsMatch) {
-  std::mt19937 rng(7);
-  std::normal_distribution<float> nd(0.0f, 0.008f);
-  std::vector<Vec3> p;
-  for (int i = 0; i < 2000; ++i) {
-    p.push_back(Vec3{std::clamp(0.08f + nd(rng), 0.0f, 0.179f), std::clamp(0.08f + nd(rng), 0.0f, 0.159f),
-                     std::clamp(0.08f + nd(rng), 0.0f, 0.159f)});
-  }
-  CompareForces(p, 24, "clustered, lists overflowing");
+  CompareForces(Clustered(), 24, "clustered, lists overflowing");
 }
 
 /// Position-based fluids' three neighbour passes (cpu/pbf.h) against the per-particle stages
@@ -661,14 +666,7 @@ TEST(CpuStages, PbfPassesMatchPerParticleAndBruteForce) {
   ComparePbf(Random(3000, 0.0f, 0.16f, 6, 0.18f), 64, "random");
   const WallScene scene;
   ComparePbf(scene.water, 64, "walls", scene.walls);
-  std::mt19937 rng(7);
-  std::normal_distribution<float> nd(0.0f, 0.008f);
-  std::vector<Vec3> p;
-  for (int i = 0; i < 2000; ++i) {
-    p.push_back(Vec3{std::clamp(0.08f + nd(rng), 0.0f, 0.179f), std::clamp(0.08f + nd(rng), 0.0f, 0.159f),
-                     std::clamp(0.08f + nd(rng), 0.0f, 0.159f)});
-  }
-  ComparePbf(p, 24, "clustered, lists overflowing");
+  ComparePbf(Clustered(), 24, "clustered, lists overflowing");
 }
 
 TEST(CpuStages, DensityRandomSetMatchesPerParticleAndBruteForce) {

@@ -24,25 +24,30 @@ SPHXR_INLINE LaneInts ListLanes(const uint32_t* slots, uint32_t base, uint32_t f
   return index;
 }
 
-/// f(index, count) for the wall particles of xi's cells, kLanes at a time (count <= kLanes valid lanes;
-/// the rest repeat lane 0), where the cell is near a wall (the scalar ForEachBoundaryNear's test).
+/// Whether particle i's list overflowed (the scalar stage then scans its cells).
+SPHXR_INLINE bool Overflowed(const NeighbourList& list, int i) {
+  return list.count[i] > static_cast<uint32_t>(list.maxNeighbours);
+}
+
+/// f(index, dx, dy, dz, r, q, pair) for particle i's listed fluid neighbours kLanes at a time: d = x_i - x_j,
+/// r = |d|, q = r / H, `pair` the lanes within the support other than i itself (batches with none skipped).
 template <class F>
-SPHXR_INLINE void ForWallLanes(const GridView& g, Vec3 xi, F&& f) {
-  int cx, cy, cz;
-  g.CellOf(xi, &cx, &cy, &cz);
-  if (!g.boundaryNear[g.Linear(cx, cy, cz)]) return;
-  LaneInts index;
-  int n = 0;
-  ForEachInCells(g, g.boundaryStart, g.boundaryEnd, g.boundary, xi, [&](uint32_t b, Vec3) {
-    index[n++] = static_cast<int32_t>(b);
-    if (n == kLanes) {
-      f(index, n);
-      n = 0;
-    }
-  });
-  if (n > 0) {
-    for (int l = n; l < kLanes; ++l) index[l] = index[0];
-    f(index, n);
+SPHXR_INLINE void ForListLanes(const NeighbourList& list, const FluidView& fluid, const CubicSpline& k, int i, Vec3 xi,
+                               F&& f) {
+  const uint32_t found = list.count[i];
+  const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+  const float* position = reinterpret_cast<const float*>(fluid.position);  // Vec4: x y z w
+  const LaneInts self = LaneInts{} + i;
+  for (uint32_t base = 0; base < found; base += kLanes) {
+    const LaneInts index = ListLanes(slots, base, found, i);
+    Lanes xj, yj, zj;
+    GatherXyz(position, index, &xj, &yj, &zj);
+    const Lanes dx = xi.x - xj, dy = xi.y - yj, dz = xi.z - zj;
+    const Lanes r2 = dx * dx + dy * dy + dz * dz;
+    const LaneInts pair = And(Less(r2, Splat(k.H2)), index != self);
+    if (Bits(pair) == 0) continue;
+    const Lanes r = Sqrt(r2);
+    f(index, dx, dy, dz, r, r * k.invH, pair);
   }
 }
 
@@ -53,58 +58,63 @@ SPHXR_INLINE LaneInts FirstLanes(int n) {
   return Less(laneNumber, Splat(static_cast<float>(n)));
 }
 
+/// f(dx, dy, dz, r, q, psi, pair) for the wall particles of xi's cells kLanes at a time, where the cell is
+/// near a wall (the scalar ForEachBoundaryNear's test): d = x_i - x_b, psi = Psi_b, `pair` the lanes
+/// within the support (batches with none skipped).
+template <class F>
+SPHXR_INLINE void ForWallLanes(const GridView& g, const CubicSpline& k, Vec3 xi, F&& f) {
+  int cx, cy, cz;
+  g.CellOf(xi, &cx, &cy, &cz);
+  if (!g.boundaryNear[g.Linear(cx, cy, cz)]) return;
+  const float* boundary = reinterpret_cast<const float*>(g.boundary);  // Vec4: x y z Psi
+  LaneInts index;
+  int n = 0;
+  auto flush = [&]() {
+    for (int l = n; l < kLanes; ++l) index[l] = index[0];  // padding, masked off below
+    Lanes xb, yb, zb, psi;
+    GatherXyzw(boundary, index, &xb, &yb, &zb, &psi);
+    const Lanes dx = xi.x - xb, dy = xi.y - yb, dz = xi.z - zb;
+    const Lanes r2 = dx * dx + dy * dy + dz * dz;
+    const LaneInts pair = And(Less(r2, Splat(k.H2)), FirstLanes(n));
+    n = 0;
+    if (Bits(pair) == 0) return;
+    const Lanes r = Sqrt(r2);
+    f(dx, dy, dz, r, r * k.invH, psi, pair);
+  };
+  ForEachInCells(g, g.boundaryStart, g.boundaryEnd, g.boundary, xi, [&](uint32_t b, Vec3) {
+    index[n++] = static_cast<int32_t>(b);
+    if (n == kLanes) flush();
+  });
+  if (n > 0) flush();
+}
+
 struct PbfLambdaListStage {
   PbfLambdaStage stage;
 
   void operator()(int i) const {
-    const NeighbourList& list = stage.list;
-    const uint32_t found = list.count[i];
-    const uint32_t capacity = static_cast<uint32_t>(list.maxNeighbours);
-    if (found > capacity) {
+    if (Overflowed(stage.list, i)) {
       stage(i);
       return;
     }
     const Physics& ph = stage.ph;
     const CubicSpline k = ph.kernel;
-    const FluidView& f = stage.fluid;
-    const Vec3 xi = Xyz(f.position[i]);
-    const float* position = reinterpret_cast<const float*>(f.position);
-    const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(capacity);
+    const Vec3 xi = Xyz(stage.fluid.position[i]);
     const Lanes zero = Splat(0.0f);
-    const LaneInts self = LaneInts{} + i;
     Lanes w = zero, s2 = zero, gx = zero, gy = zero, gz = zero;
-    for (uint32_t base = 0; base < found; base += kLanes) {
-      const LaneInts index = ListLanes(slots, base, found, i);
-      Lanes xj, yj, zj;
-      GatherXyz(position, index, &xj, &yj, &zj);
-      const Lanes dx = xi.x - xj, dy = xi.y - yj, dz = xi.z - zj;
-      const Lanes r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts pair = And(Less(r2, Splat(k.H2)), index != self);
-      if (Bits(pair) == 0) continue;
-      const Lanes r = Sqrt(r2);
-      const Lanes q = r * k.invH;
+    ForListLanes(stage.list, stage.fluid, k, i, xi, [&](LaneInts, Lanes dx, Lanes dy, Lanes dz, Lanes r, Lanes q, LaneInts pair) {
       w += KernelWLanes(k, q, pair);
       const Lanes grad = ph.volume * GradFactorLanes(k, q, r, pair);
       const Lanes ax = dx * grad, ay = dy * grad, az = dz * grad;
       gx += ax, gy += ay, gz += az;
       s2 += ax * ax + ay * ay + az * az;
-    }
+    });
     Vec3 gradI{SumLanes(gx), SumLanes(gy), SumLanes(gz)};
     const float sumW = k.W(0.0f) + SumLanes(w);
     const float sum2 = SumLanes(s2);
     const float invRho0 = ph.invRestDensity;
     const GridView& g = stage.grid;
-    const float* boundary = reinterpret_cast<const float*>(g.boundary);  // Vec4: x y z Psi
     Lanes bw = zero, bx = zero, by = zero, bz = zero;
-    ForWallLanes(g, xi, [&](LaneInts index, int n) {
-      Lanes xb, yb, zb, psi;
-      GatherXyzw(boundary, index, &xb, &yb, &zb, &psi);
-      const Lanes dx = xi.x - xb, dy = xi.y - yb, dz = xi.z - zb;
-      const Lanes r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts pair = And(Less(r2, Splat(k.H2)), FirstLanes(n));
-      if (Bits(pair) == 0) return;
-      const Lanes r = Sqrt(r2);
-      const Lanes q = r * k.invH;
+    ForWallLanes(g, k, xi, [&](Lanes dx, Lanes dy, Lanes dz, Lanes r, Lanes q, Lanes psi, LaneInts pair) {
       bw += psi * KernelWLanes(k, q, pair);
       const Lanes grad = psi * invRho0 * GradFactorLanes(k, q, r, pair);
       bx += dx * grad, by += dy * grad, bz += dz * grad;
@@ -129,33 +139,18 @@ struct PbfCorrectListStage {
   PbfCorrectStage stage;
 
   void operator()(int i) const {
-    const NeighbourList& list = stage.list;
-    const uint32_t found = list.count[i];
-    const uint32_t capacity = static_cast<uint32_t>(list.maxNeighbours);
-    if (found > capacity) {
+    if (Overflowed(stage.list, i)) {
       stage(i);
       return;
     }
     const Physics& ph = stage.ph;
     const CubicSpline k = ph.kernel;
-    const FluidView& f = stage.fluid;
-    const Vec3 xi = Xyz(f.position[i]);
+    const Vec3 xi = Xyz(stage.fluid.position[i]);
     const float li = stage.view.lambda[i];
-    const float* position = reinterpret_cast<const float*>(f.position);
-    const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(capacity);
     const Lanes zero = Splat(0.0f);
-    const LaneInts self = LaneInts{} + i;
     Lanes cx = zero, cy = zero, cz = zero;
-    for (uint32_t base = 0; base < found; base += kLanes) {
-      const LaneInts index = ListLanes(slots, base, found, i);
-      Lanes xj, yj, zj;
-      GatherXyz(position, index, &xj, &yj, &zj);
-      const Lanes dx = xi.x - xj, dy = xi.y - yj, dz = xi.z - zj;
-      const Lanes r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts pair = And(Less(r2, Splat(k.H2)), index != self);
-      if (Bits(pair) == 0) continue;
-      const Lanes r = Sqrt(r2);
-      const Lanes q = r * k.invH;
+    ForListLanes(stage.list, stage.fluid, k, i, xi, [&](LaneInts index, Lanes dx, Lanes dy, Lanes dz, Lanes r, Lanes q,
+                                                         LaneInts pair) {
       Lanes corr = zero;
       if (ph.pbfCorrK > 0.0f) {
         const Lanes wq = KernelWLanes(k, q, pair) * ph.pbfInvCorrW;
@@ -165,22 +160,14 @@ struct PbfCorrectListStage {
       }
       const Lanes s = (li + Gather(stage.view.lambda, index) + corr) * ph.volume * GradFactorLanes(k, q, r, pair);
       cx += dx * s, cy += dy * s, cz += dz * s;
-    }
+    });
     Vec3 dx{SumLanes(cx), SumLanes(cy), SumLanes(cz)};
     if (li != 0.0f) {  // the walls' and paddles' terms are li times theirs
       const float scale = li * ph.invRestDensity;
       const GridView& g = stage.grid;
-      const float* boundary = reinterpret_cast<const float*>(g.boundary);
       Lanes bx = zero, by = zero, bz = zero;
-      ForWallLanes(g, xi, [&](LaneInts index, int n) {
-        Lanes xb, yb, zb, psi;
-        GatherXyzw(boundary, index, &xb, &yb, &zb, &psi);
-        const Lanes ex = xi.x - xb, ey = xi.y - yb, ez = xi.z - zb;
-        const Lanes r2 = ex * ex + ey * ey + ez * ez;
-        const LaneInts pair = And(Less(r2, Splat(k.H2)), FirstLanes(n));
-        if (Bits(pair) == 0) return;
-        const Lanes r = Sqrt(r2);
-        const Lanes s = scale * psi * GradFactorLanes(k, r * k.invH, r, pair);
+      ForWallLanes(g, k, xi, [&](Lanes ex, Lanes ey, Lanes ez, Lanes r, Lanes q, Lanes psi, LaneInts pair) {
+        const Lanes s = scale * psi * GradFactorLanes(k, q, r, pair);
         bx += ex * s, by += ey * s, bz += ez * s;
       });
       dx += Vec3{SumLanes(bx), SumLanes(by), SumLanes(bz)};
@@ -199,10 +186,7 @@ struct PbfXsphListStage {
   PbfXsphStage stage;
 
   void operator()(int i) const {
-    const NeighbourList& list = stage.list;
-    const uint32_t found = list.count[i];
-    const uint32_t capacity = static_cast<uint32_t>(list.maxNeighbours);
-    if (found > capacity) {
+    if (Overflowed(stage.list, i)) {
       stage(i);
       return;
     }
@@ -211,25 +195,15 @@ struct PbfXsphListStage {
     const FluidView& f = stage.fluid;
     const Vec3 xi = Xyz(f.position[i]);
     const Vec3 vi = Xyz(f.velocity[i]);
-    const float* position = reinterpret_cast<const float*>(f.position);
     const float* velocity = reinterpret_cast<const float*>(f.velocity);
-    const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(capacity);
     const Lanes zero = Splat(0.0f);
-    const LaneInts self = LaneInts{} + i;
     Lanes ux = zero, uy = zero, uz = zero;
-    for (uint32_t base = 0; base < found; base += kLanes) {
-      const LaneInts index = ListLanes(slots, base, found, i);
-      Lanes xj, yj, zj;
-      GatherXyz(position, index, &xj, &yj, &zj);
-      const Lanes dx = xi.x - xj, dy = xi.y - yj, dz = xi.z - zj;
-      const Lanes r2 = dx * dx + dy * dy + dz * dz;
-      const LaneInts pair = And(Less(r2, Splat(k.H2)), index != self);
-      if (Bits(pair) == 0) continue;
-      const Lanes wj = KernelWLanes(k, Sqrt(r2) * k.invH, pair);
+    ForListLanes(stage.list, f, k, i, xi, [&](LaneInts index, Lanes, Lanes, Lanes, Lanes, Lanes q, LaneInts pair) {
+      const Lanes wj = KernelWLanes(k, q, pair);
       Lanes vx, vy, vz;
       GatherXyz(velocity, index, &vx, &vy, &vz);
       ux += (vx - vi.x) * wj, uy += (vy - vi.y) * wj, uz += (vz - vi.z) * wj;
-    }
+    });
     const Vec3 dv{SumLanes(ux), SumLanes(uy), SumLanes(uz)};
     stage.view.delta[i] = MakeVec4(dv * (ph.pbfXsph * ph.volume));
   }
