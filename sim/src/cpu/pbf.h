@@ -121,16 +121,11 @@ struct PbfLambdaListStage {
     });
     float sumBoundary = SumLanes(bw);
     gradI += Vec3{SumLanes(bx), SumLanes(by), SumLanes(bz)};
-    if (g.MovingNear(xi)) {
-      ForEachInCells(g, g.bodyStart, g.bodyEnd, g.body, xi, [&](uint32_t b, Vec3 d) {
-        const float r2 = Dot(d, d);
-        if (r2 >= k.H2) return;
-        const float r = sqrtf(r2);
-        const float psi = g.body[b].w;
-        sumBoundary += psi * k.W(r);
-        gradI += d * (psi * invRho0 * k.GradFactor(r));
-      });
-    }
+    ForEachBodyNear(g, xi, k.H2, [&](float psi, Vec3 d) {
+      const float r = sqrtf(Dot(d, d));
+      sumBoundary += psi * k.W(r);
+      gradI += d * (psi * invRho0 * k.GradFactor(r));
+    });
     stage.Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
   }
 };
@@ -171,12 +166,7 @@ struct PbfCorrectListStage {
         bx += ex * s, by += ey * s, bz += ez * s;
       });
       dx += Vec3{SumLanes(bx), SumLanes(by), SumLanes(bz)};
-      if (g.MovingNear(xi)) {
-        ForEachInCells(g, g.bodyStart, g.bodyEnd, g.body, xi, [&](uint32_t b, Vec3 d) {
-          const float r2 = Dot(d, d);
-          if (r2 < k.H2) dx += d * (scale * g.body[b].w * k.GradFactor(sqrtf(r2)));
-        });
-      }
+      ForEachBodyNear(g, xi, k.H2, [&](float psi, Vec3 d) { dx += d * (scale * psi * k.GradFactor(sqrtf(Dot(d, d)))); });
     }
     stage.view.delta[i] = MakeVec4(dx);
   }

@@ -79,6 +79,15 @@ struct PbfPredictStage {
   }
 };
 
+/// f(Psi_b, x_i - x_b) for every paddle particle within the support of xi.
+template <class F>
+SPHXR_HD SPHXR_INLINE void ForEachBodyNear(const GridView& grid, Vec3 xi, float h2, F&& f) {
+  if (!grid.MovingNear(xi)) return;
+  ForEachInCells(grid, grid.bodyStart, grid.bodyEnd, grid.body, xi, [&](uint32_t b, Vec3 d) {
+    if (Dot(d, d) < h2) f(grid.body[b].w, d);
+  });
+}
+
 /// f(Psi_b, x_i - x_b) for every wall and paddle particle within the support of xi.
 template <class F>
 SPHXR_HD SPHXR_INLINE void ForEachBoundaryNear(const GridView& grid, Vec3 xi, float h2, F&& f) {
@@ -89,11 +98,7 @@ SPHXR_HD SPHXR_INLINE void ForEachBoundaryNear(const GridView& grid, Vec3 xi, fl
       if (Dot(d, d) < h2) f(grid.boundary[b].w, d);
     });
   }
-  if (grid.MovingNear(xi)) {
-    ForEachInCells(grid, grid.bodyStart, grid.bodyEnd, grid.body, xi, [&](uint32_t b, Vec3 d) {
-      if (Dot(d, d) < h2) f(grid.body[b].w, d);
-    });
-  }
+  ForEachBodyNear(grid, xi, h2, f);
 }
 
 /// f(j, x_i - x_j) for every other fluid particle in particle i's list (or cells, where it overflowed).
