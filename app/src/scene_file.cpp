@@ -256,14 +256,9 @@ Status ParseScene(const std::string& text, const std::string& origin, SceneFile*
       return Status::Error(Format("%s: nested more than %d levels deep: not a scene", origin.c_str(), kMaxDepth));
     }
   } catch (const json::exception& e) {  // parse errors, and numbers too large for a double
-    // (The parser quotes the bytes it read last: a binary file given by mistake must not put raw control
-    // bytes on the terminal.)
-    std::string what = e.what();
-    for (char& c : what) {
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-    }
-    // ("last read" quotes the whole token: a 5 MB unterminated string would be a 5 MB message.)
-    if (what.size() > 2 * kMaxEcho) what = what.substr(0, 2 * kMaxEcho - 3) + "...";
+    // The parser quotes the bytes it read last, whole: a binary file given by mistake, invalid UTF-8
+    // or a 5 MB unterminated string must reach the terminal escaped and cut, like any user text.
+    const std::string what = ShowText(e.what(), 2 * kMaxEcho);
     return Status::Error(origin + ": not valid JSON: " + what);
   }
   if (Status s = scan.Run(origin); !s) return s;

@@ -38,6 +38,7 @@ void ExpectCleanRefusal(const Status& s, const std::string& needle, size_t longe
   for (const char* hidden : {"\xC2\x85", "\xC2\x9B", "\xE2\x80\xAE", "\xE2\x80\xA8"}) {
     EXPECT_EQ(m.find(hidden), std::string::npos) << m.substr(0, 400);
   }
+  EXPECT_TRUE(IsPlainText(m)) << "not plain text (invalid UTF-8 or a hidden code point): " << ShowText(m, 400);
 }
 
 Status Parse(const std::string& text, SceneFile* scene) { return ParseScene(text, "test.json", scene); }
@@ -157,6 +158,16 @@ TEST(HardeningRound2, NamesWithControlBidiOrLineSeparatorsAreRefused) {
   ExpectCleanRefusal(Parse(SceneWith(forged), &scene), "probes.level[0].name");
   // Plain UTF-8 is a name.
   EXPECT_TRUE(Parse(SceneWith("\"name\": \"Becken \\u00fcber \\u6c34\""), &scene).ok());
+}
+
+// The JSON parser's own message quotes the bytes it read last: invalid UTF-8 (the fuzzer's find: a
+// Latin-1 byte pair after a number), an escape sequence and a C1 control must reach the user escaped.
+TEST(HardeningRound2, TheJsonParsersMessageIsShownEscaped) {
+  SceneFile scene;
+  const std::string latin1 = "{\"name\": \"plain\", \"tank\": {\"min\": [0, 0, 0\xA1\xD3 \"max\": [1, 1, 1]}}";
+  ExpectCleanRefusal(Parse(latin1, &scene), "not valid JSON");
+  ExpectCleanRefusal(Parse("{\"name\": \x1b]0;owned\x07\xC2\x9B\xE2\x80\xAE}", &scene), "not valid JSON");
+  ExpectCleanRefusal(Parse("{\"name\": \"" + std::string(100000, 'n'), &scene), "not valid JSON");
 }
 
 TEST(HardeningRound2, UnknownKeysAndBodiesAreShownEscapedAndCut) {
