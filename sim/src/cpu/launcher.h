@@ -17,6 +17,8 @@ class CpuLauncher {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  /// PBF's SIMD lambda pass keeps each pair's kernel gradient for the correction pass (cpu/pbf.h).
+  static constexpr bool kPbfPairCache = true;
   /// The SIMD stages' loop. thrust's OpenMP for_each gives each thread one equal slice; these stages'
   /// items cost what their neighbours and walls cost, and with reuse the compacted list puts the calm
   /// (skipped) water in one part of the index range, so one thread waited for the other at every stage.

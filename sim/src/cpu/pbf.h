@@ -6,7 +6,15 @@
 // stage, and the paddles' particles (a few near any fluid particle) stay scalar. CpuLauncher::ForEach
 // runs these in place of the scalar stages (SimdForm); the CUDA backend and cpu-reference run the scalar
 // ones. Deterministic for any thread count: a particle's sums never depend on the schedule.
+//
+// The pair cache (PbfView::pairGrad): between an iteration's lambda pass and its correction pass no
+// particle moves, so the lambda pass keeps each listed pair's V grad W_ij (kLanes pairs of x, then y,
+// then z) and each particle's own terms, lambda_i (sum_j V grad W_ij + B_i) + sum_j s_corr V grad W_ij.
+// The correction pass is then sum_j lambda_j V grad W_ij over the cache plus the own terms: a gather of
+// lambda and three loads a batch, no position, square root or kernel. It took the correction pass
+// from as long as the lambda pass to a fifth of it on `stir` (docs/design/pbf.md).
 #include <cstdint>
+#include <cstring>
 
 #include "cpu/simd.h"
 #include "solvers/pbf_stages.h"
@@ -29,27 +37,37 @@ SPHXR_INLINE bool Overflowed(const NeighbourList& list, int i) {
   return list.count[i] > static_cast<uint32_t>(list.maxNeighbours);
 }
 
-/// f(index, dx, dy, dz, r, q, pair) for particle i's listed fluid neighbours kLanes at a time: d = x_i - x_j,
-/// r = |d|, q = r / H, `pair` the lanes within the support other than i itself (batches with none skipped).
+/// f(index, dx, dy, dz, r, q, pair, batch) for particle i's listed fluid neighbours kLanes at a time:
+/// d = x_i - x_j, r = |d|, q = r / H, `pair` the lanes within the support other than i itself, `batch`
+/// the batch's number in the list. Batches with no pair are skipped unless `everyBatch`.
 template <class F>
 SPHXR_INLINE void ForListLanes(const NeighbourList& list, const FluidView& fluid, const CubicSpline& k, int i, Vec3 xi,
-                               F&& f) {
+                               F&& f, bool everyBatch = false) {
   const uint32_t found = list.count[i];
   const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
   const float* position = reinterpret_cast<const float*>(fluid.position);  // Vec4: x y z w
   const LaneInts self = LaneInts{} + i;
-  for (uint32_t base = 0; base < found; base += kLanes) {
+  int batch = 0;
+  for (uint32_t base = 0; base < found; base += kLanes, ++batch) {
     const LaneInts index = ListLanes(slots, base, found, i);
     Lanes xj, yj, zj;
     GatherXyz(position, index, &xj, &yj, &zj);
     const Lanes dx = xi.x - xj, dy = xi.y - yj, dz = xi.z - zj;
     const Lanes r2 = dx * dx + dy * dy + dz * dz;
     const LaneInts pair = And(Less(r2, Splat(k.H2)), index != self);
-    if (Bits(pair) == 0) continue;
+    if (!everyBatch && Bits(pair) == 0) continue;
     const Lanes r = Sqrt(r2);
-    f(index, dx, dy, dz, r, r * k.invH, pair);
+    f(index, dx, dy, dz, r, r * k.invH, pair, batch);
   }
 }
+
+/// kLanes floats from p (any alignment), and back.
+SPHXR_INLINE Lanes LoadLanes(const float* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+SPHXR_INLINE void StoreLanes(float* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
 
 /// The lanes l < n as a mask.
 SPHXR_INLINE LaneInts FirstLanes(int n) {
@@ -88,6 +106,15 @@ SPHXR_INLINE void ForWallLanes(const GridView& g, const CubicSpline& k, Vec3 xi,
   if (n > 0) flush();
 }
 
+/// PbfCorr (MM13's s_corr) in every lane from the pairs' W_ij.
+SPHXR_INLINE Lanes CorrLanes(const Physics& ph, Lanes w) {
+  if (ph.pbfCorrK <= 0.0f) return Splat(0.0f);
+  const Lanes wq = w * ph.pbfInvCorrW;
+  Lanes p = wq;
+  for (int e = 1; e < ph.pbfCorrN; ++e) p *= wq;
+  return -ph.pbfCorrK * p;
+}
+
 struct PbfLambdaListStage {
   PbfLambdaStage stage;
 
@@ -99,16 +126,34 @@ struct PbfLambdaListStage {
     const Physics& ph = stage.ph;
     const CubicSpline k = ph.kernel;
     const Vec3 xi = Xyz(stage.fluid.position[i]);
+    const PbfView& view = stage.view;
+    // With the pair cache: each batch's V grad W_ij kept (every batch, so that the correction pass reads
+    // zeros where no pair is), and the sum of the pairs' s_corr V grad W_ij.
+    float* cache = view.pairGrad ? view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride) : nullptr;
+    const bool corrected = cache && ph.pbfCorrK > 0.0f;
     const Lanes zero = Splat(0.0f);
-    Lanes w = zero, s2 = zero, gx = zero, gy = zero, gz = zero;
-    ForListLanes(stage.list, stage.fluid, k, i, xi, [&](LaneInts, Lanes dx, Lanes dy, Lanes dz, Lanes r, Lanes q, LaneInts pair) {
-      w += KernelWLanes(k, q, pair);
-      const Lanes grad = ph.volume * GradFactorLanes(k, q, r, pair);
-      const Lanes ax = dx * grad, ay = dy * grad, az = dz * grad;
-      gx += ax, gy += ay, gz += az;
-      s2 += ax * ax + ay * ay + az * az;
-    });
-    Vec3 gradI{SumLanes(gx), SumLanes(gy), SumLanes(gz)};
+    Lanes w = zero, s2 = zero, gx = zero, gy = zero, gz = zero, sx = zero, sy = zero, sz = zero;
+    ForListLanes(
+        stage.list, stage.fluid, k, i, xi,
+        [&](LaneInts, Lanes dx, Lanes dy, Lanes dz, Lanes r, Lanes q, LaneInts pair, int batch) {
+          const Lanes wj = KernelWLanes(k, q, pair);
+          w += wj;
+          const Lanes grad = ph.volume * GradFactorLanes(k, q, r, pair);
+          const Lanes ax = dx * grad, ay = dy * grad, az = dz * grad;
+          gx += ax, gy += ay, gz += az;
+          s2 += ax * ax + ay * ay + az * az;
+          if (!cache) return;
+          float* out = cache + 3 * kLanes * batch;
+          StoreLanes(out, ax);
+          StoreLanes(out + kLanes, ay);
+          StoreLanes(out + 2 * kLanes, az);
+          if (corrected) {
+            const Lanes corr = CorrLanes(ph, wj);
+            sx += corr * ax, sy += corr * ay, sz += corr * az;
+          }
+        },
+        cache != nullptr);
+    const Vec3 gradF{SumLanes(gx), SumLanes(gy), SumLanes(gz)};
     const float sumW = k.W(0.0f) + SumLanes(w);
     const float sum2 = SumLanes(s2);
     const float invRho0 = ph.invRestDensity;
@@ -120,13 +165,17 @@ struct PbfLambdaListStage {
       bx += dx * grad, by += dy * grad, bz += dz * grad;
     });
     float sumBoundary = SumLanes(bw);
-    gradI += Vec3{SumLanes(bx), SumLanes(by), SumLanes(bz)};
+    Vec3 gradB{SumLanes(bx), SumLanes(by), SumLanes(bz)};
     ForEachBodyNear(g, xi, k.H2, [&](float psi, Vec3 d) {
       const float r = sqrtf(Dot(d, d));
       sumBoundary += psi * k.W(r);
-      gradI += d * (psi * invRho0 * k.GradFactor(r));
+      gradB += d * (psi * invRho0 * k.GradFactor(r));
     });
-    stage.Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
+    view.boundaryGrad[i] = MakeVec4(gradB);
+    const Vec3 gradI = gradF + gradB;
+    const float li = stage.Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
+    // The correction's terms that the pass below need not visit the pairs for: lambda_i's and s_corr's.
+    if (cache) view.ownCorrection[i] = MakeVec4(gradI * li + Vec3{SumLanes(sx), SumLanes(sy), SumLanes(sz)});
   }
 };
 
@@ -138,37 +187,32 @@ struct PbfCorrectListStage {
       stage(i);
       return;
     }
+    const PbfView& view = stage.view;
+    const Lanes zero = Splat(0.0f);
+    Lanes cx = zero, cy = zero, cz = zero;
+    if (view.pairGrad) {  // the lambda pass's pair gradients: sum_j lambda_j V grad W_ij, plus its own terms
+      const uint32_t found = stage.list.count[i];
+      const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(stage.list.maxNeighbours);
+      const float* cache = view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride);
+      for (uint32_t base = 0; base < found; base += kLanes, cache += 3 * kLanes) {
+        const Lanes lj = Gather(view.lambda, ListLanes(slots, base, found, i));  // padding: i, whose term is 0
+        cx += lj * LoadLanes(cache), cy += lj * LoadLanes(cache + kLanes), cz += lj * LoadLanes(cache + 2 * kLanes);
+      }
+      view.delta[i] = MakeVec4(Vec3{SumLanes(cx), SumLanes(cy), SumLanes(cz)} + Xyz(view.ownCorrection[i]));
+      return;
+    }
     const Physics& ph = stage.ph;
     const CubicSpline k = ph.kernel;
     const Vec3 xi = Xyz(stage.fluid.position[i]);
-    const float li = stage.view.lambda[i];
-    const Lanes zero = Splat(0.0f);
-    Lanes cx = zero, cy = zero, cz = zero;
+    const float li = view.lambda[i];
     ForListLanes(stage.list, stage.fluid, k, i, xi, [&](LaneInts index, Lanes dx, Lanes dy, Lanes dz, Lanes r, Lanes q,
-                                                         LaneInts pair) {
-      Lanes corr = zero;
-      if (ph.pbfCorrK > 0.0f) {
-        const Lanes wq = KernelWLanes(k, q, pair) * ph.pbfInvCorrW;
-        Lanes p = wq;
-        for (int e = 1; e < ph.pbfCorrN; ++e) p *= wq;
-        corr = -ph.pbfCorrK * p;
-      }
-      const Lanes s = (li + Gather(stage.view.lambda, index) + corr) * ph.volume * GradFactorLanes(k, q, r, pair);
+                                                         LaneInts pair, int) {
+      const Lanes corr = CorrLanes(ph, KernelWLanes(k, q, pair));
+      const Lanes s = (li + Gather(view.lambda, index) + corr) * ph.volume * GradFactorLanes(k, q, r, pair);
       cx += dx * s, cy += dy * s, cz += dz * s;
     });
-    Vec3 dx{SumLanes(cx), SumLanes(cy), SumLanes(cz)};
-    if (li != 0.0f) {  // the walls' and paddles' terms are li times theirs
-      const float scale = li * ph.invRestDensity;
-      const GridView& g = stage.grid;
-      Lanes bx = zero, by = zero, bz = zero;
-      ForWallLanes(g, k, xi, [&](Lanes ex, Lanes ey, Lanes ez, Lanes r, Lanes q, Lanes psi, LaneInts pair) {
-        const Lanes s = scale * psi * GradFactorLanes(k, q, r, pair);
-        bx += ex * s, by += ey * s, bz += ez * s;
-      });
-      dx += Vec3{SumLanes(bx), SumLanes(by), SumLanes(bz)};
-      ForEachBodyNear(g, xi, k.H2, [&](float psi, Vec3 d) { dx += d * (scale * psi * k.GradFactor(sqrtf(Dot(d, d)))); });
-    }
-    stage.view.delta[i] = MakeVec4(dx);
+    // the walls' and paddles' terms: lambda_i B_i (B_i from the lambda pass)
+    view.delta[i] = MakeVec4(Vec3{SumLanes(cx), SumLanes(cy), SumLanes(cz)} + Xyz(view.boundaryGrad[i]) * li);
   }
 };
 
@@ -188,7 +232,7 @@ struct PbfXsphListStage {
     const float* velocity = reinterpret_cast<const float*>(f.velocity);
     const Lanes zero = Splat(0.0f);
     Lanes ux = zero, uy = zero, uz = zero;
-    ForListLanes(stage.list, f, k, i, xi, [&](LaneInts index, Lanes, Lanes, Lanes, Lanes, Lanes q, LaneInts pair) {
+    ForListLanes(stage.list, f, k, i, xi, [&](LaneInts index, Lanes, Lanes, Lanes, Lanes, Lanes q, LaneInts pair, int) {
       const Lanes wj = KernelWLanes(k, q, pair);
       Lanes vx, vy, vz;
       GatherXyz(velocity, index, &vx, &vy, &vz);

@@ -33,7 +33,7 @@ class PbfSolver final : public PressureSolver<Traits> {
     SPHXR_TRY(ctx.Lap(Stage::kDensity));
     // 3. pbf_iterations Jacobi iterations of the density constraint                 [MM13 eq. 9-13]
     const NeighbourList list = ctx.Neighbours();
-    const PbfView view = View();
+    const PbfView view = View(ph.maxNeighbours);
     thrust::fill(Traits::Policy(), m_lambdaSum.begin(), m_lambdaSum.end(), 0.0f);
     for (int k = 0; k < ph.pbfIterations; ++k) {
       ctx.Launch().ForEach(ctx.n, 64, PbfLambdaStage{ctx.grid, ctx.fluid, list, ph, view});
@@ -73,17 +73,37 @@ class PbfSolver final : public PressureSolver<Traits> {
   }
 
  private:
+  /// Whether the backend's launcher runs the SIMD passes that keep the lambda pass's pair terms (the
+  /// CPU's, cpu/pbf.h); the others recompute them and need no pair array.
+  static constexpr bool kPairCache = [] {
+    if constexpr (requires { Traits::Launcher::kPbfPairCache; }) return Traits::Launcher::kPbfPairCache;
+    return false;
+  }();
+
   void Size(int n) {
     const size_t count = static_cast<size_t>(n);
     if (m_lambda.size() == count) return;
     m_lambda.resize(count);
     m_lambdaSum.resize(count);
     m_delta.resize(count);
+    m_boundaryGrad.resize(count);
+    if constexpr (kPairCache) m_ownCorrection.resize(count);
   }
-  PbfView View() { return PbfView{Raw(m_lambda), Raw(m_lambdaSum), Raw(m_delta)}; }
+  PbfView View(int maxNeighbours) {
+    PbfView v{Raw(m_lambda), Raw(m_lambdaSum), Raw(m_delta), Raw(m_boundaryGrad), nullptr, nullptr, 0};
+    if constexpr (kPairCache) {
+      v.pairStride = PbfPairStride(maxNeighbours);
+      m_pairGrad.resize(m_lambda.size() * static_cast<size_t>(v.pairStride));
+      v.pairGrad = Raw(m_pairGrad);
+      v.ownCorrection = Raw(m_ownCorrection);
+    }
+    return v;
+  }
 
   Vector<float> m_lambda, m_lambdaSum;
-  Vector<Vec4> m_delta;
+  Vector<Vec4> m_delta, m_boundaryGrad;
+  Vector<float> m_pairGrad;        // the CPU's pair cache (PbfView::pairGrad)
+  Vector<Vec4> m_ownCorrection;
 };
 
 }  // namespace sphxr::sim

@@ -8,7 +8,8 @@
 //             lambda_i = -C_i / (sum_k |grad_k C_i|^2 + eps)                   [MM13 eq. 1, 9, 11]
 //             with grad_j C_i = -V grad W_ij, grad_i C_i = V sum_j grad W_ij + sum_b (Psi_b / rho0) grad W_ib
 //             (the walls and paddles are Akinci et al. 2012's boundary particles, as everywhere)
-//   correct   dx_i = sum_j V (lambda_i + lambda_j + s_corr) grad W_ij + sum_b lambda_i (Psi_b / rho0) grad W_ib,
+//   correct   dx_i = sum_j V (lambda_i + lambda_j + s_corr) grad W_ij + lambda_i B_i,
+//             B_i = sum_b (Psi_b / rho0) grad W_ib kept from the lambda pass (the positions have not moved),
 //             s_corr = -k (W_ij / W(dq))^n against clumping where the kernel is cut  [MM13 eq. 12, 13]
 //   collide   x* out of the tank's faces and the obstacles by the particle's radius (half a spacing),
 //             in the prediction and after every iteration's correction                 [MM13 alg. 1]
@@ -26,10 +27,22 @@ namespace sphxr::sim {
 
 /// The solve's per-particle arrays (scratch of one step).
 struct PbfView {
-  float* lambda;     // this iteration's lambda_i
-  float* lambdaSum;  // Lambda_i, the step's sum
-  Vec4* delta;       // this iteration's position correction (xsph: the velocity change)
+  float* lambda;       // this iteration's lambda_i
+  float* lambdaSum;    // Lambda_i, the step's sum
+  Vec4* delta;         // this iteration's position correction (xsph: the velocity change)
+  Vec4* boundaryGrad;  // B_i = sum_b (Psi_b / rho0) grad W_ib over the walls and paddles, from the lambda
+                       // pass: the correction's boundary term is lambda_i B_i (positions do not move between)
+  // The CPU's SIMD passes only (cpu/pbf.h; nullptr on the other backends): the lambda pass keeps
+  // V grad W_ij of each list slot, and lambda_i (sum_j V grad W_ij + B_i) + sum_j s_corr V grad W_ij of each
+  // particle, so the correction pass adds sum_j lambda_j V grad W_ij without evaluating the kernel again.
+  float* pairGrad;     // pairStride floats a particle: per kLanes slots, the x, y and z of kLanes pairs
+  Vec4* ownCorrection;
+  int pairStride;
 };
+
+/// Floats a particle of PbfView::pairGrad takes for `maxNeighbours` list slots, in batches of up to 16
+/// lanes (so at least what any CPU tier's kLanes needs).
+SPHXR_HD SPHXR_INLINE int PbfPairStride(int maxNeighbours) { return (maxNeighbours + 15) / 16 * 16 * 3; }
 
 /// The collision response of MM13's solver loop: x* moved out of the tank's faces and the obstacles to
 /// the particle's radius from them (ph.pbfContact beyond the clamp box, whose inset is a quarter
@@ -142,22 +155,35 @@ struct PbfLambdaStage {
     });
     float sumBoundary = 0.0f;
     const float invRho0 = ph.invRestDensity;
+    Vec3 gradB{0.0f, 0.0f, 0.0f};
     ForEachBoundaryNear(grid, xi, k.H2, [&](float psi, Vec3 d) {
       const float r = sqrtf(Dot(d, d));
       sumBoundary += psi * k.W(r);
-      gradI += d * (psi * invRho0 * k.GradFactor(r));
+      gradB += d * (psi * invRho0 * k.GradFactor(r));
     });
+    view.boundaryGrad[i] = MakeVec4(gradB);
+    gradI += gradB;
     Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
   }
   /// rho_i, and lambda_i from it and sum_k |grad_k C_i|^2 (also the CPU's SIMD form's end, cpu/pbf.h).
-  SPHXR_HD SPHXR_INLINE void Finish(int i, float rho, float gradSum2) const {
+  SPHXR_HD SPHXR_INLINE float Finish(int i, float rho, float gradSum2) const {
     fluid.density[i] = rho;
     const float c = AtLeast(rho * ph.invRestDensity - 1.0f, 0.0f);
     const float lambda = -c / (gradSum2 + ph.pbfRelaxation);
     view.lambda[i] = lambda;
     view.lambdaSum[i] += lambda;
+    return lambda;
   }
 };
+
+/// MM13's artificial pressure s_corr = -k (W(r) / W(dq))^n of a pair at distance r with W(r) = w [eq. 13].
+SPHXR_HD SPHXR_INLINE float PbfCorr(const Physics& ph, float w) {
+  if (ph.pbfCorrK <= 0.0f) return 0.0f;
+  const float wq = w * ph.pbfInvCorrW;
+  float p = wq;
+  for (int e = 1; e < ph.pbfCorrN; ++e) p *= wq;
+  return -ph.pbfCorrK * p;
+}
 
 struct PbfCorrectStage {
   GridView grid;
@@ -172,19 +198,10 @@ struct PbfCorrectStage {
     const float volume = ph.volume;
     Vec3 dx{0.0f, 0.0f, 0.0f};
     ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t j, Vec3 d, float r) {
-      float corr = 0.0f;
-      if (ph.pbfCorrK > 0.0f) {
-        const float w = k.W(r) * ph.pbfInvCorrW;
-        float p = w;
-        for (int e = 1; e < ph.pbfCorrN; ++e) p *= w;
-        corr = -ph.pbfCorrK * p;
-      }
+      const float corr = PbfCorr(ph, k.W(r));
       dx += d * ((li + view.lambda[j] + corr) * volume * k.GradFactor(r));
     });
-    const float invRho0 = ph.invRestDensity;
-    ForEachBoundaryNear(grid, xi, k.H2, [&](float psi, Vec3 d) {
-      dx += d * (li * psi * invRho0 * k.GradFactor(sqrtf(Dot(d, d))));
-    });
+    dx += Xyz(view.boundaryGrad[i]) * li;  // sum_b lambda_i (Psi_b / rho0) grad W_ib
     view.delta[i] = MakeVec4(dx);
   }
 };
