@@ -43,8 +43,72 @@ float KernelFractionInside(float offset, float supportRadius) {
   return static_cast<float>(0.5 + simpson(0.0, offset, 64, plane));
 }
 
-float ProbeDryThreshold(float offset, float supportRadius) {
-  return kDryFraction * KernelFractionInside(offset, supportRadius);
+namespace {
+
+/// The kernel's integral over the box [lo, hi] (relative to the kernel's centre), clipped to its support's
+/// cube: composite Simpson, 32 intervals an axis (the kernel is C2, so the rule's error is far below the
+/// thresholds' needs; tests/sim/probes_test.cpp holds it to the flat wall's exact fraction).
+double KernelBoxIntegral(Vec3 lo, Vec3 hi, const CubicSpline& k) {
+  const double H = k.H;
+  const double a[3] = {std::max<double>(lo.x, -H), std::max<double>(lo.y, -H), std::max<double>(lo.z, -H)};
+  const double b[3] = {std::min<double>(hi.x, H), std::min<double>(hi.y, H), std::min<double>(hi.z, H)};
+  if (!(a[0] < b[0] && a[1] < b[1] && a[2] < b[2])) return 0.0;
+  constexpr int n = 32;
+  double h[3], w[n + 1];
+  for (int d = 0; d < 3; ++d) h[d] = (b[d] - a[d]) / n;
+  for (int i = 0; i <= n; ++i) w[i] = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+  double sum = 0.0;
+  for (int i = 0; i <= n; ++i) {
+    const double x = a[0] + i * h[0];
+    for (int j = 0; j <= n; ++j) {
+      const double y = a[1] + j * h[1], xy2 = x * x + y * y;
+      if (xy2 >= H * H) continue;
+      double row = 0.0;
+      for (int l = 0; l <= n; ++l) {
+        const double z = a[2] + l * h[2];
+        row += w[l] * static_cast<double>(k.W(static_cast<float>(std::sqrt(xy2 + z * z))));
+      }
+      sum += w[i] * w[j] * row;
+    }
+  }
+  return sum * h[0] * h[1] * h[2] / 27.0;
+}
+
+bool Overlaps(const Aabb& box, Vec3 lo, Vec3 hi) {
+  return box.min.x < hi.x && box.max.x > lo.x && box.min.y < hi.y && box.max.y > lo.y && box.min.z < hi.z &&
+         box.max.z > lo.z;
+}
+
+}  // namespace
+
+float KernelFractionInRegion(Vec3 point, const Aabb& tank, const std::vector<Aabb>& obstacles, float supportRadius) {
+  const float H = supportRadius;
+  const Vec3 lo = point - Vec3{H, H, H}, hi = point + Vec3{H, H, H};
+  bool nearObstacle = false;
+  for (const Aabb& o : obstacles) nearObstacle = nearObstacle || Overlaps(o, lo, hi);
+  // The tank's faces within the support, and the distance to the nearest.
+  const float gaps[6] = {point.x - tank.min.x, tank.max.x - point.x, point.y - tank.min.y,
+                         tank.max.y - point.y, point.z - tank.min.z, tank.max.z - point.z};
+  int faces = 0;
+  float nearest = H;
+  for (const float g : gaps) {
+    if (g < H) ++faces;
+    nearest = std::min(nearest, g);
+  }
+  if (!nearObstacle && faces == 0) return 1.0f;
+  if (!nearObstacle && faces == 1) return KernelFractionInside(nearest, H);  // exact: one flat face
+  const CubicSpline k = CubicSpline::Make(H);
+  double inside = KernelBoxIntegral(tank.min - point, tank.max - point, k);
+  for (const Aabb& o : obstacles) {  // (obstacles that overlap each other are taken out twice: clamped)
+    const Aabb solid{{std::max(o.min.x, tank.min.x), std::max(o.min.y, tank.min.y), std::max(o.min.z, tank.min.z)},
+                     {std::min(o.max.x, tank.max.x), std::min(o.max.y, tank.max.y), std::min(o.max.z, tank.max.z)}};
+    inside -= KernelBoxIntegral(solid.min - point, solid.max - point, k);
+  }
+  return static_cast<float>(std::clamp(inside, 0.0, 1.0));
+}
+
+float ProbeDryThreshold(Vec3 point, const Aabb& tank, const std::vector<Aabb>& obstacles, float supportRadius) {
+  return kDryFraction * KernelFractionInRegion(point, tank, obstacles, supportRadius);
 }
 
 Status Solver::UploadProbes(const ProbeSet& probes, std::vector<float>* dry) {
@@ -70,7 +134,7 @@ Status Solver::UploadProbes(const ProbeSet& probes, std::vector<float>* dry) {
                            Str(tank.max));
     }
     points.push_back(MakeVec4(x));
-    dry->push_back(ProbeDryThreshold(wall ? offset : support, support));
+    dry->push_back(ProbeDryThreshold(x, tank, m_scene.obstacles, support));
   }
   for (const LevelGauge& g : probes.level) {
     const std::string who = "gauge '" + g.name + "'";

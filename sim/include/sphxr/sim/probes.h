@@ -65,13 +65,22 @@ struct ProbeSample {
 /// flooded wall. Host only.
 float KernelFractionInside(float offset, float supportRadius);
 
-/// A pressure probe is dry when its Shepard sum is below half of KernelFractionInside at its offset:
-/// half of what the water gives it next to a flooded wall, which is what it has when the free surface
-/// of still water passes through the probe's point (half of its kernel in the air). A lone drop of one
-/// particle on the probe gives 1/pi ~ 0.32 against a threshold of 0.5 (away from walls) or 0.41 (half a
-/// spacing from a wall at the default support): spray that touches a sensor does not make it wet.
+/// The fraction of the kernel's volume integral around `point` that lies in the tank and outside its
+/// obstacles: what sum_j V_j W is at that point when the water floods everything around it. 1 a support
+/// from every face; KernelFractionInside of the distance next to one flat face; less in an edge or a
+/// corner (about a quarter and an eighth at the faces, 0.66 and 0.53 half a spacing from two and three
+/// faces at the default support). Host only; numerical (Simpson) where two faces or an obstacle are
+/// within the support, to about 1e-4.
+float KernelFractionInRegion(Vec3 point, const Aabb& tank, const std::vector<Aabb>& obstacles, float supportRadius);
+
+/// A pressure probe is dry when its Shepard sum is below half of KernelFractionInRegion at its point:
+/// half of what the water gives it there when the water floods the walls around it, which is what it has
+/// when the free surface of still water passes through the point (half of its kernel in the air). A lone
+/// drop of one particle on the probe gives 1/pi ~ 0.32 against a threshold of 0.5 (away from walls),
+/// 0.41 (half a spacing from a flat wall at the default support), 0.33 in a vertical edge and 0.27 in a
+/// corner: there the sensor reads the water that can reach it, as a flooded corner sensor must.
 inline constexpr float kDryFraction = 0.5f;
-float ProbeDryThreshold(float offset, float supportRadius);
+float ProbeDryThreshold(Vec3 point, const Aabb& tank, const std::vector<Aabb>& obstacles, float supportRadius);
 
 /// The level gauges' sampling: the line is walked upward in steps of kLevelCoarse spacings (the fraction
 /// falls from 1 to 0 over a kernel support, two spacings, so no surface is stepped over; an air gap
