@@ -237,6 +237,13 @@ Status ValidateScene(const SceneSetup& scene) {
                                     "error) or raise solver.stiffness",
                                     key.c_str(), speed, speed / soundSpeed, soundSpeed, method.name, soundSpeed));
       }
+      // A method that caps every speed would start the block slower than the scene says, silently.
+      if (method.speedCap && speed > method.speedCap(scene.params)) {
+        return Status::Error(Format("%s.velocity: %g m/s is above the %g m/s that solver.method %s holds every particle "
+                                    "to: lower the speed or raise solver.%s",
+                                    key.c_str(), speed, method.speedCap(scene.params), method.name,
+                                    method.speedCapParam));
+      }
     }
     if (!Contains(scene.tank, scene.fluid[i].box, slack)) {
       return Status::Error(key + ": the block " + Str(scene.fluid[i].box.min) + " to " + Str(scene.fluid[i].box.max) +

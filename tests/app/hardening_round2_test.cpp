@@ -283,6 +283,12 @@ TEST(HardeningRound2, ABlockFasterThanTheSoundSpeedIsRefusedUnderWcsph) {
   s.fluid[0].velocity = {100.0f, 0.0f, 0.0f};
   s.method = sim::SolverMethod::kDfsph;
   EXPECT_TRUE(sim::ValidateScene(s).ok());
+  // PBF holds every speed to pbf_max_speed (20 m/s): a faster block would start slower than the scene
+  // says, silently (it ran at 20 m/s).
+  s.method = sim::SolverMethod::kPbf;
+  ExpectCleanRefusal(sim::ValidateScene(s), "pbf_max_speed");
+  s.fluid[0].velocity = {15.0f, 0.0f, 0.0f};
+  EXPECT_TRUE(sim::ValidateScene(s).ok());
 }
 
 // ---- state-file clocks -----------------------------------------------------------------------------
