@@ -1,8 +1,9 @@
 // sphxr_bench_tradeoff: cost against accuracy on the Martin & Moyce (1952) dam break
 // (scenes/dam_break.json), swept over particle spacing (a/14, a/20, a/26 with a = 0.05715 m) and, per
-// method, the knob that buys accuracy with time: WCSPH's Tait stiffness (x0.5, x1, x4 of the scene's
-// value) and DFSPH's density tolerance (1 %, 0.1 %, 0.01 %). Everything else is the scene's: the column
-// and the tank are fixed in metres, so the particle count changes with the spacing.
+// method, the knob that buys accuracy with time (kKnobs): WCSPH's Tait stiffness (x0.5, x1, x4 of the
+// scene's value), DFSPH's density tolerance (1 %, 0.1 %, 0.01 %) and PBF's iterations per substep (2, 3,
+// 6; its 3 substeps a 90 Hz frame). Everything else is the scene's: the column and the tank are fixed
+// in metres, so the particle count changes with the spacing.
 //
 // Each run goes to t = 0.19 s (T = t sqrt(2g/a) = 3.5) and records:
 //   - wall seconds per simulated second (time inside Solver::Step only; the probe is not counted),
@@ -11,7 +12,7 @@
 //     minPerBin from app::DamBreakMinPerBin, as the headless runner) interpolated linearly in time at
 //     each measured T; RMS and maximum of |Z_sim / Z_measured - 1|,
 //   - the mean density error, time-averaged (weighted by dt) over the run,
-//   - under DFSPH the mean iterations of its density and divergence solves.
+//   - the mean iterations of DFSPH's density and divergence solves, PBF's iterations a step.
 // --csv writes one row per run (bench/results/tradeoff.csv); bench/plot_tradeoff.py draws docs/images/tradeoff.png.
 #include <chrono>
 #include <cmath>
@@ -30,6 +31,7 @@
 #include "sphxr/common/log.h"
 #include "sphxr/sim/measure.h"
 #include "sphxr/sim/solver.h"
+#include "sphxr/sim/solver_table.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR "scenes"
@@ -43,7 +45,7 @@ namespace {
 
 struct Args {
   bool quick = false;
-  std::string methods = "wcsph,dfsph";
+  std::string methods = "wcsph,dfsph,pbf";
   int threads = 0;
   std::string csv;
   std::string scene = SPHXR_SCENES_DIR "/dam_break.json";
@@ -53,9 +55,9 @@ struct Args {
 
 const char* kUsage =
     "usage: sphxr_bench_tradeoff [--quick] [--methods LIST] [--threads N] [--csv FILE] [--scene FILE] [--data FILE]\n"
-    "  --quick       2 configurations per method (a/14 and a/20; stiffness x1, tolerance 0.1 %) to t = 0.05 s (a\n"
-    "                smoke run; the front error then covers only the measured points with T <= 0.93)\n"
-    "  --methods L   comma-separated: wcsph, dfsph (default both)\n"
+    "  --quick       2 configurations per method (a/14 and a/20; stiffness x1, tolerance 0.1 %, 3 iterations) to\n"
+    "                t = 0.05 s (a smoke run; the front error then covers only the measured points with T <= 0.93)\n"
+    "  --methods L   comma-separated: wcsph, dfsph, pbf (default all three)\n"
     "  --threads N   CPU backend threads (default 0 = all cores)\n"
     "  --csv FILE    write one row per run to FILE (overwritten; only a file with this bench's header)\n"
     "  --scene FILE  dam-break scene (default " SPHXR_SCENES_DIR "/dam_break.json)\n"
@@ -82,7 +84,7 @@ bool ParseArgs(int argc, char** argv, Args* out) {
       for (std::string m; std::getline(ss, m, ',');) {
         sim::SolverMethod parsed;
         if (!sim::ParseSolverMethod(m, &parsed)) {
-          std::fprintf(stderr, "--methods: unknown method '%s' (wcsph, dfsph)\n", m.c_str());
+          std::fprintf(stderr, "--methods: unknown method '%s' (%s)\n", m.c_str(), sim::SolverNames().c_str());
           return false;
         }
       }
@@ -144,8 +146,39 @@ double Interpolate(const std::vector<Point>& s, double t) {
 struct Config {
   sim::SolverMethod method;
   int spacingDivisor;     // spacing = a / divisor
-  double knob;            // WCSPH: x the scene's stiffness; DFSPH: the density tolerance in %
+  double knob;            // its method's Knob: WCSPH x the scene's stiffness, DFSPH the tolerance %, PBF iterations
 };
+
+/// Per method, the setting that buys accuracy with time, and its sweep.
+struct Knob {
+  sim::SolverMethod method;
+  const char* label;           // for the table and the log
+  std::vector<double> values;  // the full sweep
+  double quick;                // the smoke run's
+};
+const Knob kKnobs[] = {
+    {sim::SolverMethod::kWcsph, "stiffness x", {0.5, 1.0, 4.0}, 1.0},
+    {sim::SolverMethod::kDfsph, "density tolerance %", {1.0, 0.1, 0.01}, 0.1},
+    {sim::SolverMethod::kPbf, "iterations", {2.0, 3.0, 6.0}, 3.0},
+};
+
+const Knob& KnobOf(sim::SolverMethod m) {
+  for (const Knob& k : kKnobs) {
+    if (k.method == m) return k;
+  }
+  std::fprintf(stderr, "sphxr_bench_tradeoff: no sweep for method %s\n", sim::SolverMethodName(m));
+  std::exit(2);
+}
+
+/// The --set assignment of a configuration's knob (stiffness in Pa from the scene's).
+std::string KnobSetting(const Config& c, float sceneStiffness) {
+  switch (c.method) {
+    case sim::SolverMethod::kWcsph: return Format("stiffness=%.9g", static_cast<float>(c.knob * sceneStiffness));
+    case sim::SolverMethod::kDfsph: return Format("density_tolerance=%.9g", c.knob);
+    case sim::SolverMethod::kPbf: return Format("pbf_iterations=%.9g", c.knob);
+  }
+  return std::string();
+}
 
 struct Result {
   Config config{};
@@ -186,9 +219,7 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
   const double a = probe.columnWidth;
   // Only the method, the spacing and the method's knob are overridden, through the same path as --set on
   // the command line.
-  const bool dfsph = config.method == sim::SolverMethod::kDfsph;
-  const float stiffness = static_cast<float>((dfsph ? 1.0 : config.knob) * scene.setup.params.stiffness);
-  const std::string knob = dfsph ? Format("density_tolerance=%.9g", config.knob) : Format("stiffness=%.9g", stiffness);
+  const std::string knob = KnobSetting(config, scene.setup.params.stiffness);
   for (const std::string& set : {Format("method=%s", sim::SolverMethodName(config.method)),
                                  Format("spacing=%.9g", a / config.spacingDivisor), knob}) {
     if (Status s = app::SetSolverParam(&scene.setup, set); !s) {
@@ -220,7 +251,7 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
   r->threads = omp_get_max_threads();
   std::fprintf(stderr, "%s a/%d (%.4g mm), %s %g: %d fluid + %d boundary particles, to t = %g s ...\n",
                sim::SolverMethodName(config.method), config.spacingDivisor, 1e3 * dx,
-               dfsph ? "density tolerance %" : "stiffness x", config.knob, r->fluid, r->boundary, tEnd);
+               KnobOf(config.method).label, config.knob, r->fluid, r->boundary, tEnd);
 
   sim::HostFluid host;
   std::vector<Point> front;  // (T, Z)
@@ -307,7 +338,7 @@ int main(int argc, char** argv) {
       "stiffness_factor,density_tolerance_pct,density_iterations,divergence_iterations,stiffness_pa,sound_speed,fluid,boundary,steps,dt_clamped_steps,clamped_events,sim_time_s,"
       "step_wall_s,loop_wall_s,wall_per_sim_s,front_rms_rel,front_max_rel,front_bias_rel,front_points,front_T_min,front_T_max,final_Z,"
       "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_viscosity,cfl,"
-      "max_dt";
+      "max_dt,pbf_iterations";
   if (!args.csv.empty()) {  // before minutes of measuring
     if (const std::string why = CsvRefusal(args.csv, header); !why.empty()) {
       std::fprintf(stderr, "%s\n", why.c_str());
@@ -328,14 +359,12 @@ int main(int argc, char** argv) {
   for (std::string name; std::getline(methods, name, ',');) {
     sim::SolverMethod m = sim::SolverMethod::kWcsph;
     sim::ParseSolverMethod(name, &m);
-    const bool dfsph = m == sim::SolverMethod::kDfsph;
+    const Knob& knob = KnobOf(m);
     if (args.quick) {
-      for (int d : {14, 20}) configs.push_back({m, d, dfsph ? 0.1 : 1.0});
+      for (int d : {14, 20}) configs.push_back({m, d, knob.quick});
     } else {
       for (int d : {14, 20, 26}) {
-        for (double k : dfsph ? std::vector<double>{1.0, 0.1, 0.01} : std::vector<double>{0.5, 1.0, 4.0}) {
-          configs.push_back({m, d, k});
-        }
+        for (double k : knob.values) configs.push_back({m, d, k});
       }
     }
   }
@@ -360,7 +389,8 @@ int main(int argc, char** argv) {
   const double loadEnd = LoadAverage();
 
   std::printf("\n## sphxr_bench_tradeoff%s\n\n", args.quick ? " (--quick: a smoke run, not a measurement)" : "");
-  std::printf("- scene: %s to t = %g s (T = %.2f), CPU backend, adaptive dt (WCSPH: CFL on c + v; DFSPH: CFL on v)\n", args.scene.c_str(), tEnd,
+  std::printf("- scene: %s to t = %g s (T = %.2f), CPU backend, the methods' own steps (WCSPH: CFL on c + v; DFSPH: CFL "
+              "on v; PBF: 3 substeps a 1/90 s frame)\n", args.scene.c_str(), tEnd,
               tEnd * std::sqrt(2.0 * 9.81 / 0.05715));
   std::printf("- front error over the Martin & Moyce points with %g <= T <= %g reached by the run\n", tMin, tMax);
   std::printf("- machine: %s, nproc %d, solver threads %d; 1-min load average %.2f at start, %.2f at end; %s\n",
@@ -379,15 +409,23 @@ int main(int argc, char** argv) {
                 loadStart);
   }
   std::printf("\n");
-  std::printf("| method | spacing | stiffness or tolerance | fluid | steps | iterations (density, divergence) | wall s per "
+  std::printf("| method | spacing | stiffness, tolerance or iterations | fluid | steps | iterations (density, divergence) | wall s per "
               "simulated s | front RMS error | front max error | front mean signed error | points | mean density error | "
               "final Z |\n");
   std::printf("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const Result& r : results) {
-    const bool dfsph = r.config.method == sim::SolverMethod::kDfsph;
-    const std::string knob = dfsph ? Format("tolerance %g %%", r.config.knob)
-                                   : Format("x%g (%.0f Pa, c = %.1f m/s)", r.config.knob, r.stiffness, r.soundSpeed);
-    const std::string iterations = dfsph ? Format("%.1f, %.1f", r.densityIterations, r.divergenceIterations) : "—";
+    std::string knob, iterations = "—";
+    switch (r.config.method) {
+      case sim::SolverMethod::kWcsph: knob = Format("x%g (%.0f Pa, c = %.1f m/s)", r.config.knob, r.stiffness, r.soundSpeed); break;
+      case sim::SolverMethod::kDfsph:
+        knob = Format("tolerance %g %%", r.config.knob);
+        iterations = Format("%.1f, %.1f", r.densityIterations, r.divergenceIterations);
+        break;
+      case sim::SolverMethod::kPbf:
+        knob = Format("%g iterations", r.config.knob);
+        iterations = Format("%.0f, —", r.densityIterations);
+        break;
+    }
     std::printf("| %s | a/%d (%.3f mm) | %s | %d | %lld | %s | %.1f | %s | %s | %s | %d | %.3f %% | %.3f |\n",
                 sim::SolverMethodName(r.config.method), r.config.spacingDivisor, 1e3 * r.spacing, knob.c_str(), r.fluid,
                 static_cast<long long>(r.steps), iterations.c_str(), r.wallPerSimSecond, Percent(r.frontRms).c_str(),
@@ -405,7 +443,7 @@ int main(int argc, char** argv) {
       csv << when << ',' << CsvField(model) << ',' << cpus << ',' << r.threads << ',' << loadStart << ',' << loadEnd << ','
           << (args.quick ? "quick" : "full") << ',' << sim::SolverMethodName(r.config.method) << ','
           << r.config.spacingDivisor << ',' << r.spacing << ','
-          << (r.config.method == sim::SolverMethod::kDfsph ? 1.0 : r.config.knob) << ','
+          << (r.config.method == sim::SolverMethod::kWcsph ? r.config.knob : 1.0) << ','
           << (r.config.method == sim::SolverMethod::kDfsph ? Format("%g", r.config.knob) : std::string()) << ','
           << r.densityIterations << ',' << r.divergenceIterations << ',' << r.stiffness << ',' << r.soundSpeed << ',' << r.fluid << ',' << r.boundary
           << ',' << r.steps << ',' << r.dtClampedSteps << ',' << r.clampedEvents << ',' << r.simTime << ','
@@ -414,7 +452,8 @@ int main(int argc, char** argv) {
           << r.meanDensityError << ',' << r.peakMeanDensityError << ',' << r.params.supportFactor << ','
           << r.params.viscosity << ',' << r.params.boundaryViscosity << ','
           << (r.floorViscosity >= 0 ? r.floorViscosity : r.params.boundaryViscosity) << ',' << r.params.cfl << ','
-          << r.params.maxDt << '\n';
+          << r.params.maxDt << ','
+          << (r.config.method == sim::SolverMethod::kPbf ? Format("%g", r.config.knob) : std::string()) << '\n';
     }
     std::printf("\nwrote %zu row(s) to %s\n", results.size(), args.csv.c_str());
   }
