@@ -341,7 +341,8 @@ TEST(Probes, BadProbesAreNamed) {
 
 // The kernel fraction of a point in a box against a brute-force sum of the kernel over a fine lattice
 // (a midpoint rule of 200^3 cells over the support's cube, good to ~1e-4 here): one face (where the
-// exact 1D fraction is used), an edge, a corner, a floor under an obstacle; the flat face against the
+// exact 1D fraction is used), an edge, a corner, an obstacle's top, its side, the corner it makes with
+// the floor and its top's edge (where the water wraps round it: more than half); the flat face against the
 // exact fraction where the box rule is used (one face beside an obstacle far off in its cube).
 TEST(Probes, KernelFractionInRegionIsTheKernelsShareOfTheWater) {
   const float H = 0.02f;
@@ -373,7 +374,10 @@ TEST(Probes, KernelFractionInRegionIsTheKernelsShareOfTheWater) {
   };
   const Case cases[] = {{"inside", {0.1f, 0.15f, 0.05f}, &none},       {"face", {0.1f, 0.15f, 0.5f * dx}, &none},
                         {"edge", {0.5f * dx, 0.15f, 0.5f * dx}, &none}, {"corner", {0.5f * dx, 0.5f * dx, 0.5f * dx}, &none},
-                        {"under", {0.15f, 0.5f * dx, 0.05f}, &block},   {"beside", {0.12f, 0.02f, 0.05f}, &block}};
+                        {"box top", {0.075f, 0.05f + 0.5f * dx, 0.05f}, &block},
+                        {"beside the box", {0.1f + 0.5f * dx, 0.03f, 0.05f}, &block},
+                        {"box and floor", {0.1f + 0.5f * dx, 0.5f * dx, 0.05f}, &block},
+                        {"box top's edge", {0.1f - 0.5f * dx, 0.05f + 0.5f * dx, 0.05f}, &block}};
   for (const Case& c : cases) {
     const double want = brute(c.p, *c.obstacles);
     EXPECT_NEAR(KernelFractionInRegion(c.p, tank, *c.obstacles, H), want, 2e-3) << c.name;
