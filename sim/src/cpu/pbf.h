@@ -127,10 +127,11 @@ struct PbfLambdaListStage {
     const CubicSpline k = ph.kernel;
     const Vec3 xi = Xyz(stage.fluid.position[i]);
     const PbfView& view = stage.view;
-    // With the pair cache: each batch's V grad W_ij kept (every batch, so that the correction pass reads
+    // Each batch's V grad W_ij kept in the pair cache (every batch, so that the correction pass reads
     // zeros where no pair is), and the sum of the pairs' s_corr V grad W_ij.
-    float* cache = view.pairGrad ? view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride) : nullptr;
-    const bool corrected = cache && ph.pbfCorrK > 0.0f;
+    SPHXR_ASSERT(view.pairGrad && view.ownCorrection);  // the CPU launcher's kPbfPairCache
+    float* cache = view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride);
+    const bool corrected = ph.pbfCorrK > 0.0f;
     const Lanes zero = Splat(0.0f);
     Lanes w = zero, s2 = zero, gx = zero, gy = zero, gz = zero, sx = zero, sy = zero, sz = zero;
     ForListLanes(
@@ -142,7 +143,6 @@ struct PbfLambdaListStage {
           const Lanes ax = dx * grad, ay = dy * grad, az = dz * grad;
           gx += ax, gy += ay, gz += az;
           s2 += ax * ax + ay * ay + az * az;
-          if (!cache) return;
           float* out = cache + 3 * kLanes * batch;
           StoreLanes(out, ax);
           StoreLanes(out + kLanes, ay);
@@ -152,7 +152,7 @@ struct PbfLambdaListStage {
             sx += corr * ax, sy += corr * ay, sz += corr * az;
           }
         },
-        cache != nullptr);
+        /*everyBatch=*/true);
     const Vec3 gradF{SumLanes(gx), SumLanes(gy), SumLanes(gz)};
     const float sumW = k.W(0.0f) + SumLanes(w);
     const float sum2 = SumLanes(s2);
@@ -175,7 +175,7 @@ struct PbfLambdaListStage {
     const Vec3 gradI = gradF + gradB;
     const float li = stage.Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
     // The correction's terms that the pass below need not visit the pairs for: lambda_i's and s_corr's.
-    if (cache) view.ownCorrection[i] = MakeVec4(gradI * li + Vec3{SumLanes(sx), SumLanes(sy), SumLanes(sz)});
+    view.ownCorrection[i] = MakeVec4(gradI * li + Vec3{SumLanes(sx), SumLanes(sy), SumLanes(sz)});
   }
 };
 
@@ -187,32 +187,19 @@ struct PbfCorrectListStage {
       stage(i);
       return;
     }
+    // sum_j lambda_j V grad W_ij over the lambda pass's pair cache, plus the particle's own terms
     const PbfView& view = stage.view;
+    SPHXR_ASSERT(view.pairGrad && view.ownCorrection);
+    const uint32_t found = stage.list.count[i];
+    const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(stage.list.maxNeighbours);
+    const float* cache = view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride);
     const Lanes zero = Splat(0.0f);
     Lanes cx = zero, cy = zero, cz = zero;
-    if (view.pairGrad) {  // the lambda pass's pair gradients: sum_j lambda_j V grad W_ij, plus its own terms
-      const uint32_t found = stage.list.count[i];
-      const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(stage.list.maxNeighbours);
-      const float* cache = view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride);
-      for (uint32_t base = 0; base < found; base += kLanes, cache += 3 * kLanes) {
-        const Lanes lj = Gather(view.lambda, ListLanes(slots, base, found, i));  // padding: i, whose term is 0
-        cx += lj * LoadLanes(cache), cy += lj * LoadLanes(cache + kLanes), cz += lj * LoadLanes(cache + 2 * kLanes);
-      }
-      view.delta[i] = MakeVec4(Vec3{SumLanes(cx), SumLanes(cy), SumLanes(cz)} + Xyz(view.ownCorrection[i]));
-      return;
+    for (uint32_t base = 0; base < found; base += kLanes, cache += 3 * kLanes) {
+      const Lanes lj = Gather(view.lambda, ListLanes(slots, base, found, i));  // padding: i, whose term is 0
+      cx += lj * LoadLanes(cache), cy += lj * LoadLanes(cache + kLanes), cz += lj * LoadLanes(cache + 2 * kLanes);
     }
-    const Physics& ph = stage.ph;
-    const CubicSpline k = ph.kernel;
-    const Vec3 xi = Xyz(stage.fluid.position[i]);
-    const float li = view.lambda[i];
-    ForListLanes(stage.list, stage.fluid, k, i, xi, [&](LaneInts index, Lanes dx, Lanes dy, Lanes dz, Lanes r, Lanes q,
-                                                         LaneInts pair, int) {
-      const Lanes corr = CorrLanes(ph, KernelWLanes(k, q, pair));
-      const Lanes s = (li + Gather(view.lambda, index) + corr) * ph.volume * GradFactorLanes(k, q, r, pair);
-      cx += dx * s, cy += dy * s, cz += dz * s;
-    });
-    // the walls' and paddles' terms: lambda_i B_i (B_i from the lambda pass)
-    view.delta[i] = MakeVec4(Vec3{SumLanes(cx), SumLanes(cy), SumLanes(cz)} + Xyz(view.boundaryGrad[i]) * li);
+    view.delta[i] = MakeVec4(Vec3{SumLanes(cx), SumLanes(cy), SumLanes(cz)} + Xyz(view.ownCorrection[i]));
   }
 };
 
