@@ -238,11 +238,11 @@ Status ValidateScene(const SceneSetup& scene) {
                                     key.c_str(), speed, speed / soundSpeed, soundSpeed, method.name, soundSpeed));
       }
       // A method that caps every speed would start the block slower than the scene says, silently.
-      if (method.speedCap && speed > method.speedCap(scene.params)) {
+      if (const ParamInfo* cap = method.speedCapParam ? FindSolverParam(method.speedCapParam) : nullptr;
+          cap && speed > scene.params.*cap->member) {
         return Status::Error(Format("%s.velocity: %g m/s is above the %g m/s that solver.method %s holds every particle "
                                     "to: lower the speed or raise solver.%s",
-                                    key.c_str(), speed, method.speedCap(scene.params), method.name,
-                                    method.speedCapParam));
+                                    key.c_str(), speed, scene.params.*cap->member, method.name, cap->key));
       }
     }
     if (!Contains(scene.tank, scene.fluid[i].box, slack)) {

@@ -57,8 +57,6 @@ int64_t DfsphBytes(int64_t slots) { return 12 * slots + 16 + 20 + 16 + 8; }
 /// boundary gradients (16); on the CPU the own terms (16) and the pair cache (12 a slot, in batches of
 /// 16 slots: PbfPairStride). The step's start positions live in the acceleration field.
 int64_t PbfBytes(int64_t slots) { return 4 + 4 + 16 + 16 + 16 + 12 * ((slots + 15) / 16 * 16); }
-/// PBF caps every speed at pbf_max_speed (the prediction and the corrections' velocity).
-float PbfSpeedCap(const SolverParams& p) { return p.pbfMaxSpeed; }
 
 constexpr std::array<SolverStat, 4> kDfsphStats = {SolverStat::kDensityIterations, SolverStat::kDivergenceIterations,
                                                    SolverStat::kDensityError, SolverStat::kDivergenceError};
@@ -68,15 +66,16 @@ const std::array<SolverInfo, 3> kSolvers = {{
     {SolverMethod::kWcsph, "wcsph", "Becker & Teschner 2007 (weakly compressible SPH, Tait equation of state)",
      "weakly compressible SPH: explicit pressure from the Tait equation, a step bounded by the sound speed",
      /*wallDensity=*/true, /*deltaSph=*/true, /*reuse=*/true, /*wallContact=*/true, /*acoustic=*/true, WcsphStableDt, {}, false, NoBytes,
-     nullptr, nullptr},
+     nullptr},
     {SolverMethod::kDfsph, "dfsph", "Bender & Koschier 2015, 2017 (divergence-free SPH)",
      "divergence-free SPH: implicit pressure from two Jacobi solves, a step that follows the flow speed "
      "([../design/dfsph.md](../design/dfsph.md))",
-     false, false, false, false, false, DfsphStableDt, kDfsphStats, true, DfsphBytes, nullptr, nullptr},
+     false, false, false, false, false, DfsphStableDt, kDfsphStats, true, DfsphBytes, nullptr},
     {SolverMethod::kPbf, "pbf", "Macklin & Müller 2013 (position based fluids)",
      "position-based fluids: a fixed number of Jacobi iterations of the density constraint per step, one step "
      "per displayed frame, so its cost per frame is fixed ([../design/pbf.md](../design/pbf.md))",
-     false, false, false, false, false, PbfStableDt, kPbfStats, false, PbfBytes, PbfSpeedCap, "pbf_max_speed"},
+     false, false, false, false, false, PbfStableDt, kPbfStats, false, PbfBytes,
+     /*speedCapParam=*/"pbf_max_speed"},  // the prediction's and the corrections' velocity are capped
 }};
 
 }  // namespace

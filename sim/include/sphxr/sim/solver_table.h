@@ -44,10 +44,9 @@ struct SolverInfo {
   bool iterationCap;
   /// Bytes of its own per fluid particle, given the neighbour-list slots per particle.
   int64_t (*bytesPerFluid)(int64_t neighbourSlots);
-  /// The speed its steps hold every particle to (m/s), or nullptr: a scene's block faster than this is
-  /// refused, as the start state the method would silently slow down.
-  float (*speedCap)(const SolverParams& params);
-  const char* speedCapParam;  // the solver parameter that sets it
+  /// The solver parameter (m/s) that its steps hold every particle's speed to, or nullptr: a scene's
+  /// block faster than it is refused, as the start state the method would silently slow down.
+  const char* speedCapParam;
 };
 
 std::span<const SolverInfo> SolverTable();
