@@ -5,12 +5,13 @@
 // 6; its 3 substeps a 90 Hz frame). Everything else is the scene's: the column and the tank are fixed
 // in metres, so the particle count changes with the spacing.
 //
-// Each run goes to t = 0.19 s (T = t sqrt(2g/a) = 3.5) and records:
+// Each run goes to t = 0.235 s (tau = t sqrt(g/a) = 3.05) and records:
 //   - wall seconds per simulated second (time inside Solver::Step only; the probe is not counted),
-//   - the surge front error against tests/data/martin_moyce_1952.csv: relative error of Z over the
-//     measured points with 1.0 <= T <= 3.3, the simulated Z (sim::SurgeFront on a host copy every step,
-//     minPerBin from app::DamBreakMinPerBin, as the headless runner) interpolated linearly in time at
-//     each measured T; RMS and maximum of |Z_sim / Z_measured - 1|,
+//   - the judgement of tests/validation/dam_break_test.cpp against tests/data/martin_moyce_1952.csv
+//     (sim::JudgeMartinMoyce: one gate lag for the front and the column height, then the relative
+//     error of Z over the measured points with 1.0 <= T <= 3.3; sim::SurgeFront and sim::ColumnHeight on
+//     a host copy every step, minPerBin from app::DamBreakMinPerBin, as the headless runner): the lag,
+//     RMS, maximum and mean of Z_sim / Z_measured - 1, the height's largest deviation,
 //   - the mean density error, time-averaged (weighted by dt) over the run,
 //   - the mean iterations of DFSPH's density and divergence solves, PBF's iterations a step.
 // --csv writes one row per run (bench/results/tradeoff.csv); bench/plot_tradeoff.py draws docs/images/tradeoff.png.
@@ -110,12 +111,9 @@ bool ParseArgs(int argc, char** argv, Args* out) {
   return true;
 }
 
-struct Point {
-  double t, value;
-};
-
-/// The "front" series of the measurements file: (T, Z).
-bool ReadFront(const std::string& path, std::vector<Point>* front) {
+/// The measurements file's series: front (T, Z) and height (tau, H).
+bool ReadMeasurements(const std::string& path, std::vector<sim::DamBreakPoint>* front,
+                      std::vector<sim::DamBreakPoint>* height) {
   std::ifstream in(path);
   if (!in) return false;
   std::string line;
@@ -126,21 +124,9 @@ bool ReadFront(const std::string& path, std::vector<Point>* front) {
     std::getline(ss, series, ',');
     std::getline(ss, t, ',');
     std::getline(ss, v, ',');
-    if (series == "front") front->push_back({std::stod(t), std::stod(v)});
+    (series == "front" ? front : height)->push_back({std::stod(t), std::stod(v)});
   }
-  return !front->empty();
-}
-
-/// Linear interpolation in a series sorted by t (clamped at the ends).
-double Interpolate(const std::vector<Point>& s, double t) {
-  if (t <= s.front().t) return s.front().value;
-  for (size_t i = 1; i < s.size(); ++i) {
-    if (s[i].t >= t) {
-      const double w = (t - s[i - 1].t) / (s[i].t - s[i - 1].t);
-      return s[i - 1].value + w * (s[i].value - s[i - 1].value);
-    }
-  }
-  return s.back().value;
+  return !front->empty() && !height->empty();
 }
 
 struct Config {
@@ -186,7 +172,7 @@ struct Result {
   float stiffness = 0.0f;
   float soundSpeed = 0.0f;
   sim::SolverParams params;      // as run (the scene's, with spacing and stiffness overridden)
-  float floorViscosity = -1.0f;  // the scene's tank.floor_viscosity (negative: boundary_viscosity)
+  std::string friction;          // the scene's tank.friction of the floor
   int fluid = 0, boundary = 0, threads = 0;
   int64_t steps = 0, dtClampedSteps = 0, clampedEvents = 0;
   double simTime = 0.0;
@@ -198,12 +184,15 @@ struct Result {
   int frontPoints = 0;
   double densityIterations = 0.0, divergenceIterations = 0.0;  // DFSPH: means per step
   double frontTMin = 0.0, frontTMax = 0.0;
+  double gateLag = NAN;    // s, sim::JudgeMartinMoyce's
+  double heightMax = NAN;  // relative, the column height's largest deviation
   double finalZ = 0.0;
   double meanDensityError = 0.0;     // time average
   float peakMeanDensityError = 0.0f;
 };
 
-bool Run(const Args& args, const Config& config, double tEnd, double tMin, double tMax, const std::vector<Point>& measured,
+bool Run(const Args& args, const Config& config, double tEnd, double tMin, double tMax,
+         const std::vector<sim::DamBreakPoint>& measuredFront, const std::vector<sim::DamBreakPoint>& measuredHeight,
          Result* r) {
   r->config = config;
   app::SceneFile scene;
@@ -230,12 +219,11 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
   const float dx = scene.setup.params.spacing;
   r->spacing = dx;
   r->params = scene.setup.params;
-  r->floorViscosity = scene.setup.floorViscosity;
+  r->friction = sim::WallFrictionName(scene.setup.friction.floor);
   r->stiffness = scene.setup.params.stiffness;
   const int minPerBin = app::DamBreakMinPerBin(probe, dx);
   const double g = std::sqrt(scene.setup.gravity.x * scene.setup.gravity.x + scene.setup.gravity.y * scene.setup.gravity.y +
                              scene.setup.gravity.z * scene.setup.gravity.z);
-  const double toT = std::sqrt(2.0 * g / a);  // T = t sqrt(2g/a)
 
   sim::SolverConfig solverConfig;
   solverConfig.device = sim::Device::kCpu;
@@ -254,9 +242,13 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
                KnobOf(config.method).label, config.knob, r->fluid, r->boundary, tEnd);
 
   sim::HostFluid host;
-  std::vector<Point> front;  // (T, Z)
+  std::vector<sim::DamBreakSample> samples;
+  auto sample = [&](double t) {
+    samples.push_back({t, sim::SurgeFront(host, probe.wallX, dx, minPerBin) / a,
+                       sim::ColumnHeight(host, probe.floorY, probe.wallX, dx, std::max(1, minPerBin / 2)) / (2.0 * a)});
+  };
   solver->Download(&host);
-  front.push_back({0.0, sim::SurgeFront(host, probe.wallX, dx, minPerBin) / a});
+  sample(0.0);
   double errorTime = 0.0;
   const auto begin = std::chrono::steady_clock::now();
   while (solver->Time() < tEnd - 1e-9) {
@@ -272,7 +264,7 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
     errorTime += static_cast<double>(info.meanDensityError) * info.dt;
     r->peakMeanDensityError = std::max(r->peakMeanDensityError, info.meanDensityError);
     solver->Download(&host);
-    front.push_back({info.time * toT, sim::SurgeFront(host, probe.wallX, dx, minPerBin) / a});
+    sample(info.time);
   }
   r->loopWall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   const sim::Totals& totals = solver->GetTotals();
@@ -283,34 +275,23 @@ bool Run(const Args& args, const Config& config, double tEnd, double tMin, doubl
   r->stepWall = totals.stepSeconds;
   r->wallPerSimSecond = r->simTime > 0 ? r->stepWall / r->simTime : 0.0;
   r->meanDensityError = r->simTime > 0 ? errorTime / r->simTime : 0.0;
-  r->finalZ = front.back().value;
+  r->finalZ = samples.back().front;
   if (totals.steps > 0) {
     r->densityIterations = static_cast<double>(totals.densityIterations) / static_cast<double>(totals.steps);
     r->divergenceIterations = static_cast<double>(totals.divergenceIterations) / static_cast<double>(totals.steps);
   }
 
-  const double tReached = front.back().t;
-  double sumSq = 0.0, maxAbs = 0.0, sumRel = 0.0;
-  int n = 0;
-  r->frontTMin = 1e30;
-  r->frontTMax = 0.0;
-  for (const Point& m : measured) {
-    if (m.t < tMin || m.t > tMax || m.t > tReached) continue;
-    const double rel = Interpolate(front, m.t) / m.value - 1.0;
-    sumSq += rel * rel;
-    sumRel += rel;
-    maxAbs = std::max(maxAbs, std::fabs(rel));
-    r->frontTMin = std::min(r->frontTMin, m.t);
-    r->frontTMax = std::max(r->frontTMax, m.t);
-    ++n;
-  }
-  r->frontPoints = n;
-  if (n > 0) {
-    r->frontRms = std::sqrt(sumSq / n);
-    r->frontMax = maxAbs;
-    r->frontBias = sumRel / n;
-  } else {
-    r->frontTMin = r->frontTMax = 0.0;
+  // The shared judge (sim/measure.h): one gate lag for both series, then the deviations.
+  sim::DamBreakJudgement j;
+  if (sim::JudgeMartinMoyce(samples, measuredFront, measuredHeight, a, g, &j, tMin, tMax) && !j.front.empty()) {
+    r->frontPoints = static_cast<int>(j.front.size());
+    r->frontRms = j.frontRms;
+    r->frontMax = j.frontMax;
+    r->frontBias = j.frontBias;
+    r->gateLag = j.lag;
+    r->heightMax = j.height.empty() ? NAN : j.heightMax;
+    r->frontTMin = j.front.front().t;
+    r->frontTMax = j.front.back().t;
   }
   return true;
 }
@@ -337,7 +318,8 @@ int main(int argc, char** argv) {
       "timestamp_utc,cpu_model,nproc,threads,load_avg_start,load_avg_end,mode,method,spacing_divisor,spacing_m,"
       "stiffness_factor,density_tolerance_pct,density_iterations,divergence_iterations,stiffness_pa,sound_speed,fluid,boundary,steps,dt_clamped_steps,clamped_events,sim_time_s,"
       "step_wall_s,loop_wall_s,wall_per_sim_s,front_rms_rel,front_max_rel,front_bias_rel,front_points,front_T_min,front_T_max,final_Z,"
-      "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_viscosity,cfl,"
+      "gate_lag_ms,height_max_rel,"
+      "mean_density_error,peak_mean_density_error,support_factor,viscosity,boundary_viscosity,floor_friction,cfl,"
       "max_dt,pbf_iterations";
   if (!args.csv.empty()) {  // before minutes of measuring
     if (const std::string why = CsvRefusal(args.csv, header); !why.empty()) {
@@ -346,15 +328,15 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::vector<Point> measured;
-  if (!ReadFront(args.measurements, &measured)) {
-    std::fprintf(stderr, "%s: cannot read the front series of the Martin & Moyce measurements\n",
+  std::vector<sim::DamBreakPoint> measuredFront, measuredHeight;
+  if (!ReadMeasurements(args.measurements, &measuredFront, &measuredHeight)) {
+    std::fprintf(stderr, "%s: cannot read the front and height series of the Martin & Moyce measurements\n",
                  args.measurements.c_str());
     return 1;
   }
 
   std::vector<Config> configs;
-  double tEnd = 0.19, tMin = 1.0, tMax = 3.3;
+  double tEnd = 0.235, tMin = 1.0, tMax = 3.3;  // tau = 3.05: the height series to tau = 3 as the test
   std::stringstream methods(args.methods);
   for (std::string name; std::getline(methods, name, ',');) {
     sim::SolverMethod m = sim::SolverMethod::kWcsph;
@@ -380,7 +362,7 @@ int main(int argc, char** argv) {
   std::vector<Result> results;
   for (const Config& c : configs) {
     Result r;
-    if (!Run(args, c, tEnd, tMin, tMax, measured, &r)) return 1;
+    if (!Run(args, c, tEnd, tMin, tMax, measuredFront, measuredHeight, &r)) return 1;
     std::fprintf(stderr, "  %lld steps, %.1f s wall per simulated s, front RMS %s max %s, mean density error %.3f %%\n",
                  static_cast<long long>(r.steps), r.wallPerSimSecond, Percent(r.frontRms).c_str(),
                  Percent(r.frontMax).c_str(), 100.0 * r.meanDensityError);
@@ -398,9 +380,9 @@ int main(int argc, char** argv) {
   if (!results.empty()) {
     const sim::SolverParams& p = results[0].params;
     std::printf("- the scene's other settings (shared by every run): support_factor %g, viscosity %g, boundary_viscosity "
-                "%g, floor_viscosity %g, cfl %g, max_dt %g s, exponent %g\n",
+                "%g, floor friction %s, cfl %g, max_dt %g s, exponent %g\n",
                 p.supportFactor, p.viscosity, p.boundaryViscosity,
-                results[0].floorViscosity >= 0 ? results[0].floorViscosity : p.boundaryViscosity, p.cfl, p.maxDt,
+                results[0].friction.c_str(), p.cfl, p.maxDt,
                 p.exponent);
   }
   if (loadStart > 0.5) {
@@ -410,9 +392,9 @@ int main(int argc, char** argv) {
   }
   std::printf("\n");
   std::printf("| method | spacing | stiffness, tolerance or iterations | fluid | steps | iterations (density, divergence) | wall s per "
-              "simulated s | front RMS error | front max error | front mean signed error | points | mean density error | "
-              "final Z |\n");
-  std::printf("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+              "simulated s | gate lag | front RMS error | front max error | front mean signed error | points | "
+              "column height max error | mean density error | final Z |\n");
+  std::printf("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const Result& r : results) {
     std::string knob, iterations = "—";
     switch (r.config.method) {
@@ -426,10 +408,11 @@ int main(int argc, char** argv) {
         iterations = Format("%.0f, —", r.densityIterations);
         break;
     }
-    std::printf("| %s | a/%d (%.3f mm) | %s | %d | %lld | %s | %.1f | %s | %s | %s | %d | %.3f %% | %.3f |\n",
+    std::printf("| %s | a/%d (%.3f mm) | %s | %d | %lld | %s | %.1f | %.2f ms | %s | %s | %s | %d | %s | %.3f %% | %.3f |\n",
                 sim::SolverMethodName(r.config.method), r.config.spacingDivisor, 1e3 * r.spacing, knob.c_str(), r.fluid,
-                static_cast<long long>(r.steps), iterations.c_str(), r.wallPerSimSecond, Percent(r.frontRms).c_str(),
-                Percent(r.frontMax).c_str(), Percent(r.frontBias).c_str(), r.frontPoints, 100.0 * r.meanDensityError, r.finalZ);
+                static_cast<long long>(r.steps), iterations.c_str(), r.wallPerSimSecond, 1e3 * r.gateLag,
+                Percent(r.frontRms).c_str(), Percent(r.frontMax).c_str(), Percent(r.frontBias).c_str(), r.frontPoints,
+                Percent(r.heightMax).c_str(), 100.0 * r.meanDensityError, r.finalZ);
   }
 
   if (!args.csv.empty()) {
@@ -449,9 +432,10 @@ int main(int argc, char** argv) {
           << ',' << r.steps << ',' << r.dtClampedSteps << ',' << r.clampedEvents << ',' << r.simTime << ','
           << r.stepWall << ',' << r.loopWall << ',' << r.wallPerSimSecond << ',' << r.frontRms << ',' << r.frontMax
           << ',' << r.frontBias << ',' << r.frontPoints << ',' << r.frontTMin << ',' << r.frontTMax << ',' << r.finalZ << ','
+          << 1e3 * r.gateLag << ',' << r.heightMax << ','
           << r.meanDensityError << ',' << r.peakMeanDensityError << ',' << r.params.supportFactor << ','
           << r.params.viscosity << ',' << r.params.boundaryViscosity << ','
-          << (r.floorViscosity >= 0 ? r.floorViscosity : r.params.boundaryViscosity) << ',' << r.params.cfl << ','
+          << r.friction << ',' << r.params.cfl << ','
           << r.params.maxDt << ','
           << (r.config.method == sim::SolverMethod::kPbf ? Format("%g", r.config.knob) : std::string()) << '\n';
     }

@@ -59,6 +59,7 @@ class Reader {
   // The sections; each takes the root object and reads its own key.
   Status Solver(const json& root);
   Status Tank(const json& root);
+  Status Friction(const json& friction, sim::TankFriction* out);  // tank.friction
   Status Fluid(const json& root);
   Status Obstacles(const json& root);
   Status Reuse(const json& root);

@@ -8,17 +8,19 @@ Status Reader::Tank(const json& root) {
   if (!root.contains("tank")) return Error("tank", "missing: every scene needs a tank (its interior is the domain)");
   const json& tank = root["tank"];
   if (!tank.is_object()) return Error("tank", "must be an object");
-  CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity", "wall_pressure", "wall_contact"});
+  CheckKeys(tank, "tank", {"min", "max", "open_top", "boundary_layers", "floor_viscosity", "friction", "wall_pressure", "wall_contact"});
   if (Status st = Box(tank, "tank", &s.tank); !st) return st;
   if (tank.contains("open_top")) {
     if (!tank["open_top"].is_boolean()) return Error("tank.open_top", "must be true or false");
     s.openTop = tank["open_top"].get<bool>();
   }
   if (tank.contains("floor_viscosity")) {
-    double v;
-    if (Status st = Number(tank["floor_viscosity"], "tank.floor_viscosity", &v); !st) return st;
-    if (v < 0 || v > 10) return Error("tank.floor_viscosity", "must be from 0 to 10 (artificial viscosity alpha)");
-    s.floorViscosity = static_cast<float>(v);
+    return Error("tank.floor_viscosity",
+                 "was removed: a wall's friction is now tank.friction (\"no_slip\", \"free_slip\" or \"artificial\", "
+                 "per face; docs/user/scenes.md)");
+  }
+  if (tank.contains("friction")) {
+    if (Status st = Friction(tank["friction"], &s.friction); !st) return st;
   }
   if (tank.contains("wall_pressure")) {
     const json& w = tank["wall_pressure"];
@@ -36,6 +38,43 @@ Status Reader::Tank(const json& root) {
     const int64_t layers = tank["boundary_layers"].get<int64_t>();
     if (layers < 1 || layers > 4) return Error("tank.boundary_layers", "must be 1 to 4");
     s.boundaryLayers = static_cast<int>(layers);
+  }
+  return Status::Ok();
+}
+
+Status Reader::Friction(const json& f, sim::TankFriction* out) {
+  auto parse = [&](const json& v, const std::string& key, sim::WallFriction* w) -> Status {
+    const std::string name = v.is_string() ? v.get<std::string>() : "";
+    if (name == "no_slip") *w = sim::WallFriction::kNoSlip;
+    else if (name == "free_slip") *w = sim::WallFriction::kFreeSlip;
+    else if (name == "artificial") *w = sim::WallFriction::kArtificial;
+    else return Error(key, "must be \"no_slip\", \"free_slip\" or \"artificial\"");
+    return Status::Ok();
+  };
+  if (f.is_string()) {  // one friction for every face and the obstacles
+    sim::WallFriction w;
+    if (Status st = parse(f, "tank.friction", &w); !st) return st;
+    *out = sim::TankFriction{w, w, w, w, w, w, w};
+    return Status::Ok();
+  }
+  if (!f.is_object()) {
+    return Error("tank.friction", "must be a friction name or an object of faces (floor, top, walls, x_min, x_max, "
+                                  "z_min, z_max, obstacles)");
+  }
+  CheckKeys(f, "tank.friction", {"floor", "top", "walls", "x_min", "x_max", "z_min", "z_max", "obstacles"});
+  // "walls" sets the four side faces; a side named on its own overrides it.
+  if (f.contains("walls")) {
+    sim::WallFriction w;
+    if (Status st = parse(f["walls"], "tank.friction.walls", &w); !st) return st;
+    out->xMin = out->xMax = out->zMin = out->zMax = w;
+  }
+  const std::pair<const char*, sim::WallFriction*> faces[] = {
+      {"floor", &out->floor}, {"top", &out->top},     {"x_min", &out->xMin},         {"x_max", &out->xMax},
+      {"z_min", &out->zMin},  {"z_max", &out->zMax},  {"obstacles", &out->obstacles}};
+  for (const auto& [name, w] : faces) {
+    if (f.contains(name)) {
+      if (Status st = parse(f[name], std::string("tank.friction.") + name, w); !st) return st;
+    }
   }
   return Status::Ok();
 }

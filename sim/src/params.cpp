@@ -80,6 +80,24 @@ std::span<const SceneLimitInfo> SceneLimits() {
 }
 std::span<const ReuseParamInfo> ReuseParamInfos() { return kReuseParams; }
 
+float WallFrictionAlpha(const SolverParams& params, WallFriction friction) {
+  switch (friction) {
+    case WallFriction::kArtificial: return params.boundaryViscosity;
+    case WallFriction::kNoSlip: return 4.0f * params.viscosity;
+    case WallFriction::kFreeSlip: return 0.0f;
+  }
+  return params.boundaryViscosity;
+}
+
+const char* WallFrictionName(WallFriction friction) {
+  switch (friction) {
+    case WallFriction::kArtificial: return "artificial";
+    case WallFriction::kNoSlip: return "no_slip";
+    case WallFriction::kFreeSlip: return "free_slip";
+  }
+  return "artificial";
+}
+
 const char* DensityModelName(DensityModel model) {
   return model == DensityModel::kDeltaSph ? "delta_sph" : "summation";
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "sphxr/common/log.h"
 
@@ -24,6 +25,9 @@ bool InsideExpanded(const Aabb& b, Vec3 p, float margin) {
 // i.e. in < k_a < n_a - in on every axis. outward: `layers` layers on and outside the faces (in = 0,
 // out = layers - 1); inward: on and inside (in = layers - 1, out = 0). openTop leaves the +y face and
 // everything above it out (the walls still reach the top edge).
+// emit(point, faces): `faces` holds a bit for each face whose slab holds the point.
+enum : unsigned { kFaceXMin = 1, kFaceXMax = 2, kFaceFloor = 4, kFaceTop = 8, kFaceZMin = 16, kFaceZMax = 32 };
+
 template <class Emit>
 void SampleShell(const Aabb& box, float dx, int layers, bool outward, bool openTop, Emit&& emit) {
   const float ext[3] = {box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z};
@@ -44,9 +48,18 @@ void SampleShell(const Aabb& box, float dx, int layers, bool outward, bool openT
         const bool interiorY = openTop ? ky > in : (ky > in && ky < n[1] - in);
         const bool interiorZ = kz > in && kz < n[2] - in;
         if (interiorX && interiorY && interiorZ) continue;
+        // The faces whose slab (the face and the layers behind it) holds the point: edges and corners
+        // belong to two or three.
+        unsigned faces = 0;
+        if (kx <= in) faces |= kFaceXMin;
+        if (kx >= n[0] - in) faces |= kFaceXMax;
+        if (ky <= in) faces |= kFaceFloor;
+        if (!openTop && ky >= n[1] - in) faces |= kFaceTop;
+        if (kz <= in) faces |= kFaceZMin;
+        if (kz >= n[2] - in) faces |= kFaceZMax;
         emit(Vec3{lo[0] + s[0] * static_cast<float>(kx), lo[1] + s[1] * static_cast<float>(ky),
                   lo[2] + s[2] * static_cast<float>(kz)},
-             /*bottom=*/ky <= 0 && interiorX && interiorZ);
+             faces);
       }
     }
   }
@@ -159,14 +172,28 @@ int64_t SampleFluid(const SceneSetup& scene, std::vector<Vec4>* out) {
 
 int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out, std::vector<float>* viscosity) {
   const float dx = scene.params.spacing;
-  const float wallAlpha = scene.params.boundaryViscosity;
-  const float floorAlpha = scene.floorViscosity >= 0.0f ? scene.floorViscosity : wallAlpha;
+  // Each wall particle's viscosity coefficient from its wall's friction; a particle on an edge or a
+  // corner of the tank takes the largest of its faces' (a no-slip floor's edge along a free-slip wall
+  // is still the floor's).
+  const SolverParams& params = scene.params;
+  const TankFriction& friction = scene.friction;
+  const std::pair<unsigned, WallFriction> faceFriction[] = {
+      {kFaceXMin, friction.xMin}, {kFaceXMax, friction.xMax}, {kFaceFloor, friction.floor},
+      {kFaceTop, friction.top},   {kFaceZMin, friction.zMin}, {kFaceZMax, friction.zMax}};
+  const float obstacleAlpha = WallFrictionAlpha(params, friction.obstacles);
   int64_t count = 0;
   bool tankPass = true;
-  auto emit = [&](Vec3 p, bool bottom) {
+  auto emit = [&](Vec3 p, unsigned faces) {
     ++count;
     if (out) out->push_back(MakeVec4(p));
-    if (viscosity) viscosity->push_back(tankPass && bottom ? floorAlpha : wallAlpha);
+    if (!viscosity) return;
+    float alpha = tankPass ? 0.0f : obstacleAlpha;
+    if (tankPass) {
+      for (const auto& [face, f] : faceFriction) {
+        if (faces & face) alpha = std::max(alpha, WallFrictionAlpha(params, f));
+      }
+    }
+    viscosity->push_back(alpha);
   };
   // The boundary surface lies half a spacing behind the solid's face, where the next lattice layer of
   // the fluid would be: the fluid's first layer (half a spacing inside the face) is then one spacing from

@@ -187,9 +187,6 @@ Status ValidateScene(const SceneSetup& scene) {
     }
     if (p.integer && v != std::floor(v)) return Status::Error(Format("solver.%s = %g is invalid: must be a whole number", p.key, v));
   }
-  if (!std::isfinite(scene.floorViscosity) || scene.floorViscosity > 10.0f) {
-    return Status::Error(Format("tank.floor_viscosity = %g is invalid: must be from 0 to 10", scene.floorViscosity));
-  }
   if (Status s = ValidateReuse(scene.reuse); !s) return s;
   if (scene.params.minIterations > scene.params.maxIterations) {
     return Status::Error(Format("solver.min_iterations = %g is above solver.max_iterations = %g",

@@ -15,10 +15,14 @@ float SoundSpeedOf(const SolverParams& p) { return std::sqrt(p.exponent * p.stif
 float SmoothingOf(const SolverParams& p) { return 0.5f * p.spacing * p.supportFactor; }
 
 /// The explicit artificial viscosity's diffusion limit (nu ~ alpha c h / 8), with the largest alpha
-/// of the fluid, the walls and the floor.
+/// of the fluid and of the walls' friction.
 float ViscosityDt(const SceneSetup& scene) {
   const SolverParams& p = scene.params;
-  const float alpha = std::max({p.viscosity, p.boundaryViscosity, scene.floorViscosity});
+  const TankFriction& f = scene.friction;
+  float alpha = std::max(p.viscosity, p.boundaryViscosity);  // the paddles' default alpha too
+  for (WallFriction w : {f.floor, f.top, f.xMin, f.xMax, f.zMin, f.zMax, f.obstacles}) {
+    alpha = std::max(alpha, WallFrictionAlpha(p, w));
+  }
   if (!(alpha > 0.0f)) return std::numeric_limits<float>::infinity();
   return 0.5f * SmoothingOf(p) / (alpha * SoundSpeedOf(p));
 }

@@ -83,7 +83,8 @@ TEST(SceneFileTest, FullSceneParsesEveryKey) {
     "solver": { "spacing": 0.01, "support_factor": 2.5, "rest_density": 998, "stiffness": 1e5, "exponent": 7,
                 "viscosity": 0.1, "boundary_viscosity": 0.2, "cfl": 0.3, "max_dt": 5e-4, "fixed_dt": 1e-4 },
     "gravity": [0, -1.62, 0],
-    "tank": { "min": [-1, 0, -0.5], "max": [1, 1, 0.5], "open_top": false, "boundary_layers": 2, "floor_viscosity": 0.5,
+    "tank": { "min": [-1, 0, -0.5], "max": [1, 1, 0.5], "open_top": false, "boundary_layers": 2,
+              "friction": { "walls": "no_slip", "x_max": "artificial", "floor": "free_slip", "obstacles": "no_slip" },
               "wall_pressure": "wall_density" },
     "fluid": [ { "min": [-1, 0, -0.5], "max": [0, 0.5, 0.5], "velocity": [1, 0, -2] },
                { "min": [0.5, 0.5, 0], "max": [0.6, 0.6, 0.1] } ],
@@ -108,7 +109,14 @@ TEST(SceneFileTest, FullSceneParsesEveryKey) {
   EXPECT_FLOAT_EQ(scene.setup.gravity.y, -1.62f);
   EXPECT_FALSE(scene.setup.openTop);
   EXPECT_EQ(scene.setup.boundaryLayers, 2);
-  EXPECT_FLOAT_EQ(scene.setup.floorViscosity, 0.5f);
+  const sim::TankFriction& f = scene.setup.friction;
+  EXPECT_EQ(f.floor, sim::WallFriction::kFreeSlip);
+  EXPECT_EQ(f.top, sim::WallFriction::kArtificial);  // not named: the default
+  EXPECT_EQ(f.xMin, sim::WallFriction::kNoSlip);     // "walls"
+  EXPECT_EQ(f.xMax, sim::WallFriction::kArtificial);  // named on its own: overrides "walls"
+  EXPECT_EQ(f.zMin, sim::WallFriction::kNoSlip);
+  EXPECT_EQ(f.zMax, sim::WallFriction::kNoSlip);
+  EXPECT_EQ(f.obstacles, sim::WallFriction::kNoSlip);
   EXPECT_EQ(scene.setup.wallPressure, sim::SceneSetup::WallPressure::kWallDensity);
   ASSERT_EQ(scene.setup.fluid.size(), 2u);
   EXPECT_FLOAT_EQ(scene.setup.fluid[0].velocity.z, -2.0f);
@@ -259,7 +267,18 @@ TEST(SceneFileTest, WrongTypesRefused) {
                 {"tank.boundary_layers", "integer"});
   ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "boundary_layers": 9 } })",
                 {"tank.boundary_layers", "1 to 4"});
-  ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "floor_viscosity": -1 } })", {"tank.floor_viscosity"});
+  // The fitted floor viscosity is gone; a scene that still sets it is refused (not silently run
+  // with another friction).
+  ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "floor_viscosity": 1 } })",
+                {"tank.floor_viscosity", "removed", "tank.friction"});
+  ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "friction": "sticky" } })",
+                {"tank.friction", "no_slip", "free_slip", "artificial"});
+  ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "friction": { "floor": 1 } } })",
+                {"tank.friction.floor", "no_slip"});
+  ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "friction": { "walls": "rough" } } })",
+                {"tank.friction.walls", "no_slip"});
+  ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "friction": [ "no_slip" ] } })",
+                {"tank.friction", "object of faces"});
   ExpectRefused(R"({ "tank": { "min": [0,0,0], "max": [1,1,1], "wall_pressure": "adami" } })",
                 {"tank.wall_pressure", "mirrored", "wall_density"});
   ExpectRefused(R"({ "fluid": { "min": [0,0,0], "max": [1,1,1] }, )" + tank + "}", {"fluid", "array"});

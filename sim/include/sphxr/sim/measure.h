@@ -1,5 +1,7 @@
 #pragma once
 // Measurements on a host copy of the fluid, shared by the headless runner, tests and benchmarks.
+#include <vector>
+
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/params.h"
 
@@ -23,6 +25,40 @@ inline float SurgeFront(const HostFluid& fluid, float wallX, float spacing, int 
 inline float ColumnHeight(const HostFluid& fluid, float floorY, float wallX, float spacing, int minPerBin) {
   return ConnectedExtent(fluid, 1, floorY, spacing, minPerBin, wallX, 2.0f * spacing);
 }
+
+/// The Martin & Moyce (1952) comparison of a dam-break run (docs/dev/physics.md#dam-break): one shared
+/// judge for the tests, the trade-off benchmark and bench/compare_martin_moyce.py's figures.
+///
+/// The experiment's clock started when its gate began to lift, before the water was free, so its
+/// curves lag an instantaneous release by an unknown time. The judge treats that the same way for every
+/// solver and resolution: one lag t0 for both series, chosen within [0, maxLag] to minimise the summed
+/// squared relative deviations of every compared point, the simulation's time compared with t0 added
+/// (Z_sim(t - t0) against Z_measured(t)). maxLag is the experiment's first front time (T = 0.41, 22 ms
+/// for a = 0.05715 m): by then its front had moved, so the water was free. A lag at either end of the
+/// range means the simulation is slower than the experiment (0) or cannot be lined up with it (maxLag).
+struct DamBreakSample {
+  double t;       // s
+  double front;   // Z = surge front / a
+  double height;  // H = column height at the back wall / (2 a)
+};
+struct DamBreakPoint {
+  double t, value;  // the measurement's own time (T for the front, tau for the height) and value
+};
+struct DamBreakJudgement {
+  double lag = 0.0;  // s, t0
+  double lagLimit = 0.0;  // s, maxLag
+  struct Deviation {
+    double t, measured, simulated, relative;  // at the measurement's own time
+  };
+  std::vector<Deviation> front, height;  // the compared points, relative = simulated / measured - 1
+  double frontRms = 0.0, frontMax = 0.0, frontBias = 0.0, heightMax = 0.0;  // relative; max of |.|, bias the mean
+};
+/// `samples` in time order; the front is compared over frontTMin <= T <= frontTMax, the height over
+/// tau <= heightTauMax, each point only if the run reached it at the lag found (T = t sqrt(2 g / a),
+/// tau = t sqrt(g / a)). Returns false if no point could be compared.
+bool JudgeMartinMoyce(const std::vector<DamBreakSample>& samples, const std::vector<DamBreakPoint>& measuredFront,
+                      const std::vector<DamBreakPoint>& measuredHeight, double a, double g, DamBreakJudgement* out,
+                      double frontTMin = 1.0, double frontTMax = 3.3, double heightTauMax = 3.0);
 
 struct MomentumSummary {
   double px = 0, py = 0, pz = 0;  // total momentum / particle mass

@@ -147,6 +147,31 @@ bool ApplyReusePreset(const std::string& name, ReuseParams* reuse);
 /// The preset names, for help texts and errors: "accurate, balanced, fast".
 const char* ReusePresetNames();
 
+/// How a wall drags on the water moving along it (docs/design/walls.md#friction).
+/// kArtificial: the artificial viscosity alpha = solver.boundary_viscosity between fluid and wall, with
+/// the wall at rest (Akinci et al. 2012, eq. 11). kNoSlip: the fluid's own viscosity (solver.viscosity)
+/// and a no-slip wall: the fluid's pair term with each wall particle as a fluid particle of mass Psi_b
+/// moving at the mirror image -v_i of the particle's velocity, so the velocity interpolated to the face,
+/// halfway between the first fluid layer and the first wall sheet, is zero (Morris et al. 1997); no
+/// constant is chosen. kFreeSlip: no viscous term (the wall holds the water only along its normal).
+enum class WallFriction : uint8_t { kArtificial, kNoSlip, kFreeSlip };
+
+/// The friction of each face of the tank, and of the obstacles.
+struct TankFriction {
+  WallFriction floor = WallFriction::kArtificial;  // y min
+  WallFriction top = WallFriction::kArtificial;    // y max (a closed tank's lid)
+  WallFriction xMin = WallFriction::kArtificial, xMax = WallFriction::kArtificial;
+  WallFriction zMin = WallFriction::kArtificial, zMax = WallFriction::kArtificial;
+  WallFriction obstacles = WallFriction::kArtificial;
+};
+
+/// The viscosity coefficient of a wall particle's term in the force stage (the boundaryAlpha of
+/// stages/forces.h) for a wall of this friction: boundary_viscosity, 4 x viscosity (twice for the fluid
+/// pair term's mass form, twice for the mirrored relative velocity 2 v_i), or 0.
+float WallFrictionAlpha(const SolverParams& params, WallFriction friction);
+/// "artificial", "no_slip", "free_slip".
+const char* WallFrictionName(WallFriction friction);
+
 struct SceneSetup {
   SolverParams params;
   SolverMethod method = SolverMethod::kWcsph;
@@ -156,9 +181,9 @@ struct SceneSetup {
   /// particles on its faces (the top face only when `openTop` is false).
   Aabb tank{{0, 0, 0}, {1, 1, 1}};
   bool openTop = true;
-  /// Artificial viscosity alpha of the tank floor (negative: solver.boundary_viscosity, like the walls).
-  /// A dry floor drags on a spreading front much more than glass side walls drag on the column.
-  float floorViscosity = -1.0f;
+  /// How each tank face and the obstacles drag on the water along them (`tank.friction`,
+  /// docs/design/walls.md#friction). Every face kArtificial by default.
+  TankFriction friction;
   int boundaryLayers = 1;        // layers of boundary particles behind each wall
   /// How a wall particle's pressure is found (docs/design/walls.md). kMirrored: p_b = the fluid
   /// particle's own pressure (at least its neighbours' Shepard average); matches Martin & Moyce, but
