@@ -57,7 +57,7 @@ def main(argv):
     fig, axes = plt.subplots(1, 2, figsize=(12, 6))
     fig.subplots_adjust(bottom=0.22, top=0.9, wspace=0.25)
     panels = [
-        ("front_rms_rel", "surge front RMS relative error vs Martin & Moyce, after the gate lag [%]"),
+        ("front_rms_rel", "front RMS error vs Martin & Moyce (after gate lag) [%]"),
         ("mean_density_error", "mean density error, time-averaged [%]"),
     ]
     divisors = sorted({int(r["spacing_divisor"]) for r in rows})
