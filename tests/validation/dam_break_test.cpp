@@ -113,11 +113,10 @@ TEST_P(DamBreak, MatchesMartinMoyce1952) {
 INSTANTIATE_TEST_SUITE_P(Reuse, DamBreak, ::testing::Values("off", "balanced", "dfsph"),
                          [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
-// PBF at its defaults misses every bound (docs/dev/physics.md, PBF). Measured: front +15.3 % at T = 1.19
-// (RMS 10.6 %), column height +87 % at tau = 2.45; the water gains energy (1.54 E0 at tau = 1.46, a sheet
-// jetting up the back wall to the tank's top). With 30 iterations no energy is gained and the front is
-// +20 % (RMS 11.3 %), the height +67 %: a one-particle film clings to the back wall, held by s_corr
-// (+17 % with k = 0), and the front runs ahead on a floor without friction (PBF's only viscosity is XSPH).
+// PBF at its defaults misses the column height (docs/dev/physics.md, PBF). Measured with the free-slip
+// scene and the gate judge: lag 3.4 ms, the front within its bounds (max 11.1 %, RMS 7.1 %), but the
+// column height +14 ... +81 % from tau = 1.66 (+81 % at 2.45): the water gains energy and a sheet jets
+// up the back wall, and a film one particle thick clings to it, held by s_corr.
 INSTANTIATE_TEST_SUITE_P(DISABLED_Pbf, DamBreak, ::testing::Values("pbf"),
                          [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
