@@ -8,7 +8,7 @@
 namespace sphxr::sim {
 namespace {
 
-const std::array<ParamInfo, 24> kParams = {{
+const std::array<ParamInfo, 25> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
     {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
@@ -18,7 +18,7 @@ const std::array<ParamInfo, 24> kParams = {{
     {"exponent", "", "Tait exponent gamma", 1.0, 10.0, &SolverParams::exponent},
     {"viscosity", "", "Monaghan artificial viscosity alpha between fluid particles", 0.0, 10.0,
      &SolverParams::viscosity},
-    {"boundary_viscosity", "", "artificial viscosity alpha between fluid and walls (wall friction)", 0.0, 10.0,
+    {"boundary_viscosity", "", "artificial viscosity alpha between fluid and walls for tank.friction \"artificial\" (the default) and between fluid and paddles", 0.0, 10.0,
      &SolverParams::boundaryViscosity},
     {"cfl", "", "CFL number: dt <= cfl * h / (c + v_max)", 0.01, 1.0, &SolverParams::cfl},
     {"max_dt", "s", "upper bound of the time step", 1e-7, 0.1, &SolverParams::maxDt},
@@ -32,6 +32,8 @@ const std::array<ParamInfo, 24> kParams = {{
      "dfsph"},
     {"max_iterations", "", "dfsph: density solve iterations at most (reaching it is a warning; 0 = no density solve)", 0.0, 10000.0,
      &SolverParams::maxIterations, true, "dfsph"},
+    {"min_divergence_iterations", "", "dfsph: divergence solve iterations at least (when it runs)", 0.0, 1000.0,
+     &SolverParams::minDivergenceIterations, true, "dfsph"},
     {"max_divergence_iterations", "", "dfsph: divergence solve iterations at most (0 = no divergence solve)", 0.0,
      10000.0, &SolverParams::maxDivergenceIterations, true, "dfsph"},
     {"pbf_frame", "s", "pbf: the displayed frame it advances by, in pbf_substeps steps (pbf ignores max_dt and cfl)",

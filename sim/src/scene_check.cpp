@@ -192,6 +192,11 @@ Status ValidateScene(const SceneSetup& scene) {
     return Status::Error(Format("solver.min_iterations = %g is above solver.max_iterations = %g",
                                 scene.params.minIterations, scene.params.maxIterations));
   }
+  if (scene.params.maxDivergenceIterations > 0 &&
+      scene.params.minDivergenceIterations > scene.params.maxDivergenceIterations) {
+    return Status::Error(Format("solver.min_divergence_iterations = %g is above solver.max_divergence_iterations = %g",
+                                scene.params.minDivergenceIterations, scene.params.maxDivergenceIterations));
+  }
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
   {
     const double gx = scene.gravity.x, gy = scene.gravity.y, gz = scene.gravity.z;

@@ -71,12 +71,16 @@ Physics MakePhysics(const SceneSetup& scene) {
   // Its potential at the clamp box stops a particle arriving at a quarter of the sound speed.
   ph.contactStrength =
       scene.wallContact && method.wallContact ? 3.0f * ph.soundSpeed * ph.soundSpeed / (32.0f * ph.contactWidth) : 0.0f;
+  // DFSPH's density solve holds every particle at rho0 or above it; the contact is for those it cannot
+  // push, lighter than rho0 (films and spray), so the first layer of water at rest never carries it.
+  ph.contactBelowRestOnly = scene.method == SolverMethod::kDfsph;
   ph.closedTop = !scene.openTop;
   ph.volume = ph.mass / p.restDensity;
   ph.densityTolerance = 0.01f * p.densityTolerance;  // % to a fraction
   ph.divergenceTolerance = 0.01f * p.divergenceTolerance;
   ph.minIterations = static_cast<int>(p.minIterations);
   ph.maxIterations = static_cast<int>(p.maxIterations);
+  ph.minDivergenceIterations = static_cast<int>(p.minDivergenceIterations);
   ph.maxDivergenceIterations = static_cast<int>(p.maxDivergenceIterations);
   ph.pbfIterations = static_cast<int>(p.pbfIterations);
   // The constraint's scale D0 = sum_k |grad_k C_i|^2 of the rest lattice (1/m^2): epsilon and s_corr are

@@ -74,7 +74,7 @@ const std::array<SolverInfo, 3> kSolvers = {{
     {SolverMethod::kDfsph, "dfsph", "Bender & Koschier 2015, 2017 (divergence-free SPH)",
      "divergence-free SPH: implicit pressure from two Jacobi solves, a step that follows the flow speed "
      "([../design/dfsph.md](../design/dfsph.md))",
-     false, false, false, false, false, DfsphStableDt, kDfsphStats, true, DfsphBytes, nullptr},
+     false, false, false, /*wallContact=*/true, false, DfsphStableDt, kDfsphStats, true, DfsphBytes, nullptr},
     {SolverMethod::kPbf, "pbf", "Macklin & Müller 2013 (position based fluids)",
      "position-based fluids: a fixed number of Jacobi iterations of the density constraint per step, one step "
      "per displayed frame, so its cost per frame is fixed ([../design/pbf.md](../design/pbf.md))",

@@ -28,7 +28,7 @@ class DfsphSolver final : public PressureSolver<Traits> {
     SPHXR_TRY(ctx.Lap(Stage::kDensity));
     // 3. divergence-free solve on the velocities at the start of the step        [BK17 §4.2, alg. 2]
     if (ph.maxDivergenceIterations > 0) {
-      const Result r = Solve(ctx, false, 0, ph.maxDivergenceIterations, ph.divergenceTolerance);
+      const Result r = Solve(ctx, false, ph.minDivergenceIterations, ph.maxDivergenceIterations, ph.divergenceTolerance);
       ctx.report.divergenceIterations = r.iterations;
       ctx.report.divergenceError = r.error;
     }

@@ -14,7 +14,9 @@ namespace sphxr::sim {
 /// where: StepReductionOp), and the store of particle i's position, velocity and acceleration.
 SPHXR_HD SPHXR_INLINE void DriftAndStore(const FluidView& fluid, const Physics& ph, float dt, int i, Vec4 x, Vec4 v,
                                          Vec4 a) {
-  if (ph.contactStrength > 0.0f) WallContact(ph, Xyz(x), dt, &v);
+  if (ph.contactStrength > 0.0f && (!ph.contactBelowRestOnly || fluid.density[i] < ph.restDensity)) {
+    WallContact(ph, Xyz(x), dt, &v);
+  }
   x.x += dt * v.x;
   x.y += dt * v.y;
   x.z += dt * v.z;

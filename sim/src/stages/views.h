@@ -196,6 +196,7 @@ struct Physics {
   // acceleration at its floor (m/s^2; 0: tank.wall_contact off); the top face counts when the tank is closed.
   float contactWidth;
   float contactStrength;
+  bool contactBelowRestOnly;  // the contact acts only on particles lighter than rho0 (DFSPH; contact.h)
   bool closedTop;
   float volume;                 // m / rho0, each fluid particle's rest volume
   // dfsph (solvers/dfsph.h)
@@ -203,6 +204,7 @@ struct Physics {
   float divergenceTolerance;    // mean compression per step (fraction) at which the divergence solve stops
   int minIterations;
   int maxIterations;
+  int minDivergenceIterations;
   int maxDivergenceIterations;  // 0: no divergence solve
   // pbf (solvers/pbf.h)
   int pbfIterations;

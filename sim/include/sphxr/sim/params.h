@@ -29,6 +29,7 @@ struct SolverParams {
   float divergenceTolerance = 0.1f;  // %, mean compression rate (per step) at which the divergence solve stops
   float minIterations = 2.0f;        // density solve iterations at least
   float maxIterations = 100.0f;      // density solve iterations at most (then a warning)
+  float minDivergenceIterations = 0.0f;   // divergence solve iterations at least (when it runs)
   float maxDivergenceIterations = 100.0f;  // divergence solve iterations at most
   // pbf (Macklin & Müller 2013): the constraint solve and its corrections (docs/design/pbf.md says why
   // these values: the least work that holds a 20-spacing column at rest at 90 Hz).
