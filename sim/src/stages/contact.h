@@ -20,8 +20,9 @@
 // at the clamp box, K width / 3, equals (c/4)^2 / 2), and capped so that symplectic Euler resolves the
 // spring at the zone's floor: omega dt <= 1.5 with omega^2 = 2 K / width. At WCSPH's acoustic step the
 // cap lowers K by up to about 2x; the capped contact still stops a particle arriving at 0.17 c (cfl 0.4,
-// support 2.5 dx) to 0.22 c (support 2 dx). WCSPH only (Physics::contactStrength is 0 under DFSPH,
-// whose first layer rests inside the zone: solver.cpp).
+// support 2.5 dx) to 0.22 c (support 2 dx). Under DFSPH only on particles lighter than rho0
+// (Physics::contactBelowRestOnly, DriftAndStore), the ones its density solve cannot push: DFSPH's
+// first layer of water at rest sits inside the zone, and must not carry the contact (solver.cpp).
 #include "stages/views.h"
 
 namespace sphxr::sim {
