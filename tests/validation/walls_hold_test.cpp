@@ -3,9 +3,12 @@
 // (a quarter spacing in front of each face) catches fewer than 1 in 10,000 particle-steps
 // (sim::kLeakingClampRate, where it is a safety net; docs/design/walls.md). The Martin & Moyce scene's
 // rate is checked in dam_break_test.cpp, a jet at a wall and an obstacle in tests/sim/walls_clamp_test.cpp.
+// The same bound under DFSPH, whose walls are its density solve and the contact on water lighter than
+// rho0 (docs/design/dfsph.md).
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <string>
 
 #include "sphxr/app/scene_file.h"
 #include "sphxr/sim/solver.h"
@@ -13,9 +16,12 @@
 namespace sphxr {
 namespace {
 
-TEST(WallsHold, TheBenchmarkDamBreakIsHeldByItsWalls) {
+class WallsHold : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(WallsHold, TheBenchmarkDamBreakIsHeldByItsWalls) {
   app::SceneFile scene;
   ASSERT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/dam_break_1m.json", &scene).ok());
+  ASSERT_TRUE(sim::ParseSolverMethod(GetParam(), &scene.setup.method));
   ASSERT_GT(scene.runTime, 1.5) << "past the impact on the far wall and the run-up";
   std::unique_ptr<sim::Solver> solver;
   ASSERT_TRUE(sim::Solver::Create(scene.setup, sim::SolverConfig{}, &solver).ok());
@@ -28,6 +34,9 @@ TEST(WallsHold, TheBenchmarkDamBreakIsHeldByItsWalls) {
   EXPECT_LT(rate, sim::kLeakingClampRate) << totals.clampedEvents << " clamps in " << totals.particleSteps
                                           << " particle-steps";
 }
+
+INSTANTIATE_TEST_SUITE_P(Method, WallsHold, ::testing::Values("wcsph", "dfsph"),
+                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
 
 }  // namespace
 }  // namespace sphxr
