@@ -70,10 +70,8 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.contactWidth = 0.1f * p.spacing;
   // Its potential at the clamp box stops a particle arriving at a quarter of the sound speed.
   ph.contactStrength =
-      scene.wallContact && method.wallContact ? 3.0f * ph.soundSpeed * ph.soundSpeed / (32.0f * ph.contactWidth) : 0.0f;
-  // DFSPH's density solve holds every particle at rho0 or above it; the contact is for those it cannot
-  // push, lighter than rho0 (films and spray), so the first layer of water at rest never carries it.
-  ph.contactBelowRestOnly = scene.method == SolverMethod::kDfsph;
+      scene.wallContact && method.wallContact != ContactUse::kNone ? 3.0f * ph.soundSpeed * ph.soundSpeed / (32.0f * ph.contactWidth) : 0.0f;
+  ph.contactBelowRestOnly = method.wallContact == ContactUse::kBelowRestDensity;
   ph.closedTop = !scene.openTop;
   ph.volume = ph.mass / p.restDensity;
   ph.densityTolerance = 0.01f * p.densityTolerance;  // % to a fraction

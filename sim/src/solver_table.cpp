@@ -69,16 +69,16 @@ constexpr std::array<SolverStat, 2> kPbfStats = {SolverStat::kDensityIterations,
 const std::array<SolverInfo, 3> kSolvers = {{
     {SolverMethod::kWcsph, "wcsph", "Becker & Teschner 2007 (weakly compressible SPH, Tait equation of state)",
      "weakly compressible SPH: explicit pressure from the Tait equation, a step bounded by the sound speed",
-     /*wallDensity=*/true, /*deltaSph=*/true, /*reuse=*/true, /*wallContact=*/true, /*acoustic=*/true, WcsphStableDt, {}, false, NoBytes,
+     /*wallDensity=*/true, /*deltaSph=*/true, /*reuse=*/true, ContactUse::kEveryParticle, /*acoustic=*/true, WcsphStableDt, {}, false, NoBytes,
      nullptr},
     {SolverMethod::kDfsph, "dfsph", "Bender & Koschier 2015, 2017 (divergence-free SPH)",
      "divergence-free SPH: implicit pressure from two Jacobi solves, a step that follows the flow speed "
      "([../design/dfsph.md](../design/dfsph.md))",
-     false, false, false, /*wallContact=*/true, false, DfsphStableDt, kDfsphStats, true, DfsphBytes, nullptr},
+     false, false, false, ContactUse::kBelowRestDensity, false, DfsphStableDt, kDfsphStats, true, DfsphBytes, nullptr},
     {SolverMethod::kPbf, "pbf", "Macklin & Müller 2013 (position based fluids)",
      "position-based fluids: a fixed number of Jacobi iterations of the density constraint per step, one step "
      "per displayed frame, so its cost per frame is fixed ([../design/pbf.md](../design/pbf.md))",
-     false, false, false, false, false, PbfStableDt, kPbfStats, false, PbfBytes,
+     false, false, false, ContactUse::kNone, false, PbfStableDt, kPbfStats, false, PbfBytes,
      /*speedCapParam=*/"pbf_max_speed"},  // the prediction's and the corrections' velocity are capped
 }};
 

@@ -26,6 +26,15 @@ struct StableDtInput {
   float maxAccel;  // m/s^2, of the last step (gravity at least)
 };
 
+/// Which fluid particles the walls' contact (tank.wall_contact, stages/contact.h) acts on.
+enum class ContactUse {
+  kNone,
+  kEveryParticle,
+  /// Only particles lighter than rho0: the ones an implicit density solve cannot push (films, spray),
+  /// so that its first layer of water at rest, which sits inside the contact zone, never carries it.
+  kBelowRestDensity,
+};
+
 struct SolverInfo {
   SolverMethod method;
   const char* name;     // solver.method
@@ -35,7 +44,7 @@ struct SolverInfo {
   bool wallDensity;  // tank.wall_pressure "wall_density" (docs/design/walls.md)
   bool deltaSph;     // solver.density "delta_sph"
   bool reuse;        // activity-based reuse (Huang et al. 2013, §3.3)
-  bool wallContact;  // tank.wall_contact (stages/contact.h)
+  ContactUse wallContact;  // tank.wall_contact (stages/contact.h)
   bool acoustic;     // its step and its compression follow the sound speed (the scene check's Mach warnings)
   /// Its stable step for the current state, solver.max_dt included (solver.fixed_dt is clamped to it).
   float (*stableDt)(const StableDtInput& in);
