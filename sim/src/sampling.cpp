@@ -177,9 +177,10 @@ int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out, std::vec
   // is still the floor's).
   const SolverParams& params = scene.params;
   const TankFriction& friction = scene.friction;
-  const std::pair<unsigned, WallFriction> faceFriction[] = {
-      {kFaceXMin, friction.xMin}, {kFaceXMax, friction.xMax}, {kFaceFloor, friction.floor},
-      {kFaceTop, friction.top},   {kFaceZMin, friction.zMin}, {kFaceZMax, friction.zMax}};
+  const std::pair<unsigned, float> faceAlpha[] = {
+      {kFaceXMin, WallFrictionAlpha(params, friction.xMin)},   {kFaceXMax, WallFrictionAlpha(params, friction.xMax)},
+      {kFaceFloor, WallFrictionAlpha(params, friction.floor)}, {kFaceTop, WallFrictionAlpha(params, friction.top)},
+      {kFaceZMin, WallFrictionAlpha(params, friction.zMin)},   {kFaceZMax, WallFrictionAlpha(params, friction.zMax)}};
   const float obstacleAlpha = WallFrictionAlpha(params, friction.obstacles);
   int64_t count = 0;
   bool tankPass = true;
@@ -189,8 +190,8 @@ int64_t SampleBoundary(const SceneSetup& scene, std::vector<Vec4>* out, std::vec
     if (!viscosity) return;
     float alpha = tankPass ? 0.0f : obstacleAlpha;
     if (tankPass) {
-      for (const auto& [face, f] : faceFriction) {
-        if (faces & face) alpha = std::max(alpha, WallFrictionAlpha(params, f));
+      for (const auto& [face, a] : faceAlpha) {
+        if (faces & face) alpha = std::max(alpha, a);
       }
     }
     viscosity->push_back(alpha);
