@@ -111,24 +111,6 @@ bool ParseArgs(int argc, char** argv, Args* out) {
   return true;
 }
 
-/// The measurements file's series: front (T, Z) and height (tau, H).
-bool ReadMeasurements(const std::string& path, std::vector<sim::DamBreakPoint>* front,
-                      std::vector<sim::DamBreakPoint>* height) {
-  std::ifstream in(path);
-  if (!in) return false;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || line.rfind("series", 0) == 0) continue;
-    std::stringstream ss(line);
-    std::string series, t, v;
-    std::getline(ss, series, ',');
-    std::getline(ss, t, ',');
-    std::getline(ss, v, ',');
-    (series == "front" ? front : height)->push_back({std::stod(t), std::stod(v)});
-  }
-  return !front->empty() && !height->empty();
-}
-
 struct Config {
   sim::SolverMethod method;
   int spacingDivisor;     // spacing = a / divisor
@@ -329,7 +311,7 @@ int main(int argc, char** argv) {
   }
 
   std::vector<sim::DamBreakPoint> measuredFront, measuredHeight;
-  if (!ReadMeasurements(args.measurements, &measuredFront, &measuredHeight)) {
+  if (!sim::ReadMartinMoyce(args.measurements, &measuredFront, &measuredHeight)) {
     std::fprintf(stderr, "%s: cannot read the front and height series of the Martin & Moyce measurements\n",
                  args.measurements.c_str());
     return 1;

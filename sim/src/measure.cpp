@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <string>
 #include <vector>
 
 #include "sphxr/sim/host_grid.h"
@@ -105,6 +108,27 @@ double SampleAt(const std::vector<DamBreakSample>& s, double DamBreakSample::*me
 }
 
 }  // namespace
+
+bool ReadMartinMoyce(const std::string& path, std::vector<DamBreakPoint>* front, std::vector<DamBreakPoint>* height) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("series", 0) == 0) continue;
+    const size_t a = line.find(','), b = a == std::string::npos ? a : line.find(',', a + 1);
+    if (b == std::string::npos) return false;
+    const std::string series = line.substr(0, a);
+    char* end = nullptr;
+    const double t = std::strtod(line.c_str() + a + 1, &end);
+    if (end != line.c_str() + b) return false;
+    const double v = std::strtod(line.c_str() + b + 1, &end);
+    if (end == line.c_str() + b + 1 || !std::isfinite(t) || !std::isfinite(v)) return false;
+    if (series == "front") front->push_back({t, v});
+    else if (series == "height") height->push_back({t, v});
+    else return false;
+  }
+  return !front->empty() && !height->empty();
+}
 
 bool JudgeMartinMoyce(const std::vector<DamBreakSample>& samples, const std::vector<DamBreakPoint>& measuredFront,
                       const std::vector<DamBreakPoint>& measuredHeight, double a, double g, DamBreakJudgement* out,

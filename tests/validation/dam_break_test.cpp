@@ -5,9 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,30 +16,14 @@
 namespace sphxr {
 namespace {
 
-void ReadMeasurements(std::vector<sim::DamBreakPoint>* front, std::vector<sim::DamBreakPoint>* height) {
-  std::ifstream in(SPHXR_TEST_DATA_DIR "/martin_moyce_1952.csv");
-  ASSERT_TRUE(in) << "missing tests/data/martin_moyce_1952.csv";
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || line.rfind("series", 0) == 0) continue;
-    std::stringstream ss(line);
-    std::string series, t, v;
-    std::getline(ss, series, ',');
-    std::getline(ss, t, ',');
-    std::getline(ss, v, ',');
-    (series == "front" ? front : height)->push_back({std::stod(t), std::stod(v)});
-  }
-  ASSERT_FALSE(front->empty());
-  ASSERT_FALSE(height->empty());
-}
-
 // The same bounds with reuse off (the core solver), with the `balanced` reuse preset, under DFSPH, and
 // under PBF at its defaults (3 substeps of 3 iterations a 90 Hz frame, XSPH c = 0.01).
 class DamBreak : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(DamBreak, MatchesMartinMoyce1952) {
   std::vector<sim::DamBreakPoint> measuredFront, measuredHeight;
-  ReadMeasurements(&measuredFront, &measuredHeight);
+  ASSERT_TRUE(sim::ReadMartinMoyce(SPHXR_TEST_DATA_DIR "/martin_moyce_1952.csv", &measuredFront, &measuredHeight))
+      << "tests/data/martin_moyce_1952.csv missing or malformed";
 
   app::SceneFile scene;
   ASSERT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/dam_break.json", &scene).ok());

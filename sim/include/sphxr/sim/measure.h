@@ -1,5 +1,6 @@
 #pragma once
 // Measurements on a host copy of the fluid, shared by the headless runner, tests and benchmarks.
+#include <string>
 #include <vector>
 
 #include "sphxr/sim/fields.h"
@@ -53,6 +54,10 @@ struct DamBreakJudgement {
   std::vector<Deviation> front, height;  // the compared points, relative = simulated / measured - 1
   double frontRms = 0.0, frontMax = 0.0, frontBias = 0.0, heightMax = 0.0;  // relative; max of |.|, bias the mean
 };
+/// The measurements file (tests/data/martin_moyce_1952.csv: '#' comments, a "series,..." header, rows
+/// "front,T,Z" and "height,tau,H"). False if it cannot be read, a row is not of that form, or a
+/// series is empty.
+bool ReadMartinMoyce(const std::string& path, std::vector<DamBreakPoint>* front, std::vector<DamBreakPoint>* height);
 /// `samples` in time order; the front is compared over frontTMin <= T <= frontTMax, the height over
 /// tau <= heightTauMax, each point only if the run reached it at the lag found (T = t sqrt(2 g / a),
 /// tau = t sqrt(g / a)). Returns false if no point could be compared.
