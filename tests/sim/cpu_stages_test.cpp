@@ -554,7 +554,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   std::vector<Vec4> delta(n), deltaRef(n), boundaryGrad(n), own(n);
   // The SIMD lambda pass fills the pair cache (as on the CPU backend), which the SIMD correction reads;
   // the scalar stages recompute the pairs.
-  const int stride = PbfPairStride(maxNeighbours);
+  const int stride = PairCacheStride(maxNeighbours);
   std::vector<float> pairGrad(n * static_cast<size_t>(stride), std::numeric_limits<float>::quiet_NaN());
   const PbfView view{lambda.data(), lambdaSum.data(), delta.data(), boundaryGrad.data(), pairGrad.data(), own.data(), stride};
   const PbfLambdaStage lambdaStage{f.grid, f.fluid, f.list, ph, view};
@@ -674,6 +674,182 @@ TEST(CpuStages, PbfPassesMatchPerParticleAndBruteForce) {
   const WallScene scene;
   ComparePbf(scene.water, 64, "walls", scene.walls);
   ComparePbf(Clustered(), 24, "clustered, lists overflowing");
+}
+
+/// DFSPH's three neighbour passes (cpu/dfsph.h) against the per-particle stages (solvers/dfsph_stages.h)
+/// and against their sums in double over every fluid and wall particle: the factor alpha_i with the
+/// walls' gradient gB_i and the neighbour count, Predict's increment delta_i (the density solve's from
+/// the compressed set's rho_i and D rho_i/Dt, the divergence solve's from D rho_i/Dt), and Correct's
+/// velocity update. The SIMD passes read the lane-blocked cache the SIMD factor filled, the scalar ones
+/// their Vec3 a slot.
+void CompareDfsph(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what,
+                  const std::vector<Vec3>& walls = {}) {
+  SCOPED_TRACE(what);
+  Setup s(points, maxNeighbours, walls);
+  Physics& ph = s.ph;
+  ph.volume = kSpacing * kSpacing * kSpacing;
+  s.RunBlocked(false, 0);  // the neighbour lists, the densities and the near-a-wall flags
+  const size_t n = s.position.size();
+  const ForceStage f = s.Forces();
+  const CubicSpline k = ph.kernel;
+  const double invRho0 = ph.invRestDensity;
+  std::vector<float> kappa(n, 0.0f), kappaV(n, 0.0f), factor(n, -1.0f), delta(n, -1.0f);
+  std::vector<Vec3> grad(n * static_cast<size_t>(maxNeighbours), Vec3{9.0f, 9.0f, 9.0f});
+  std::vector<Vec4> boundary(n, Vec4{9.0f, 9.0f, 9.0f, 9.0f}), velocityStart(n);
+  std::vector<int32_t> neighbours(n, -1);
+  std::vector<uint64_t> error(n, 0);
+  const int stride = PairCacheStride(maxNeighbours);
+  std::vector<float> pairGrad(n * static_cast<size_t>(stride), std::numeric_limits<float>::quiet_NaN());
+  DfsphView view{kappa.data(),      kappaV.data(), grad.data(),  boundary.data(),      factor.data(),
+                 neighbours.data(), delta.data(),  error.data(), velocityStart.data(), pairGrad.data(),
+                 stride};
+  auto gradFactor = [&](double r) {
+    const double q = r / k.H;
+    return q <= 0.5 ? k.gradA * (3.0 * q - 2.0) : -k.gradB * (1.0 - q) * (1.0 - q) / r;
+  };
+  // f(j or -1 - b, G) over every other fluid particle (G = V grad W_ij) and every wall particle (G = Psi_b
+  // / rho0 grad W_ib) within the support, in double
+  // (`borderline`: how many of them lie within 1e-5 of the support's edge)
+  auto pairs = [&](size_t i, auto&& fn, int* borderline = nullptr) {
+    const Vec3 xi = Xyz(s.position[i]);
+    auto visit = [&](long j, Vec4 p, double c) {
+      const double d[3] = {double(xi.x) - p.x, double(xi.y) - p.y, double(xi.z) - p.z};
+      const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      if (borderline && std::abs(r - k.H) < 1e-5 * k.H) ++*borderline;
+      if (r >= (1.0 + 1e-5) * k.H || r == 0.0) return;
+      const double g = c * gradFactor(r);
+      const double G[3] = {d[0] * g, d[1] * g, d[2] * g};
+      fn(j, G);
+    };
+    for (size_t j = 0; j < n; ++j) {
+      if (j != i) visit(static_cast<long>(j), s.position[j], ph.volume);
+    }
+    for (size_t b = 0; b < s.boundary.size(); ++b) visit(-1 - static_cast<long>(b), s.boundary[b], s.boundary[b].w * invRho0);
+  };
+  constexpr double u = 5.96e-8;  // float's unit roundoff
+  // 1. the factor: scalar, then SIMD (which fills the lane-blocked cache)
+  const DfsphFactorStage factorStage{f.grid, f.fluid, f.list, ph, view};
+  for (size_t i = 0; i < n; ++i) factorStage(static_cast<int>(i));
+  const std::vector<float> factorRef = factor;
+  const std::vector<Vec4> boundaryRef = boundary;
+  const std::vector<int32_t> neighboursRef = neighbours;
+  std::fill(factor.begin(), factor.end(), -1.0f);
+  std::fill(boundary.begin(), boundary.end(), Vec4{9.0f, 9.0f, 9.0f, 9.0f});
+  std::fill(neighbours.begin(), neighbours.end(), -1);
+  for (size_t i = 0; i < n; ++i) DfsphFactorListStage{factorStage}(static_cast<int>(i));
+  size_t nearWall = 0;
+  for (size_t i = 0; i < n; ++i) {
+    double sum[3] = {0, 0, 0}, gB[3] = {0, 0, 0}, sum2 = 0.0, scale = 0.0;
+    int count = 0;
+    pairs(i, [&](long j, const double* G) {
+      ++count;
+      for (int a = 0; a < 3; ++a) (j >= 0 ? sum : gB)[a] += G[a];
+      if (j >= 0) sum2 += G[0] * G[0] + G[1] * G[1] + G[2] * G[2];
+      scale += std::sqrt(G[0] * G[0] + G[1] * G[1] + G[2] * G[2]);
+    });
+    // The count: pairs within the support in float; a pair of the lattice two spacings apart sits on its
+    // edge (rounding decides, and its G is ~0), so the count may hold any of those.
+    int borderline = 0;
+    pairs(i, [&](long, const double*) {}, &borderline);
+    EXPECT_GE(neighbours[i], count - borderline) << "particle " << i;
+    EXPECT_LE(neighbours[i], count) << "particle " << i;
+    EXPECT_EQ(neighboursRef[i], neighbours[i]) << "particle " << i;
+    const float got[3] = {boundary[i].x, boundary[i].y, boundary[i].z};
+    const float ref[3] = {boundaryRef[i].x, boundaryRef[i].y, boundaryRef[i].z};
+    // a sum of `count` terms in float, in any order: within 2 count u of their absolute sum
+    const double sumTol = 2.0 * count * u * scale + 1e-12;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(got[a], gB[a], sumTol) << "particle " << i << " axis " << a;
+      EXPECT_NEAR(ref[a], gB[a], sumTol) << "scalar: particle " << i << " axis " << a;
+    }
+    if (gB[0] != 0.0 || gB[1] != 0.0 || gB[2] != 0.0) ++nearWall;
+    const double g[3] = {sum[0] + gB[0], sum[1] + gB[1], sum[2] + gB[2]};
+    const double denominator = g[0] * (sum[0] + 2.0 * gB[0]) + g[1] * (sum[1] + 2.0 * gB[1]) +
+                               g[2] * (sum[2] + 2.0 * gB[2]) + sum2;
+    ASSERT_GT(denominator, 0.0);
+    const double alpha = 1.0 / denominator;
+    // The denominator's terms carry the sums' rounding (relative 2 count u of |G| sums, doubled in the
+    // products) against a denominator of at least sum |G|^2: relative 8 count u (scale / |G|) is a bound
+    // with room; alpha's relative error is the denominator's.
+    const double rel = 8.0 * count * u * (1.0 + scale * scale / (sum2 > 0.0 ? sum2 * count : 1.0));
+    EXPECT_NEAR(factor[i], alpha, rel * alpha) << "particle " << i;
+    EXPECT_NEAR(factorRef[i], alpha, rel * alpha) << "scalar: particle " << i;
+  }
+  if (!walls.empty()) {
+    EXPECT_GT(nearWall, n / 10) << "the wall case must put particles near the wall";
+  }
+  // 2. Predict, both solves: delta_i = residual alpha_i, from the same alpha_i (the SIMD factor's)
+  const float dt = 1e-3f;
+  for (bool densitySolve : {true, false}) {
+    SCOPED_TRACE(densitySolve ? "density solve" : "divergence solve");
+    const DfsphPredictStage predict{f.grid, f.fluid, f.list, ph, view, dt, densitySolve};
+    for (size_t i = 0; i < n; ++i) predict(static_cast<int>(i));
+    const std::vector<float> deltaRef = delta;
+    std::fill(delta.begin(), delta.end(), -1.0f);
+    for (size_t i = 0; i < n; ++i) DfsphPredictListStage{predict}(static_cast<int>(i));
+    size_t pushed = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const Vec4 vi = s.velocity[i];
+      double rate = 0.0, scale = 0.0;
+      int count = 0;
+      pairs(i, [&](long j, const double* G) {
+        ++count;
+        const Vec4 vj = j >= 0 ? s.velocity[static_cast<size_t>(j)] : Vec4{0.0f, 0.0f, 0.0f, 0.0f};  // walls at rest
+        const double term = (double(vi.x) - vj.x) * G[0] + (double(vi.y) - vj.y) * G[1] + (double(vi.z) - vj.z) * G[2];
+        rate += term;
+        scale += std::abs(double(vi.x) - vj.x) * std::abs(G[0]) + std::abs(double(vi.y) - vj.y) * std::abs(G[1]) +
+                 std::abs(double(vi.z) - vj.z) * std::abs(G[2]);
+      });
+      double residual, residualTol;
+      const double rateTol = 4.0 * (count + 3) * u * scale + 1e-12;
+      if (densitySolve) {
+        residual = std::max(s.density[i] * invRho0 + dt * rate - 1.0, 0.0);
+        residualTol = 2.0 * u * (s.density[i] * invRho0) + dt * rateTol;
+      } else {
+        residual = neighbours[i] < kDfsphMinNeighbours ? 0.0 : std::max(rate, 0.0);
+        residualTol = rateTol;
+      }
+      const double expected = residual * factor[i];
+      const double tol = residualTol * factor[i] + 2.0 * u * expected;
+      EXPECT_NEAR(delta[i], expected, tol) << "particle " << i;
+      EXPECT_NEAR(deltaRef[i], expected, tol) << "scalar: particle " << i;
+      if (expected > 0.0) ++pushed;
+    }
+    EXPECT_GT(pushed, n / 20) << "some particles must be pushed, or the increments are not tested";
+  }
+  // 3. Correct, from the divergence solve's increments above: dv_i = sum_j (delta_i + delta_j) G_ij +
+  // 2 delta_i gB_i, v_i -= dv_i (c = 1)
+  const std::vector<Vec4> v0 = s.velocity;
+  const DfsphCorrectStage correct{f.grid, f.fluid, f.list, ph, view, 1.0f, false};
+  for (size_t i = 0; i < n; ++i) correct(static_cast<int>(i));
+  const std::vector<Vec4> vRef = s.velocity;
+  s.velocity = v0;
+  for (size_t i = 0; i < n; ++i) DfsphCorrectListStage{correct}(static_cast<int>(i));
+  for (size_t i = 0; i < n; ++i) {
+    double dv[3] = {0, 0, 0}, scale = 0.0;
+    int count = 0;
+    const double di = delta[i];
+    pairs(i, [&](long j, const double* G) {
+      ++count;
+      const double c = j >= 0 ? di + delta[static_cast<size_t>(j)] : 2.0 * di;
+      for (int a = 0; a < 3; ++a) dv[a] += c * G[a];
+      scale += std::abs(c) * (std::abs(G[0]) + std::abs(G[1]) + std::abs(G[2]));
+    });
+    const double tol = 4.0 * (count + 2) * u * scale + 2.0 * u * 2.0;  // |v| < 2 m/s: its own rounding
+    const float got[3] = {s.velocity[i].x, s.velocity[i].y, s.velocity[i].z}, ref[3] = {vRef[i].x, vRef[i].y, vRef[i].z};
+    const float start[3] = {v0[i].x, v0[i].y, v0[i].z};
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(got[a], start[a] - dv[a], tol) << "particle " << i << " axis " << a;
+      EXPECT_NEAR(ref[a], start[a] - dv[a], tol) << "scalar: particle " << i << " axis " << a;
+    }
+  }
+}
+
+TEST(CpuStages, DfsphPassesMatchPerParticleAndBruteForce) {
+  CompareDfsph(Random(3000, 0.0f, 0.16f, 6, 0.18f), 64, "random");
+  const WallScene scene;
+  CompareDfsph(scene.water, 64, "walls", scene.walls);
+  CompareDfsph(Clustered(), 24, "clustered, lists overflowing");
 }
 
 TEST(CpuStages, DensityRandomSetMatchesPerParticleAndBruteForce) {

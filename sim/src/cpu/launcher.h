@@ -17,8 +17,10 @@ class CpuLauncher {
   using Vector = typename Traits::template Vector<T>;
 
  public:
-  /// PBF's SIMD lambda pass keeps each pair's kernel gradient for the correction pass (cpu/pbf.h).
-  static constexpr bool kPbfPairCache = true;
+  /// The SIMD forms keep each listed pair's kernel gradient lane-blocked (PairCacheStride) for the passes
+  /// after them: PBF's lambda pass for its correction (cpu/pbf.h), DFSPH's factor for its solves
+  /// (cpu/dfsph.h).
+  static constexpr bool kPairCache = true;
   /// The SIMD stages' loop. thrust's OpenMP for_each gives each thread one equal slice; these stages'
   /// items cost what their neighbours and walls cost, and with reuse the compacted list puts the calm
   /// (skipped) water in one part of the index range, so one thread waited for the other at every stage.

@@ -77,8 +77,14 @@ class DfsphSolver final : public PressureSolver<Traits> {
   void Prepare(StepContext<Traits>& ctx) {
     const NeighbourList list = ctx.Neighbours();
     const size_t n = static_cast<size_t>(ctx.n);
-    const size_t slots = n * static_cast<size_t>(list.maxNeighbours);
-    if (m_grad.size() != slots) m_grad.resize(slots);
+    if constexpr (kPairCache) {
+      m_pairStride = PairCacheStride(list.maxNeighbours);
+      const size_t floats = n * static_cast<size_t>(m_pairStride);
+      if (m_pairGrad.size() != floats) m_pairGrad.resize(floats);
+    } else {
+      const size_t slots = n * static_cast<size_t>(list.maxNeighbours);
+      if (m_grad.size() != slots) m_grad.resize(slots);
+    }
     if (m_boundary.size() != n) {
       m_boundary.resize(n);
       m_factor.resize(n);
@@ -114,11 +120,18 @@ class DfsphSolver final : public PressureSolver<Traits> {
   }
 
   DfsphView View() {
-    return DfsphView{Raw(m_kappa), Raw(m_kappaV), Raw(m_grad),  Raw(m_boundary),     Raw(m_factor),
-                     Raw(m_neighbours), Raw(m_delta), Raw(m_error), Raw(m_velocityStart)};
+    return DfsphView{Raw(m_kappa),      Raw(m_kappaV), Raw(m_grad),  Raw(m_boundary),      Raw(m_factor),
+                     Raw(m_neighbours), Raw(m_delta),  Raw(m_error), Raw(m_velocityStart), Raw(m_pairGrad),
+                     m_pairStride};
   }
 
-  Vector<Vec3> m_grad;
+  /// Whether the launcher's SIMD passes keep G_ij lane-blocked (the CPU's, cpu/dfsph.h) in place of the
+  /// scalar stages' Vec3 a slot.
+  static constexpr bool kPairCache = kLauncherPairCache<Traits>;
+
+  Vector<Vec3> m_grad;       // G_ij a neighbour slot (the scalar stages)
+  Vector<float> m_pairGrad;  // the same, lane-blocked (kPairCache)
+  int m_pairStride = 0;
   Vector<Vec4> m_boundary;
   Vector<float> m_factor;
   Vector<int32_t> m_neighbours;

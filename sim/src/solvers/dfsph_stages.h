@@ -22,11 +22,6 @@
 // kappa_b = kappa_i, as the WCSPH walls mirror its pressure: the pair term is 2 kappa_i, and alpha_i's
 // diagonal follows it. The paddles enter the divergence through their velocities (sB_i). The solves
 // start from zero stiffness each step (no warm start; docs/design/dfsph.md says why).
-#include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/memory.h>
-#include <thrust/reduce.h>
 
 #include <cstdint>
 
@@ -45,6 +40,10 @@ struct DfsphView {
   float* delta;           // this iteration's stiffness increment
   uint64_t* error;        // this iteration's residual of each particle, fixed point (ErrorToFixed)
   Vec4* velocityStart;    // v* (after the non-pressure forces), for the step's acceleration
+  // The CPU's SIMD passes (cpu/dfsph.h) keep G_ij here, lane-blocked (PairCacheStride floats a particle),
+  // in place of `grad`; nullptr on the backends that run the scalar stages.
+  float* pairGrad = nullptr;
+  int pairStride = 0;
 };
 
 /// Residuals are summed as integers: the mean error, and so the iteration count, is then the same for
@@ -112,31 +111,39 @@ struct DfsphFactorStage {
         sum2 += Dot(g, g);
       });
     }
-    int32_t neighbours = static_cast<int32_t>(found);
     Vec3 gB{0.0f, 0.0f, 0.0f};
-    float sB = 0.0f;
+    int32_t walls = 0;
     if (fluid.position[i].w != 0.0f) {  // a wall or a paddle within the support (DensityStage's flag)
-      const float invRho0 = ph.invRestDensity;
       int cx, cy, cz;
       grid.CellOf(xi, &cx, &cy, &cz);
       if (grid.boundaryNear[grid.Linear(cx, cy, cz)]) {
+        const float invRho0 = ph.invRestDensity;
         ForEachInCells(grid, grid.boundaryStart, grid.boundaryEnd, grid.boundary, xi, [&](uint32_t b, Vec3 d) {
           const float r2 = Dot(d, d);
           if (r2 >= k.H2) return;
           gB += d * (grid.boundary[b].w * invRho0 * k.GradFactor(sqrtf(r2)));
-          ++neighbours;
+          ++walls;
         });
       }
-      if (grid.MovingNear(xi)) {
-        ForEachInCells(grid, grid.bodyStart, grid.bodyEnd, grid.body, xi, [&](uint32_t b, Vec3 d) {
-          const float r2 = Dot(d, d);
-          if (r2 >= k.H2) return;
-          const Vec3 g = d * (grid.body[b].w * invRho0 * k.GradFactor(sqrtf(r2)));
-          gB += g;
-          sB += Dot(Xyz(grid.bodyVelocity[b]), g);
-          ++neighbours;
-        });
-      }
+    }
+    Store(i, xi, sum, sum2, gB, static_cast<int32_t>(found) + walls);
+  }
+
+  /// The paddles' terms (their particles move: sB_i), then alpha_i, the boundary terms and the neighbour
+  /// count from the fluid's sums (sum_j G_ij, sum_j |G_ij|^2) and the walls' gB_i.
+  SPHXR_HD void Store(int i, Vec3 xi, Vec3 sum, float sum2, Vec3 gB, int32_t neighbours) const {
+    float sB = 0.0f;
+    if (fluid.position[i].w != 0.0f && grid.MovingNear(xi)) {
+      const CubicSpline k = ph.kernel;
+      const float invRho0 = ph.invRestDensity;
+      ForEachInCells(grid, grid.bodyStart, grid.bodyEnd, grid.body, xi, [&](uint32_t b, Vec3 d) {
+        const float r2 = Dot(d, d);
+        if (r2 >= k.H2) return;
+        const Vec3 g = d * (grid.body[b].w * invRho0 * k.GradFactor(sqrtf(r2)));
+        gB += g;
+        sB += Dot(Xyz(grid.bodyVelocity[b]), g);
+        ++neighbours;
+      });
     }
     const Vec3 g = sum + gB;
     const float denominator = Dot(g, sum + gB * 2.0f) + sum2;  // the walls mirror kappa_i (see the top)
@@ -174,8 +181,10 @@ struct DfsphPredictStage {
   DfsphView view;
   float dt;
   bool density;  // the density solve, else the divergence solve
-  SPHXR_HD void operator()(int i) const {
-    const float rate = DensityRate(grid, fluid, list, ph, view, i);
+  SPHXR_HD void operator()(int i) const { Store(i, DensityRate(grid, fluid, list, ph, view, i)); }
+
+  /// The residual and increment from D rho^_i / Dt.
+  SPHXR_HD void Store(int i, float rate) const {
     float residual, error;
     if (density) {
       residual = AtLeast(fluid.density[i] * ph.invRestDensity + dt * rate - 1.0f, 0.0f);
@@ -203,6 +212,12 @@ struct DfsphCorrectStage {
     const float di = view.delta[i];
     Vec3 dv = Xyz(view.boundary[i]) * (2.0f * di);
     ForEachGradient(grid, fluid, list, view.grad, ph, i, [&](uint32_t j, Vec3 g) { dv += g * (di + view.delta[j]); });
+    Store(i, dv);
+  }
+
+  /// v_i -= c dv, kappa_i += delta_i.
+  SPHXR_HD void Store(int i, Vec3 dv) const {
+    const float di = view.delta[i];
     Vec4 v = fluid.velocity[i];
     v.x -= scale * dv.x;
     v.y -= scale * dv.y;

@@ -75,10 +75,7 @@ class PbfSolver final : public PressureSolver<Traits> {
  private:
   /// Whether the backend's launcher runs the SIMD passes that keep the lambda pass's pair terms (the
   /// CPU's, cpu/pbf.h); the others recompute them and need no pair array.
-  static constexpr bool kPairCache = [] {
-    if constexpr (requires { Traits::Launcher::kPbfPairCache; }) return Traits::Launcher::kPbfPairCache;
-    return false;
-  }();
+  static constexpr bool kPairCache = kLauncherPairCache<Traits>;
 
   void Size(int n) {
     const size_t count = static_cast<size_t>(n);
@@ -92,7 +89,7 @@ class PbfSolver final : public PressureSolver<Traits> {
   PbfView View(int maxNeighbours) {
     PbfView v{Raw(m_lambda), Raw(m_lambdaSum), Raw(m_delta), Raw(m_boundaryGrad), nullptr, nullptr, 0};
     if constexpr (kPairCache) {
-      v.pairStride = PbfPairStride(maxNeighbours);
+      v.pairStride = PairCacheStride(maxNeighbours);
       m_pairGrad.resize(m_lambda.size() * static_cast<size_t>(v.pairStride));
       v.pairGrad = Raw(m_pairGrad);
       v.ownCorrection = Raw(m_ownCorrection);

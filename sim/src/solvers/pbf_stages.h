@@ -40,9 +40,6 @@ struct PbfView {
   int pairStride;
 };
 
-/// Floats a particle of PbfView::pairGrad takes for `maxNeighbours` list slots, in batches of up to 16
-/// lanes (so at least what any CPU tier's kLanes needs).
-SPHXR_HD SPHXR_INLINE int PbfPairStride(int maxNeighbours) { return (maxNeighbours + 15) / 16 * 16 * 3; }
 
 /// The collision response of MM13's solver loop: x* moved out of the tank's faces and the obstacles to
 /// the particle's radius from them (ph.pbfContact beyond the clamp box, whose inset is a quarter

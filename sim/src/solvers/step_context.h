@@ -126,6 +126,15 @@ class StepContext {
 };
 
 /// A pressure solver: one method's step over the shared stages. The backend owns one (solvers/factory.h).
+/// Whether the backend's launcher runs SIMD passes that keep a lane-blocked pair cache (the CPU's,
+/// CpuLauncher::kPairCache): a solver then allocates the cache its passes share; the others recompute or
+/// keep their own layout.
+template <class Traits>
+inline constexpr bool kLauncherPairCache = [] {
+  if constexpr (requires { Traits::Launcher::kPairCache; }) return Traits::Launcher::kPairCache;
+  return false;
+}();
+
 template <class Traits>
 class PressureSolver {
  public:

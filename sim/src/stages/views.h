@@ -44,6 +44,11 @@ struct NeighbourList {
   int maxNeighbours;
 };
 
+/// Floats a particle takes in a lane-blocked pair cache (the CPU's SIMD passes of PBF and DFSPH keep each
+/// listed pair's V grad W_ij as kLanes x, then kLanes y, then kLanes z) for `maxNeighbours` list slots,
+/// in batches of up to 16 lanes (so at least what any CPU tier's kLanes needs).
+SPHXR_HD SPHXR_INLINE int PairCacheStride(int maxNeighbours) { return (maxNeighbours + 15) / 16 * 16 * 3; }
+
 /// The uniform grid over the domain: cells of size >= the kernel support; two particle sets
 /// (fluid, re-sorted every step; boundary, sorted once) with their own cell ranges.
 struct GridView {
