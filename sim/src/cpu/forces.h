@@ -3,6 +3,7 @@
 #include <cstdint>
 
 #include "cpu/blocks.h"
+#include "cpu/lists.h"
 #include "cpu/simd.h"
 #include "stages/forces.h"
 
@@ -35,11 +36,8 @@ struct ForceListStage {
     const Lanes zero = Splat(0.0f);
     Lanes ax = zero, ay = zero, az = zero, pSum = zero, wSum = zero;
     for (uint32_t base = 0; base < found; base += kLanes) {
-      LaneInts index;
-      for (int l = 0; l < kLanes; ++l) {
-        // Lanes past the list read particle i itself: r2 = 0, which the pair test excludes.
-        index[l] = static_cast<int32_t>(base + static_cast<uint32_t>(l) < found ? slots[base + l] : static_cast<uint32_t>(i));
-      }
+      // Lanes past the list read particle i itself: r2 = 0, which the pair test excludes.
+      const LaneInts index = ListLanes(slots, base, found, i);
       Lanes xj, yj, zj;
       GatherXyz(position, index, &xj, &yj, &zj);
       const Lanes dx = P.xi.x - xj, dy = P.xi.y - yj, dz = P.xi.z - zj;

@@ -12,13 +12,32 @@ namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {
 
 /// The lanes of particle i's list: up to kLanes entries from `base`, lanes past the end set to i itself
-/// (masked off by the pair test, which excludes j == i as ForEachOther does).
+/// (masked off by the pair test, which excludes j == i as ForEachOther does). With AVX-512 and AVX one
+/// masked load (the lanes past `found` are not read: a list's last batch may end past the list's
+/// allocation); else entry by entry.
 SPHXR_INLINE LaneInts ListLanes(const uint32_t* slots, uint32_t base, uint32_t found, int i) {
+  const uint32_t left = found - base;  // > 0
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+  const __mmask16 m = left >= 16u ? static_cast<__mmask16>(0xffff) : static_cast<__mmask16>((1u << left) - 1u);
+  const __m512i v = _mm512_mask_loadu_epi32(_mm512_set1_epi32(i), m, slots + base);
+  LaneInts index;
+  std::memcpy(&index, &v, sizeof index);
+  return index;
+#elif defined(__AVX__)
+  const __m256 m = _mm256_cmp_ps(_mm256_setr_ps(0.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f),
+                                 _mm256_set1_ps(static_cast<float>(left < 8u ? left : 8u)), _CMP_LT_OQ);
+  const __m256 loaded = _mm256_maskload_ps(reinterpret_cast<const float*>(slots + base), _mm256_castps_si256(m));
+  const __m256 v = _mm256_blendv_ps(_mm256_castsi256_ps(_mm256_set1_epi32(i)), loaded, m);
+  LaneInts index;
+  std::memcpy(&index, &v, sizeof index);
+  return index;
+#else
   LaneInts index;
   for (int l = 0; l < kLanes; ++l) {
-    index[l] = static_cast<int32_t>(base + static_cast<uint32_t>(l) < found ? slots[base + l] : static_cast<uint32_t>(i));
+    index[l] = static_cast<int32_t>(static_cast<uint32_t>(l) < left ? slots[base + l] : static_cast<uint32_t>(i));
   }
   return index;
+#endif
 }
 
 /// Whether particle i's list overflowed (the scalar stage then scans its cells).
