@@ -58,7 +58,7 @@ TEST_P(DamBreak, MatchesMartinMoyce1952) {
   EXPECT_EQ(static_cast<int>(host.size()), n) << "particles lost";
   // WCSPH's walls hold the water: the clamp behind them is a safety net (docs/design/walls.md). DFSPH's
   // do not yet here: its CFL step lets a fast particle cross the walls' contact zone within one step
-  // (0.85 clamps per 1,000 particle-steps; docs/design/dfsph.md). Recorded, not bounded.
+  // (0.84 clamps per 1,000 particle-steps at the default tolerance; docs/design/dfsph.md). Recorded, not bounded.
   const sim::Totals& totals = solver->GetTotals();
   const double clampRate = static_cast<double>(totals.clampedEvents) / static_cast<double>(totals.particleSteps);
   RecordProperty("clamps_per_thousand", std::to_string(1e3 * clampRate));

@@ -21,12 +21,6 @@
 namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {
 
-/// Particle i's first lane-blocked batch of G_ij.
-SPHXR_INLINE float* DfsphPairs(const DfsphView& view, int i) {
-  SPHXR_ASSERT(view.pairGrad);  // the CPU launcher's kPairCache
-  return view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride);
-}
-
 struct DfsphFactorListStage {
   DfsphFactorStage stage;
 
@@ -38,7 +32,7 @@ struct DfsphFactorListStage {
     const Physics& ph = stage.ph;
     const CubicSpline k = ph.kernel;
     const Vec3 xi = Xyz(stage.fluid.position[i]);
-    float* cache = DfsphPairs(stage.view, i);
+    float* cache = PairCacheRow(stage.view.pairGrad, stage.view.pairStride, i);
     const Lanes zero = Splat(0.0f);
     Lanes gx = zero, gy = zero, gz = zero, s2 = zero;
     // Every batch is stored (zeros where no pair is), so that the iterations read whole batches.
@@ -49,10 +43,7 @@ struct DfsphFactorListStage {
           const Lanes ax = dx * grad, ay = dy * grad, az = dz * grad;
           gx += ax, gy += ay, gz += az;
           s2 += ax * ax + ay * ay + az * az;
-          float* out = cache + 3 * kLanes * batch;
-          StoreLanes(out, ax);
-          StoreLanes(out + kLanes, ay);
-          StoreLanes(out + 2 * kLanes, az);
+          StorePairBatch(cache, batch, ax, ay, az);
         },
         /*everyBatch=*/true);
     Lanes bx = zero, by = zero, bz = zero;
@@ -82,16 +73,13 @@ struct DfsphPredictListStage {
     const DfsphView& view = stage.view;
     const float* velocity = reinterpret_cast<const float*>(stage.fluid.velocity);
     const Vec3 vi = Xyz(stage.fluid.velocity[i]);
-    const uint32_t found = stage.list.count[i];
-    const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(stage.list.maxNeighbours);
     Lanes rate = Splat(0.0f);
-    const float* cache = DfsphPairs(view, i);
-    for (uint32_t base = 0; base < found; base += kLanes, cache += 3 * kLanes) {
-      Lanes vx, vy, vz;
-      GatherXyz(velocity, ListLanes(slots, base, found, i), &vx, &vy, &vz);
-      rate += (vi.x - vx) * LoadLanes(cache) + (vi.y - vy) * LoadLanes(cache + kLanes) +
-              (vi.z - vz) * LoadLanes(cache + 2 * kLanes);
-    }
+    ForCachedPairs(stage.list, PairCacheRow(view.pairGrad, view.pairStride, i), i,
+                   [&](LaneInts index, Lanes gx, Lanes gy, Lanes gz) {
+                     Lanes vx, vy, vz;
+                     GatherXyz(velocity, index, &vx, &vy, &vz);
+                     rate += (vi.x - vx) * gx + (vi.y - vy) * gy + (vi.z - vz) * gz;
+                   });
     const Vec4 b = view.boundary[i];
     stage.Store(i, SumLanes(rate) + Dot(vi, Xyz(b)) - b.w);
   }
@@ -108,15 +96,13 @@ struct DfsphCorrectListStage {
     // sum_j (delta_i + delta_j) G_ij over the cache, plus the walls' 2 delta_i gB_i
     const DfsphView& view = stage.view;
     const float di = view.delta[i];
-    const uint32_t found = stage.list.count[i];
-    const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(stage.list.maxNeighbours);
     const Lanes zero = Splat(0.0f);
     Lanes cx = zero, cy = zero, cz = zero;
-    const float* cache = DfsphPairs(view, i);
-    for (uint32_t base = 0; base < found; base += kLanes, cache += 3 * kLanes) {
-      const Lanes s = di + Gather(view.delta, ListLanes(slots, base, found, i));
-      cx += s * LoadLanes(cache), cy += s * LoadLanes(cache + kLanes), cz += s * LoadLanes(cache + 2 * kLanes);
-    }
+    ForCachedPairs(stage.list, PairCacheRow(view.pairGrad, view.pairStride, i), i,
+                   [&](LaneInts index, Lanes gx, Lanes gy, Lanes gz) {
+                     const Lanes s = di + Gather(view.delta, index);
+                     cx += s * gx, cy += s * gy, cz += s * gz;
+                   });
     stage.Store(i, Vec3{SumLanes(cx), SumLanes(cy), SumLanes(cz)} + Xyz(view.boundary[i]) * (2.0f * di));
   }
 };

@@ -40,6 +40,36 @@ SPHXR_INLINE LaneInts ListLanes(const uint32_t* slots, uint32_t base, uint32_t f
 #endif
 }
 
+/// Particle i's row of a lane-blocked pair cache (PairCacheStride floats a particle): the passes of PBF
+/// and DFSPH that keep each listed pair's V grad W_ij for the passes after them (cpu/pbf.h, cpu/dfsph.h).
+SPHXR_INLINE float* PairCacheRow(float* cache, int stride, int i) {
+  SPHXR_ASSERT(cache);  // the CPU launcher's kPairCache
+  return cache + static_cast<size_t>(i) * static_cast<size_t>(stride);
+}
+
+/// Stores batch `batch` of a row: kLanes x, then kLanes y, then kLanes z.
+SPHXR_INLINE void StorePairBatch(float* row, int batch, Lanes x, Lanes y, Lanes z) {
+  float* out = row + 3 * kLanes * batch;
+  std::memcpy(out, &x, sizeof x);
+  std::memcpy(out + kLanes, &y, sizeof y);
+  std::memcpy(out + 2 * kLanes, &z, sizeof z);
+}
+
+/// f(index, gx, gy, gz) for particle i's listed neighbours kLanes at a time with their cached V grad W_ij
+/// (the row's batches; the lanes past the list's end hold i itself and a zero gradient).
+template <class F>
+SPHXR_INLINE void ForCachedPairs(const NeighbourList& list, const float* row, int i, F&& f) {
+  const uint32_t found = list.count[i];
+  const uint32_t* slots = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+  for (uint32_t base = 0; base < found; base += kLanes, row += 3 * kLanes) {
+    Lanes gx, gy, gz;
+    std::memcpy(&gx, row, sizeof gx);
+    std::memcpy(&gy, row + kLanes, sizeof gy);
+    std::memcpy(&gz, row + 2 * kLanes, sizeof gz);
+    f(ListLanes(slots, base, found, i), gx, gy, gz);
+  }
+}
+
 /// Whether particle i's list overflowed (the scalar stage then scans its cells).
 SPHXR_INLINE bool Overflowed(const NeighbourList& list, int i) {
   return list.count[i] > static_cast<uint32_t>(list.maxNeighbours);
@@ -68,14 +98,6 @@ SPHXR_INLINE void ForListLanes(const NeighbourList& list, const FluidView& fluid
     f(index, dx, dy, dz, r, r * k.invH, pair, batch);
   }
 }
-
-/// kLanes floats from p (any alignment), and back.
-SPHXR_INLINE Lanes LoadLanes(const float* p) {
-  Lanes v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-SPHXR_INLINE void StoreLanes(float* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
 
 /// The lanes l < n as a mask.
 SPHXR_INLINE LaneInts FirstLanes(int n) {

@@ -47,7 +47,7 @@ struct PbfLambdaListStage {
     // Each batch's V grad W_ij kept in the pair cache (every batch, so that the correction pass reads
     // zeros where no pair is), and the sum of the pairs' s_corr V grad W_ij.
     SPHXR_ASSERT(view.pairGrad && view.ownCorrection);  // the CPU launcher's kPairCache
-    float* cache = view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride);
+    float* cache = PairCacheRow(view.pairGrad, view.pairStride, i);
     const bool corrected = ph.pbfCorrK > 0.0f;
     const Lanes zero = Splat(0.0f);
     Lanes w = zero, s2 = zero, gx = zero, gy = zero, gz = zero, sx = zero, sy = zero, sz = zero;
@@ -60,10 +60,7 @@ struct PbfLambdaListStage {
           const Lanes ax = dx * grad, ay = dy * grad, az = dz * grad;
           gx += ax, gy += ay, gz += az;
           s2 += ax * ax + ay * ay + az * az;
-          float* out = cache + 3 * kLanes * batch;
-          StoreLanes(out, ax);
-          StoreLanes(out + kLanes, ay);
-          StoreLanes(out + 2 * kLanes, az);
+          StorePairBatch(cache, batch, ax, ay, az);
           if (corrected) {
             const Lanes corr = CorrLanes(ph, wj);
             sx += corr * ax, sy += corr * ay, sz += corr * az;
@@ -107,15 +104,13 @@ struct PbfCorrectListStage {
     // sum_j lambda_j V grad W_ij over the lambda pass's pair cache, plus the particle's own terms
     const PbfView& view = stage.view;
     SPHXR_ASSERT(view.pairGrad && view.ownCorrection);
-    const uint32_t found = stage.list.count[i];
-    const uint32_t* slots = stage.list.index + static_cast<size_t>(i) * static_cast<size_t>(stage.list.maxNeighbours);
-    const float* cache = view.pairGrad + static_cast<size_t>(i) * static_cast<size_t>(view.pairStride);
     const Lanes zero = Splat(0.0f);
     Lanes cx = zero, cy = zero, cz = zero;
-    for (uint32_t base = 0; base < found; base += kLanes, cache += 3 * kLanes) {
-      const Lanes lj = Gather(view.lambda, ListLanes(slots, base, found, i));  // padding: i, whose term is 0
-      cx += lj * LoadLanes(cache), cy += lj * LoadLanes(cache + kLanes), cz += lj * LoadLanes(cache + 2 * kLanes);
-    }
+    ForCachedPairs(stage.list, PairCacheRow(view.pairGrad, view.pairStride, i), i,
+                   [&](LaneInts index, Lanes gx, Lanes gy, Lanes gz) {
+                     const Lanes lj = Gather(view.lambda, index);  // padding: i, whose term is 0
+                     cx += lj * gx, cy += lj * gy, cz += lj * gz;
+                   });
     view.delta[i] = MakeVec4(Vec3{SumLanes(cx), SumLanes(cy), SumLanes(cz)} + Xyz(view.ownCorrection[i]));
   }
 };
