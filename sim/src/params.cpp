@@ -8,7 +8,7 @@
 namespace sphxr::sim {
 namespace {
 
-const std::array<ParamInfo, 25> kParams = {{
+const std::array<ParamInfo, 26> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
     {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
@@ -50,6 +50,8 @@ const std::array<ParamInfo, 25> kParams = {{
     {"pbf_corr_dq", "", "pbf: the artificial pressure's dq, in kernel support radii", 0.01, 0.9, &SolverParams::pbfCorrDq,
      false, "pbf"},
     {"pbf_xsph", "", "pbf: XSPH viscosity c (0 = none)", 0.0, 1.0, &SolverParams::pbfXsph, false, "pbf"},
+    {"pbf_vorticity", "m/s", "pbf: vorticity confinement epsilon: the acceleration eps (N x omega), N toward the vortices' cores (0 = off)",
+     0.0, 10.0, &SolverParams::pbfVorticity, false, "pbf"},
     {"pbf_max_speed", "m/s", "pbf: speeds are capped here (a safety net against a runaway correction)", 0.01, 1000.0,
      &SolverParams::pbfMaxSpeed, false, "pbf"},
 }};

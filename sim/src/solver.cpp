@@ -90,6 +90,7 @@ Physics MakePhysics(const SceneSetup& scene) {
   ph.pbfCorrN = static_cast<int>(p.pbfCorrN);
   ph.pbfInvCorrW = 1.0f / ph.kernel.W(p.pbfCorrDq * support);
   ph.pbfXsph = p.pbfXsph;
+  ph.pbfVorticity = p.pbfVorticity;
   // The collision response keeps a particle its radius (half a spacing, where the sampling puts the
   // first layer) from a face: a quarter spacing beyond the clamp box's quarter-spacing inset.
   ph.pbfContact = 0.25f * p.spacing;

@@ -53,6 +53,13 @@ class PbfSolver final : public PressureSolver<Traits> {
       ctx.Launch().ForEach(ctx.n, 64, PbfXsphStage{ctx.grid, ctx.fluid, list, ph, view});
       ctx.Map(PbfXsphApplyStage{ctx.fluid, view});
     }
+    // 5b. vorticity confinement, when the scene asks for it                            [MM13 eq. 15-16]
+    if (ph.pbfVorticity > 0.0f) {
+      if (m_vorticity.size() != static_cast<size_t>(ctx.n)) m_vorticity.resize(static_cast<size_t>(ctx.n));
+      ctx.Launch().ForEach(ctx.n, 64, PbfVorticityStage{ctx.grid, ctx.fluid, list, ph, Raw(m_vorticity)});
+      ctx.Launch().ForEach(ctx.n, 64, PbfConfinementStage{ctx.grid, ctx.fluid, list, ph, view, Raw(m_vorticity), ctx.dt});
+      ctx.Map(PbfXsphApplyStage{ctx.fluid, view});
+    }
     SPHXR_TRY(ctx.Lap(Stage::kIntegrate));
     // 6. the fluid's force on the paddles: the impulse of the corrections their particles caused
     if (ctx.HasBodies()) {
@@ -101,6 +108,7 @@ class PbfSolver final : public PressureSolver<Traits> {
   Vector<Vec4> m_delta, m_boundaryGrad;
   Vector<float> m_pairGrad;        // the CPU's pair cache (PbfView::pairGrad)
   Vector<Vec4> m_ownCorrection;
+  Vector<Vec4> m_vorticity;        // omega_i, w |omega_i| (vorticity confinement only)
 };
 
 }  // namespace sphxr::sim

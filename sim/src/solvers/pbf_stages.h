@@ -15,6 +15,8 @@
 //             in the prediction and after every iteration's correction                 [MM13 alg. 1]
 //   finish    v = (x* - x) / dt (capped at pbf_max_speed), the clamps, the pressure estimate (below)
 //   xsph      v_i += c sum_j V (v_j - v_i) W_ij                                        [MM13 eq. 17]
+//   vorticity (pbf_vorticity > 0) omega_i = sum_j V (v_i - v_j) x grad_i W_ij, N = grad|omega| / |grad|omega||,
+//             v_i += dt eps (N x omega_i)                                         [MM13 eq. 15-16]
 //
 // The pressure estimate: a step's corrections move particle i by sum over iterations of its lambda
 // terms, the displacement a pressure p_i would give in the WCSPH momentum equation over dt^2 when
@@ -284,6 +286,55 @@ struct PbfXsphApplyStage {
     v.y += d.y;
     v.z += d.z;
     fluid.velocity[i] = v;
+  }
+};
+
+/// Vorticity confinement [MM13 eq. 15-16], its first pass: the velocity's curl omega_i = sum_j V (v_i - v_j)
+/// x grad_i W_ij (2 Omega in a rigid rotation), into `vorticity` (w: |omega_i|).
+struct PbfVorticityStage {
+  GridView grid;
+  FluidView fluid;
+  NeighbourList list;
+  Physics ph;
+  Vec4* vorticity;
+  SPHXR_HD void operator()(int i) const {
+    const CubicSpline k = ph.kernel;
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const Vec3 vi = Xyz(fluid.velocity[i]);
+    Vec3 w{0.0f, 0.0f, 0.0f};
+    ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t j, Vec3 d, float r) {
+      w += Cross(vi - Xyz(fluid.velocity[j]), d * k.GradFactor(r));
+    });
+    w = w * ph.volume;
+    vorticity[i] = MakeVec4(w, Length(w));
+  }
+};
+
+/// Its second pass: eta_i = grad |omega| = sum_j V (|omega_j| - |omega_i|) grad_i W_ij, N = eta / |eta|
+/// (towards the vortex's core), and the velocity change dt eps (N x omega_i) into view.delta (applied
+/// by PbfXsphApplyStage); eps is pbf_vorticity (m/s). Where |eta| vanishes (no vortex) nothing changes.
+struct PbfConfinementStage {
+  GridView grid;
+  FluidView fluid;
+  NeighbourList list;
+  Physics ph;
+  PbfView view;
+  const Vec4* vorticity;
+  float dt;
+  SPHXR_HD void operator()(int i) const {
+    const CubicSpline k = ph.kernel;
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const Vec4 wi = vorticity[i];
+    Vec3 eta{0.0f, 0.0f, 0.0f};
+    ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t j, Vec3 d, float r) {
+      eta += d * ((vorticity[j].w - wi.w) * k.GradFactor(r));
+    });
+    // N = eta / |eta|, but proportional to eta where |eta| is under 1e-3 |omega_i| / H (a vorticity
+    // that is flat within rounding has no direction to confine toward).
+    const float length = AtLeast(Length(eta), 1e-3f * wi.w * k.invH);
+    Vec3 dv{0.0f, 0.0f, 0.0f};
+    if (length > 0.0f) dv = Cross(eta * (1.0f / length), Xyz(wi)) * (ph.pbfVorticity * dt);
+    view.delta[i] = MakeVec4(dv);
   }
 };
 

@@ -218,6 +218,7 @@ struct Physics {
   int pbfCorrN;
   float pbfInvCorrW;            // 1 / W(dq)
   float pbfXsph;
+  float pbfVorticity;           // m/s, vorticity confinement's epsilon (0: off)
   float pbfMaxSpeed;
   float pbfContact;             // m: the collision response's distance beyond the clamp box (the
                                 // particle radius, half a spacing from a face, less the clamp's inset)

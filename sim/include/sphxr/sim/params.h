@@ -41,6 +41,7 @@ struct SolverParams {
   float pbfCorrN = 4.0f;
   float pbfCorrDq = 0.2f;        // dq in kernel support radii
   float pbfXsph = 0.01f;         // XSPH viscosity c
+  float pbfVorticity = 0.0f;     // m/s: vorticity confinement epsilon (0 = off; docs/design/pbf.md)
   float pbfMaxSpeed = 20.0f;     // m/s, the velocity cap (a safety net)
 };
 
