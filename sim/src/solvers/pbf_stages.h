@@ -257,7 +257,7 @@ struct PbfFinishStage {
   }
 };
 
-/// XSPH viscosity [MM13 eq. 17]: the velocity change into view.delta (applied by PbfXsphApplyStage).
+/// XSPH viscosity [MM13 eq. 17]: the velocity change into view.delta (applied by PbfAddVelocityChangeStage).
 struct PbfXsphStage {
   GridView grid;
   FluidView fluid;
@@ -276,7 +276,8 @@ struct PbfXsphStage {
   }
 };
 
-struct PbfXsphApplyStage {
+/// v_i += view.delta_i: the velocity change a pass before it left there (XSPH's, the confinement's).
+struct PbfAddVelocityChangeStage {
   FluidView fluid;
   PbfView view;
   SPHXR_HD void operator()(int i) const {
@@ -312,7 +313,7 @@ struct PbfVorticityStage {
 
 /// Its second pass: eta_i = grad |omega| = sum_j V (|omega_j| - |omega_i|) grad_i W_ij, N = eta / |eta|
 /// (towards the vortex's core), and the velocity change dt eps (N x omega_i) into view.delta (applied
-/// by PbfXsphApplyStage); eps is pbf_vorticity (m/s). Where |eta| vanishes (no vortex) nothing changes.
+/// by PbfAddVelocityChangeStage); eps is pbf_vorticity (m/s). Where |eta| vanishes (no vortex) nothing changes.
 struct PbfConfinementStage {
   GridView grid;
   FluidView fluid;
