@@ -345,8 +345,50 @@ TEST(Pbf, StillWaterHoldsItsHydrostaticPressureAndCalms) {
   }
 }
 
-// The issue's still-water targets at the defaults (3 substeps of 3 iterations a 90 Hz frame): not met.
-// Measured: mean speed 9.7 mm/s at 1 s (4.2 at 2 s), mean compression 3.6 % (docs/design/pbf.md).
+// The real-time issue's compression target (below 1 %, 1 s from the lattice) is a matter of work per
+// frame: the steady compression under a column falls as 1 / (S^2 N) with S substeps of N iterations a
+// frame (a Jacobi iteration carries a correction one support; bench/pbf_still_water.py measures
+// S^2 N C = 94-98.5 % over seven settings here). At 6 x 4 (S^2 N = 144) the water holds its depth within
+// the target. Its pressure estimate reads rho0 g depth within the 10 % band when s_corr is off; with it,
+// the upper bands read 10-15 % low at 6 x 4 (0-5 % at 3 x 3): s_corr's push is the same each iteration
+// whatever dt is, so at more iterations of a shorter step it carries more of the top layers' weight, and
+// the estimate (from lambda alone) does not count it.
+TEST(Pbf, StillWaterMeetsTheCompressionTargetWithSixSubstepsOfFourIterations) {
+  for (const float k : {0.1f, 0.0f}) {
+    SceneSetup scene = StillWater();
+    scene.params.pbfSubsteps = 6.0f;
+    scene.params.pbfIterations = 4.0f;
+    scene.params.pbfCorrK = k;
+    auto solver = test::CreateOrFail(scene);
+    ASSERT_TRUE(solver);
+    RunFor(*solver, 1.0);
+    const sim::HostFluid f = test::DownloadFluid(*solver);
+    ASSERT_EQ(test::FirstNonFinite(f), "");
+    EXPECT_LT(solver->LastStep().meanDensityError, 0.01f) << "pbf_corr_k " << k;
+    if (k > 0.0f) continue;
+    float top = 0.0f;
+    for (const Vec4& x : f.position) top = std::max(top, x.y);
+    const double surface = top + 0.5 * scene.params.spacing, g = 9.81, rho0 = scene.params.restDensity;
+    for (double y = 0.02; y <= 0.8 * surface; y += 0.02) {
+      double sum = 0.0;
+      int count = 0;
+      for (size_t i = 0; i < f.size(); ++i) {
+        if (std::fabs(f.position[i].y - y) < 0.01) sum += f.pressure[i], ++count;
+      }
+      ASSERT_GT(count, 0);
+      const double expected = rho0 * g * (surface - y);
+      EXPECT_NEAR(sum / count, expected, 0.1 * expected) << "at y = " << y << " m";
+    }
+  }
+}
+
+// The issue's still-water targets at the defaults (3 substeps of 3 iterations a 90 Hz frame): not met,
+// and neither can be bought without undoing what the defaults are for. Measured (bench/pbf_still_water.py,
+// bench/results/pbf_still_water.csv): mean compression 3.5 % at 1 s (below 1 % needs S^2 N >= 100, twice
+// the frame's cost, which is already twice the real-time budget); mean speed 9.9 mm/s at 1 s (4.2 at 2 s),
+// 8.9-10.1 mm/s at every S x N, so the solve is not what keeps it moving: the lattice's settling, damped
+// by XSPH alone. c = 0.1 calms it to 4.6 mm/s but takes a third of stirred water's kinetic energy
+// (13.5 against 20.3 mJ/kg after 4 s of `stir`; WCSPH 20.2). docs/design/pbf.md.
 TEST(Pbf, DISABLED_StillWaterMeetsTheRealTimeIssuesTargets) {
   SceneSetup scene = StillWater();
   auto solver = test::CreateOrFail(scene);
