@@ -468,6 +468,7 @@ Status ApplyAutoQuality(const Options& options, bool wanted, const StateFile* st
   if (Status s = ChooseQuality(*setup, config, 1.0, 1.0, &choice); !s) return Status::Error(options.scenePath + ": " + s.message());
   setup->params.spacing = choice.spacing;
   setup->method = choice.method;
+  if (choice.pbfSubsteps > 0.0f) setup->params.pbfSubsteps = choice.pbfSubsteps;
   return Status::Ok();
 }
 

@@ -33,9 +33,54 @@ TEST(QualityTest, ChoiceIsMeasuredLoggedAndWithinTheAllowedRange) {
   SceneSetup chosen = scene;
   chosen.params.spacing = choice.spacing;
   EXPECT_EQ(choice.fluid, sim::CountParticles(chosen).fluid);
+  if (choice.method == sim::SolverMethod::kPbf) {
+    EXPECT_EQ(choice.pbfSubsteps, app::PbfSubstepsForSpacing(scene.params.pbfSubsteps, 0.01f, choice.spacing));
+  } else {
+    EXPECT_EQ(choice.pbfSubsteps, 0.0f);
+  }
   EXPECT_EQ(log.Count(std::string("quality auto: method ") + sim::SolverMethodName(choice.method) + ", spacing",
                       LogLevel::kInfo), 1)
       << log.All();
+}
+
+TEST(QualityTest, PbfSubstepsKeepTheScenesStepPerSpacing) {
+  // The fewest substeps with dt / h at most the scene's (3 at 1 cm).
+  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.01f), 3.0f);
+  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.015f), 2.0f);  // 3 x 2/3 exactly, despite rounding
+  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.0177f), 2.0f);
+  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.03f), 1.0f);
+  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.1f), 1.0f);
+  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.005f), 6.0f);
+  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.001f), 16.0f);  // pbf_substeps' largest
+}
+
+/// PBF still water (a 20 cm column in a closed 0.2 x 0.3 x 0.1 m box) at `spacing` and `substeps`, 1 s
+/// from the lattice: its mean compression at the end.
+float PbfStillWaterCompression(float spacing, float substeps) {
+  SceneSetup s = TankScene({0, 0, 0}, {0.2f, 0.3f, 0.1f}, spacing);
+  s.method = sim::SolverMethod::kPbf;
+  s.openTop = false;
+  s.fluid.push_back(Block({0, 0, 0}, {0.2f, 0.2f, 0.1f}));
+  s.params.pbfSubsteps = substeps;
+  auto solver = CreateOrFail(s);
+  if (!solver) return -1.0f;
+  while (solver->Time() < 1.0 - 1e-9) {
+    if (!solver->Step().ok()) return -1.0f;
+  }
+  if (FirstNonFinite(DownloadFluid(*solver)) != "") return -1.0f;
+  return solver->LastStep().meanDensityError;
+}
+
+TEST(QualityTest, FewerPbfSubstepsAtACoarserSpacingKeepTheScenesCompression) {
+  // PBF's rest compression goes as g D dt^2 / (N h^2): at the same dt / h a coarser lattice holds the
+  // same column no more compressed, and stays stable (2 substeps at 1.5 cm, 1 at 3 cm, against 3 at 1 cm).
+  const float reference = PbfStillWaterCompression(0.01f, 3.0f);
+  ASSERT_GT(reference, 0.0f);
+  for (const float h : {0.015f, 0.03f}) {
+    const float c = PbfStillWaterCompression(h, app::PbfSubstepsForSpacing(3.0f, 0.01f, h));
+    ASSERT_GE(c, 0.0f) << "unstable at " << h << " m";
+    EXPECT_LE(c, reference) << "at " << h << " m";
+  }
 }
 
 }  // namespace
