@@ -71,6 +71,16 @@ inline SceneSetup SmallDamBreak(float spacing = 0.01f) {
   return s;
 }
 
+/// tank_rest under PBF: a 0.2 m column filling a closed 0.2 x 0.3 x 0.1 m box (20 x 20 x 10 particles at
+/// 1 cm) at rest.
+inline SceneSetup PbfStillWater(float spacing = 0.01f) {
+  SceneSetup s = TankScene({0, 0, 0}, {0.2f, 0.3f, 0.1f}, spacing);
+  s.method = sim::SolverMethod::kPbf;
+  s.openTop = false;
+  s.fluid.push_back(Block({0, 0, 0}, {0.2f, 0.2f, 0.1f}));
+  return s;
+}
+
 /// The backend named by the argument --sphxr-device=NAME, else by SPHXR_TEST_DEVICE; empty: none named.
 /// ctest passes the argument (tests/CMakeLists.txt): gtest_discover_tests (CMake 3.25) splits a list in
 /// PROPERTIES, so a discovered test's ENVIRONMENT cannot hold a second variable beside OMP_WAIT_POLICY.

@@ -54,13 +54,10 @@ TEST(QualityTest, PbfSubstepsKeepTheScenesStepPerSpacing) {
   EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.001f), 16.0f);  // pbf_substeps' largest
 }
 
-/// PBF still water (a 20 cm column in a closed 0.2 x 0.3 x 0.1 m box) at `spacing` and `substeps`, 1 s
-/// from the lattice: its mean compression at the end.
+/// PBF still water (PbfStillWater) at `spacing` and `substeps`, 1 s from the lattice: its mean
+/// compression at the end.
 float PbfStillWaterCompression(float spacing, float substeps) {
-  SceneSetup s = TankScene({0, 0, 0}, {0.2f, 0.3f, 0.1f}, spacing);
-  s.method = sim::SolverMethod::kPbf;
-  s.openTop = false;
-  s.fluid.push_back(Block({0, 0, 0}, {0.2f, 0.2f, 0.1f}));
+  SceneSetup s = PbfStillWater(spacing);
   s.params.pbfSubsteps = substeps;
   auto solver = CreateOrFail(s);
   if (!solver) return -1.0f;
