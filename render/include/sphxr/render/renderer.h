@@ -3,15 +3,15 @@
 // matrices, a target framebuffer and a viewport; the renderer does not know whether views come from a
 // headset (one per eye) or a desktop camera (DESIGN.md, "Shape" and "One frame").
 //
-// Per frame:  Draw(scene, views)
-//   1 upload     surface mesh, particles (once per frame, shared by all views)
-//   per view:
-//   2 sky        full-screen triangle, gradient + sun (the same function the water reflects)
-//   3 floor      checkered plane under the tank; obstacles, paddles (lit boxes/meshes); tank edges
-//   4 thickness  water thickness along each pixel's ray into an R16F texture (additive pass)
-//   5 water      surface mesh (or particles as spheres when there is no mesh): Fresnel-weighted sky
-//                reflection, Beer-Lambert transmission over the thickness, specular highlight
-//      or particles   point sprites coloured by speed, density error or reuse activity
+// Draw(scene, views) is a list of passes (render/src/passes/, docs/dev/rendering.md):
+//   upload          surface mesh, particles, diffuse particles, solids (once per frame)
+//   shadow          the sun's depth maps of the opaque casters and of the water (once per frame)
+//   per view, into the frame targets (the opaque scene kept as textures):
+//     sky, opaque (ground, table, obstacles, paddles; particles in particle mode), glass (far panes),
+//     bubbles, water thickness
+//   per view, into the view's framebuffer:
+//     present (the opaque scene's colour and depth), water (refraction of the scene behind, Fresnel
+//     reflection, Beer-Lambert absorption; writes its depth), glass (near panes), spray and foam
 #include <glm/glm.hpp>
 
 #include <cstdint>
@@ -65,6 +65,15 @@ struct ParticleView {
 };
 
 enum class RenderMode { kWater, kParticles };
+
+/// Spray, foam and bubbles (sphxr/sim/diffuse.h): positions with w = remaining lifetime (s), velocities
+/// with w = the kind (0 spray, 1 foam, 2 bubble). Null or empty: none drawn.
+struct DiffuseView {
+  const sim::Vec4* position = nullptr;
+  const sim::Vec4* velocity = nullptr;
+  int count = 0;
+  float radius = 0.004f;  // m, a foam sprite's half width
+};
 const char* RenderModeName(RenderMode m);
 
 /// A paddle or hand: a mesh drawn with a model matrix (or a unit cube when the mesh is empty).
@@ -87,12 +96,33 @@ struct FrameScene {
   sim::Aabb tank{{0, 0, 0}, {1, 1, 1}};
   bool drawTank = true;
   std::vector<sim::Aabb> obstacles;
-  std::vector<SolidMesh> solids;  // paddles, hands
+  std::vector<SolidMesh> solids;  // paddles, controllers
+  DiffuseView diffuse;
+  /// The place: the ground to the horizon and, when tableHeight > 0, a table under the tank (its top
+  /// at the tank's floor, the ground tableHeight below it).
   bool drawFloor = true;
-  /// Multiplies RendererConfig::waterAbsorption. Water a few centimetres deep is nearly clear; small
-  /// tabletop scenes raise this so that their water still reads as a body of water (MakeFrameScene).
-  float absorptionScale = 1.0f;
+  float tableHeight = 0.85f;  // m; 0: the tank stands on the ground
+  /// Multiplies RendererConfig::waterAbsorption (pure water's). Water a few centimetres deep is clear,
+  /// so a picture of it raises this: app::MakeFrameScene sets it from the tank's size so that its
+  /// smallest extent keeps 9 % of the red light; the default makes a decimetre read as water.
+  float absorptionScale = 15.0f;
 };
+
+/// What the renderer spends per frame: `--quality auto` lowers it with the simulation.
+enum class RenderQuality { kLow, kMedium, kHigh };
+const char* RenderQualityName(RenderQuality q);
+bool ParseRenderQuality(const std::string& text, RenderQuality* out);
+struct RenderSettings {
+  int shadowMapSize = 2048;  // texels per side of the sun's depth maps; 0: no shadows
+  bool diffuse = true;       // spray, foam and bubbles drawn
+};
+RenderSettings SettingsFor(RenderQuality q);
+
+/// Pure water's absorption (1/m) at the dominant wavelengths of the sRGB primaries (612, 549, 465 nm),
+/// from Pope & Fry, "Absorption spectrum (380-700 nm) of pure water", Applied Optics 36(33), 1997.
+inline const glm::vec3 kPureWaterAbsorption{0.26f, 0.057f, 0.013f};
+/// Water's index of refraction (visible light, 20 degrees C) and its Fresnel reflectance at normal incidence.
+inline constexpr float kWaterIor = 1.333f;
 
 /// Called for every GL debug message of type error (and for GL errors found by glGetError).
 using GlErrorHandler = std::function<void(const std::string& message)>;
@@ -108,14 +138,26 @@ struct RendererConfig {
   /// What happens on a GL error: null = log it and abort() (debug builds fail loudly).
   GlErrorHandler onError;
   glm::vec3 sunDirection = glm::normalize(glm::vec3(0.35f, 0.8f, 0.45f));  // towards the sun
-  glm::vec3 waterAbsorption{4.0f, 1.2f, 0.8f};  // 1/m, Beer-Lambert coefficients (red goes first)
+  glm::vec3 waterAbsorption = kPureWaterAbsorption;  // 1/m, Beer-Lambert coefficients (red goes first)
   glm::vec3 waterColor{0.05f, 0.32f, 0.45f};    // colour the absorbed light scatters back (inscatter)
+  float waterIor = kWaterIor;                   // 1: no refraction, and F0 = 0
+  RenderQuality quality = RenderQuality::kHigh;
 };
 
-/// Draw timings of the last frame (CPU side, with a glFinish at the end only when asked).
+/// One pass's GPU time (GL_TIME_ELAPSED), summed over the views of a frame.
+struct PassTime {
+  std::string name;
+  double gpuMs = 0.0;
+};
+
+/// Draw timings: CPU side of the last frame; GPU time per pass of the latest frame whose queries have
+/// completed (a frame or two late: reading them never waits for the GPU).
 struct DrawStats {
   double uploadMs = 0.0;
   double drawMs = 0.0;
+  std::vector<PassTime> passes;  // in drawing order
+  int views = 0;                 // views drawn in the frame the pass times belong to
+  double GpuMs() const;          // the sum of the passes
 };
 
 class Renderer {
@@ -132,6 +174,8 @@ class Renderer {
   /// GL errors seen by the debug callback since creation.
   int ErrorCount() const;
   const RendererConfig& Config() const { return m_config; }
+  /// Changes what the renderer spends from the next frame on (the panel, --quality auto).
+  void SetQuality(RenderQuality quality);
 
  private:
   struct Impl;
