@@ -79,9 +79,13 @@ render::FrameScene MakeFrameScene(const sim::SceneSetup& scene, const sim::HostF
   f.particles.radius = (mode == render::RenderMode::kWater ? 0.75f : 0.5f) * scene.params.spacing;
   f.particles.restDensity = scene.params.restDensity;
   const float height = std::max(scene.tank.max.y - scene.tank.min.y, 1e-3f);
-  // Across the tank's smallest extent, water absorbs most of the red light (exp(-0.6 * 4) = 9 % left).
+  // Across the tank's smallest extent, water absorbs most of the red light (exp(-2.4) = 9 % left); real
+  // water does so over 9 m, so a tabletop tank is drawn as if its water were that deep.
   const float smallest = std::min({scene.tank.max.x - scene.tank.min.x, height, scene.tank.max.z - scene.tank.min.z});
-  f.absorptionScale = std::max(1.0f, 0.6f / std::max(smallest, 1e-3f));
+  f.absorptionScale = std::max(1.0f, 2.4f / (render::kPureWaterAbsorption.r * std::max(smallest, 1e-3f)));
+  // A tabletop tank stands on a table; a tank taller than a person stands on the ground.
+  f.tableHeight = std::max({scene.tank.max.x - scene.tank.min.x, height, scene.tank.max.z - scene.tank.min.z}) <= 1.5f
+                      ? 0.85f : 0.0f;
   f.particles.speedScale = std::sqrt(2.0f * 9.81f * height);  // the free-fall speed over the tank's height
   return f;
 }

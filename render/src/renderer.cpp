@@ -176,6 +176,7 @@ void Renderer::Draw(const FrameScene& scene, std::span<const View> views) {
 
   m.timer.BeginFrame();
   glEnable(GL_SCISSOR_TEST);
+  glEnable(GL_PROGRAM_POINT_SIZE);  // sprites size themselves
   int drawn = 0;
   for (const View& v : views) {
     if (v.width <= 0 || v.height <= 0) continue;

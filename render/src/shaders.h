@@ -23,7 +23,7 @@ layout(std140, binding = 0) uniform ViewBlock {
   vec4 uParticle;       // x: radius (m), y: pixels per (m / eye depth) for point sizes, z: diffuse radius (m)
   vec4 uOptics;         // x: Fresnel F0 of water, y: index of refraction, z: shadows on (1/0), w: shadow depth range (m)
   vec4 uTarget;         // xy: size in texels of the frame targets (the views use their lower-left corner)
-  vec4 uTankMin;        // xyz: the tank's lower corner
+  vec4 uTankMin;        // xyz: the tank's lower corner, w: the absorption's scene scale
   vec4 uTankMax;        // xyz: the tank's upper corner
   vec4 uPlace;          // x: ground height, y: tile size (m), z: fade distance (m), w: table top height
 };
@@ -82,13 +82,14 @@ vec3 SunVisibility(vec3 world, vec3 n) {
   lit += texture(uShadowMap, vec3(p.xy + vec2(-0.75, 0.75) * texel, p.z - bias));
   lit += texture(uShadowMap, vec3(p.xy + vec2(0.75, 0.75) * texel, p.z - bias));
   vec3 light = vec3(0.25 * lit);
-  // Light that crossed water to reach a receiver in the tank (light leaving through the glass walls is
-  // refocused into caustics, which are not drawn: receivers outside the tank see no water shadow).
+  // Light that crossed water to reach a receiver in the tank: real water's absorption (the scene scale
+  // is for the colour seen along the eye's path); light leaving through the glass walls is refocused
+  // into caustics, which are not drawn, so receivers outside the tank see no water shadow.
   bool inTank = all(greaterThanEqual(world, uTankMin.xyz - 1e-4)) && all(lessThanEqual(world, uTankMax.xyz + 1e-4));
   if (inTank) {
     float waterTop = texture(uWaterShadowMap, p.xy).r;
     float below = max(p.z - waterTop, 0.0) * uOptics.w;
-    light *= exp(-uAbsorption.rgb * below);
+    light *= exp(-uAbsorption.rgb / uTankMin.w * below);
   }
   return light;
 }
@@ -148,15 +149,19 @@ float Hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453);
 void main() {
   vec3 n = normalize(vNormal);
   vec3 base = uColor.rgb;
-  if (uMaterial == 1) {
+  if (uMaterial == 1) {  // stone tiles; the grout fades with distance before it can alias
     vec2 cell = floor(vWorld.xz / uPlace.y);
     vec2 f = fract(vWorld.xz / uPlace.y);
-    float grout = step(0.03, f.x) * step(0.03, f.y);
-    base *= mix(0.62, 0.9 + 0.18 * Hash(cell), grout);
-  } else if (uMaterial == 2) {
-    float along = abs(n.y) > 0.5 ? vWorld.x : vWorld.y;
-    float grain = 0.5 + 0.5 * sin(140.0 * (along + 0.02 * sin(37.0 * vWorld.z + 11.0 * vWorld.x)));
-    base *= 0.86 + 0.14 * grain;
+    vec2 width = fwidth(vWorld.xz / uPlace.y);
+    float lineWidth = 0.02;
+    vec2 edge = smoothstep(vec2(lineWidth) - width, vec2(lineWidth) + width, min(f, 1.0 - f));
+    float grout = mix(1.0, edge.x * edge.y, clamp(1.0 - 4.0 * max(width.x, width.y), 0.0, 1.0));
+    base *= mix(0.7, 0.92 + 0.12 * Hash(cell), grout);
+  } else if (uMaterial == 2) {  // wood: fine grain along the table's length
+    float along = abs(n.y) > 0.5 ? vWorld.z : vWorld.y;
+    float warp = 0.004 * sin(23.0 * vWorld.x + 3.0 * vWorld.z) + 0.002 * sin(71.0 * vWorld.x);
+    float grain = 0.5 + 0.5 * sin(900.0 * (along + warp));
+    base *= 0.9 + 0.1 * grain * (1.0 - clamp(200.0 * fwidth(along), 0.0, 1.0));
   }
   float diffuse = max(dot(n, uSun.xyz), 0.0);
   vec3 ambient = 0.45 * SkyColor(n);

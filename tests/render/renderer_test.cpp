@@ -215,7 +215,6 @@ TEST_F(RendererTest, WaterFromParticlesIsWaterColouredWhereTheFluidIsAndNowhereE
         ++inside;
         // Water: blue-green, with the red absorbed, and visibly not the sky behind it.
         insideWater += (c.b > c.r + 0.08f && c.g > c.r && MaxDiff(c, render::SkyColor(ray, sun)) > 0.05f);
-        if (!(c.b > c.r + 0.08f && c.g > c.r && MaxDiff(c, render::SkyColor(ray, sun)) > 0.05f) && (x % 8 == 0)) printf("DBG %d %d %f %f %f sky %f %f %f\n", x, y, c.r, c.g, c.b, render::SkyColor(ray, sun).r, render::SkyColor(ray, sun).g, render::SkyColor(ray, sun).b);
       } else if (hits == 0) {
         ++outside;
         outsideNotSky += MaxDiff(c, render::SkyColor(ray, sun)) > 3.0f / 255.0f;

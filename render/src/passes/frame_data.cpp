@@ -180,7 +180,7 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
     SolidDraw ground;
     ground.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(centre.x, groundY, centre.z)),
                               glm::vec3(extent, 1.0f, extent));
-    ground.color = glm::vec3(0.78f, 0.76f, 0.72f);
+    ground.color = glm::vec3(0.80f, 0.76f, 0.68f);
     ground.material = Material::kGround;
     ground.buffer = quad.id;
     ground.count = 6;
@@ -194,7 +194,7 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
       auto box = [&](glm::vec3 a, glm::vec3 b) {
         SolidDraw d;
         d.model = BoxModel(a, b);
-        d.color = glm::vec3(0.58f, 0.38f, 0.22f);
+        d.color = glm::vec3(0.62f, 0.42f, 0.25f);
         d.material = Material::kWood;
         d.buffer = cube.id;
         d.count = cubeVertices;
@@ -307,7 +307,7 @@ void FrameData::BindView(const FrameScene& scene, const View& v, const RendererC
   const float f0 = ((ior - 1.0f) / (ior + 1.0f)) * ((ior - 1.0f) / (ior + 1.0f));
   u.optics = glm::vec4(f0, ior, shadows ? 1.0f : 0.0f, shadowRange);
   u.target = glm::vec4(targetSize, 0.0f, 0.0f);
-  u.tankMin = glm::vec4(lo, 0.0f);
+  u.tankMin = glm::vec4(lo, std::max(scene.absorptionScale, 1e-6f));
   u.tankMax = glm::vec4(hi, 0.0f);
   u.place = glm::vec4(groundY, checker, fade, tableTop);
   glNamedBufferSubData(uniforms.id, 0, sizeof(u), &u);

@@ -92,7 +92,6 @@ void OpaquePass::Run(const PassContext& ctx) const {
     glDrawArrays(GL_TRIANGLES, d.first, d.count);
   }
   if (ctx.scene.mode == RenderMode::kParticles && data.particleCount > 0) {
-    glEnable(GL_PROGRAM_POINT_SIZE);
     glUseProgram(m_particles.id);
     glBindVertexArray(data.spriteVao);
     glDrawArrays(GL_POINTS, 0, data.particleCount);
