@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake ninja-build pkg-config libthrust-dev nlohmann-json3-dev libgtest-dev libgmock-dev
           python3 python3-matplotlib libepoxy-dev libglm-dev libglfw3-dev libimgui-dev libstb-dev libegl-dev
-          libegl-mesa0 libgl1-mesa-dri xvfb xauth
+          libegl-mesa0 libgl1-mesa-dri xvfb xauth glslang-tools
           libopenxr-dev libopenxr-loader1 openxr-layer-corevalidation libgl-dev libx11-dev libpng-dev
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-distributed python3-dask python3-pytest
           clang-14 libclang-rt-14-dev libomp-14-dev)  # the last three: scripts/sanitize.sh and fuzz.sh

@@ -130,6 +130,14 @@ OffscreenTarget::~OffscreenTarget() {
 
 Image OffscreenTarget::Read() const { return ReadPixels(m_fbo, 0, 0, m_width, m_height); }
 
+std::vector<float> OffscreenTarget::ReadDepth() const {
+  std::vector<float> depth(static_cast<size_t>(m_width) * m_height);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, m_fbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, m_width, m_height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+  return depth;
+}
+
 Image ReadPixels(uint32_t framebuffer, int x, int y, int width, int height) {
   Image image;
   image.width = width;

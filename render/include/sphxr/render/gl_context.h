@@ -45,6 +45,8 @@ class OffscreenTarget {
   int Height() const { return m_height; }
   /// Reads the colour attachment (rows bottom-up).
   Image Read() const;
+  /// Reads the depth attachment as window depths in [0, 1] (rows bottom-up).
+  std::vector<float> ReadDepth() const;
 
  private:
   OffscreenTarget() = default;

@@ -139,7 +139,10 @@ struct RendererConfig {
   GlErrorHandler onError;
   glm::vec3 sunDirection = glm::normalize(glm::vec3(0.35f, 0.8f, 0.45f));  // towards the sun
   glm::vec3 waterAbsorption = kPureWaterAbsorption;  // 1/m, Beer-Lambert coefficients (red goes first)
-  glm::vec3 waterColor{0.05f, 0.32f, 0.45f};    // colour the absorbed light scatters back (inscatter)
+  /// The light the water body scatters back per unit of light it stops: pure water's single-scattering
+  /// albedo b_b / (a + b_b), with b_b half of Morel's (1974) scattering 0.00288 (lambda/500 nm)^-4.32 /m
+  /// and a as above, at the same wavelengths. Deep clear water is dark blue, never a cyan slab.
+  glm::vec3 waterColor{0.0023f, 0.017f, 0.13f};
   float waterIor = kWaterIor;                   // 1: no refraction, and F0 = 0
   RenderQuality quality = RenderQuality::kHigh;
 };
