@@ -189,6 +189,90 @@ TEST(XrApp, WaterInBothEyesWithParallaxAndACleanExit) {
   EXPECT_NEAR(wl.cy, wr.cy, 2.0);
 }
 
+/// Distance along the view axis (eye-space -z) of a play-space point from one eye of the scripted head.
+double EyeDepth(int eye, const double p[3]) {
+  const double ex = kHeadX + (eye == 0 ? -0.5 : 0.5) * kIpd;
+  const double d[3] = {p[0] - ex, p[1] - kHeadY, p[2] - kHeadZ};
+  const double c = std::cos(-kPitch), s = std::sin(-kPitch);
+  return -(s * d[1] + c * d[2]);
+}
+
+TEST(XrApp, EachEyesDepthReachesTheCompositorWithTheWaterSurfaceInIt) {
+  SimHeadset headset("app_depth");
+  SetUpHeadset(headset);
+  const auto frames = headset.dir / "frames";
+  std::filesystem::create_directories(frames);
+  headset.env.Set("SPHXR_SIM_XR_CAPTURE_DIR", frames.string());
+  headset.env.Set("SPHXR_SIM_XR_CAPTURE_EVERY", "10");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 20" + kCommon,
+                            headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  ExpectNoValidationErrors(headset);
+  // The runtime's record: every captured frame has a depth layer for both eyes, with the app's planes.
+  std::ifstream log(frames / "depth_layers.txt");
+  ASSERT_TRUE(log) << "the simulated headset received no depth layer; " << r.out;
+  std::string line;
+  int layers[2] = {0, 0}, missing = 0;
+  double nearZ = 0, farZ = 0;
+  while (std::getline(log, line)) {
+    std::istringstream ss(line);
+    std::string frame, eye, depth, size, nearWord, farWord;
+    long index = 0;
+    ss >> frame >> index >> eye >> depth >> size;
+    if (size == "none") {
+      ++missing;
+      continue;
+    }
+    ss >> nearWord >> nearZ >> farWord >> farZ;
+    ++layers[eye == "left" ? 0 : 1];
+  }
+  int captured = 0;
+  for (const auto& e : std::filesystem::directory_iterator(frames)) captured += e.path().string().ends_with("_left.png");
+  EXPECT_EQ(missing, 0);
+  EXPECT_GE(captured, 1);
+  EXPECT_EQ(layers[0], captured) << "every captured frame carries the left eye's depth";
+  EXPECT_EQ(layers[1], captured);
+  ASSERT_GT(farZ, nearZ);
+  ASSERT_GT(nearZ, 0.0);
+
+  // The depth image: at the water's pixels, the distance it holds lies on the fluid block (grown by the
+  // surface's half spacing, 5 mm): the water wrote its own depth, not the floor's behind it.
+  const auto [left, right] = LastPair(frames);
+  for (int eye = 0; eye < 2; ++eye) {
+    const auto colour = eye == 0 ? left : right;
+    std::string raw = colour.string();
+    raw.replace(raw.find(".png"), 4, "_depth.f32");
+    std::ifstream in(raw, std::ios::binary);
+    ASSERT_TRUE(in) << raw;
+    std::vector<float> depth(size_t(kEyeW) * kEyeH);
+    in.read(reinterpret_cast<char*>(depth.data()), std::streamsize(depth.size() * sizeof(float)));
+    ASSERT_TRUE(in);
+    int width = 0, height = 0;
+    std::vector<uint8_t> px;
+    ASSERT_TRUE(ReadPng(colour, &width, &height, &px));
+    double lo = 1e9, hi = -1e9;
+    for (int i = 0; i < 8; ++i) {
+      const double p[3] = {(i & 1) ? kWaterMax[0] + 0.005 : kWaterMin[0] - 0.005,
+                           (i & 2) ? kWaterMax[1] + 0.005 : kWaterMin[1] - 0.005,
+                           (i & 4) ? kWaterMax[2] + 0.005 : kWaterMin[2] - 0.005};
+      lo = std::min(lo, EyeDepth(eye, p)), hi = std::max(hi, EyeDepth(eye, p));
+    }
+    int water = 0, off = 0;
+    for (int y = 0; y < kEyeH; ++y) {
+      for (int x = 0; x < kEyeW; ++x) {
+        if (!IsWater(&px[(size_t(y) * kEyeW + x) * 4])) continue;
+        const double ndc = 2.0 * depth[size_t(y) * kEyeW + x] - 1.0;
+        const double distance = 2.0 * nearZ * farZ / (farZ + nearZ - ndc * (farZ - nearZ));
+        ++water;
+        off += distance < lo - 1e-3 || distance > hi + 1e-3;
+      }
+    }
+    std::printf("eye %d: %d water pixels, %d with a depth off the block (%.3f to %.3f m)\n", eye, water, off, lo, hi);
+    EXPECT_GT(water, 100);
+    EXPECT_LE(off, water / 50) << "eye " << eye;
+  }
+}
+
 /// The haptic requests of the simulated headset's log for one hand: (amplitude, stop) per line.
 std::vector<float> HapticAmplitudes(const std::filesystem::path& log, const std::string& hand) {
   std::vector<float> out;

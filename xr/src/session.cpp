@@ -171,5 +171,6 @@ int Session::eyeWidth() const { return m_impl->eyes[0].width; }
 int Session::eyeHeight() const { return m_impl->eyes[0].height; }
 int64_t Session::colorFormat() const { return m_impl->colorFormat; }
 int64_t Session::depthFormat() const { return m_impl->depthFormat; }
+bool Session::submitsDepth() const { return m_impl->depthLayerOffered && m_impl->eyes[0].depth != XR_NULL_HANDLE; }
 
 }  // namespace sphxr::xr

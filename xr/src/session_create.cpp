@@ -48,8 +48,18 @@ Status Session::Impl::CreateInstance() {
   ci.applicationInfo.applicationVersion = 1;
   std::snprintf(ci.applicationInfo.engineName, XR_MAX_ENGINE_NAME_SIZE, "sphxr");
   ci.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
-  const char* extNames[] = {XR_KHR_OPENGL_ENABLE_EXTENSION_NAME};
-  ci.enabledExtensionCount = 1;
+  // Each view's depth goes to the compositor with its colour (XR_KHR_composition_layer_depth) when the
+  // runtime offers it: reprojection then moves near things (the water, the paddles) by their own depth.
+  uint32_t extCount = 0;
+  SPHXR_XR_CHECK(xrEnumerateInstanceExtensionProperties(nullptr, 0, &extCount, nullptr));
+  std::vector<XrExtensionProperties> offered(extCount, {XR_TYPE_EXTENSION_PROPERTIES});
+  SPHXR_XR_CHECK(xrEnumerateInstanceExtensionProperties(nullptr, extCount, &extCount, offered.data()));
+  depthLayerOffered = options.wantDepth &&
+                      std::any_of(offered.begin(), offered.end(), [](const XrExtensionProperties& e) {
+                        return std::strcmp(e.extensionName, XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME) == 0;
+                      });
+  const char* extNames[] = {XR_KHR_OPENGL_ENABLE_EXTENSION_NAME, XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME};
+  ci.enabledExtensionCount = depthLayerOffered ? 2 : 1;
   ci.enabledExtensionNames = extNames;
   r = xrCreateInstance(&ci, &instance);
   if (r == XR_ERROR_RUNTIME_UNAVAILABLE || r == XR_ERROR_RUNTIME_FAILURE || r == XR_ERROR_INITIALIZATION_FAILED)

@@ -82,6 +82,18 @@ Status Session::Impl::RenderEyes(const FrameInfo& info, const RenderEyeFn& rende
     lv.subImage.swapchain = eye.color;
     lv.subImage.imageRect = {{0, 0}, {eye.width, eye.height}};
     lv.subImage.imageArrayIndex = 0;
+    if (depthLayerOffered && eye.depth) {
+      XrCompositionLayerDepthInfoKHR& d = depthInfos[size_t(e)];
+      d = {XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR};
+      d.subImage.swapchain = eye.depth;
+      d.subImage.imageRect = lv.subImage.imageRect;
+      d.subImage.imageArrayIndex = 0;
+      d.minDepth = 0.0f;
+      d.maxDepth = 1.0f;
+      d.nearZ = options.nearZ;
+      d.farZ = options.farZ;
+      lv.next = &d;
+    }
   }
   *rendered = true;
   return Status::Ok();

@@ -51,6 +51,8 @@ struct Session::Impl {
     int width = 0, height = 0;
   };
   std::array<Eye, 2> eyes;
+  bool depthLayerOffered = false;  // XR_KHR_composition_layer_depth enabled on the instance
+  std::array<XrCompositionLayerDepthInfoKHR, 2> depthInfos{};  // chained to the layer's views until xrEndFrame
   int64_t colorFormat = 0, depthFormat = 0;
   SessionState state = SessionState::kUnknown;
   bool running = false, lost = false, exited = false;

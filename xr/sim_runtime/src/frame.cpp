@@ -53,6 +53,7 @@ XRAPI_ATTR XrResult XRAPI_CALL EndFrame(XrSession handle, const XrFrameEndInfo* 
     return XR_ERROR_ENVIRONMENT_BLEND_MODE_UNSUPPORTED;
   if (info->layerCount > XR_MIN_COMPOSITION_LAYERS_SUPPORTED) return XR_ERROR_LAYER_LIMIT_EXCEEDED;
   const XrCompositionLayerProjection* projection = nullptr;
+  bool depthViews[2] = {false, false};
   for (uint32_t i = 0; i < info->layerCount; ++i) {
     const XrCompositionLayerBaseHeader* layer = info->layers[i];
     if (!layer) return XR_ERROR_LAYER_INVALID;
@@ -69,11 +70,16 @@ XRAPI_ATTR XrResult XRAPI_CALL EndFrame(XrSession handle, const XrFrameEndInfo* 
           uint32_t(r.offset.x + r.extent.width) > sc->width || uint32_t(r.offset.y + r.extent.height) > sc->height)
         return XR_ERROR_SWAPCHAIN_RECT_INVALID;
     }
+    if (XrResult d = CheckDepthLayers(s, *projection, depthViews); d != XR_SUCCESS) return d;
   }
   s->frameBegun = false;
   ++s->framesEnded;
   const Config& c = s->instance->config;
-  if (projection && !c.captureDir.empty() && (s->framesEnded - 1) % c.captureEvery == 0) CaptureFrame(s, *projection);
+  for (int v = 0; v < 2; ++v) s->depthLayersReceived[v] += depthViews[v];
+  if (projection && !c.captureDir.empty() && (s->framesEnded - 1) % c.captureEvery == 0) {
+    CaptureFrame(s, *projection);
+    RecordDepthLayers(s, *projection, depthViews);
+  }
   if (s->state == XR_SESSION_STATE_SYNCHRONIZED && !s->exitRequested) {
     PushSessionState(s, XR_SESSION_STATE_VISIBLE);
     PushSessionState(s, XR_SESSION_STATE_FOCUSED);

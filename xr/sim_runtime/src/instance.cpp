@@ -70,9 +70,14 @@ void PushEvent(Instance* inst, const void* event, size_t size) {
 XRAPI_ATTR XrResult XRAPI_CALL EnumerateInstanceExtensionProperties(const char* layerName, uint32_t capacity,
                                                                     uint32_t* count, XrExtensionProperties* props) {
   if (layerName) return XR_ERROR_API_LAYER_NOT_PRESENT;
-  return TwoCall(capacity, count, 1, [&](uint32_t i) {
-    std::strncpy(props[i].extensionName, XR_KHR_OPENGL_ENABLE_EXTENSION_NAME, XR_MAX_EXTENSION_NAME_SIZE);
-    props[i].extensionVersion = XR_KHR_opengl_enable_SPEC_VERSION;
+  return TwoCall(capacity, count, 2, [&](uint32_t i) {
+    if (i == 0) {
+      std::strncpy(props[i].extensionName, XR_KHR_OPENGL_ENABLE_EXTENSION_NAME, XR_MAX_EXTENSION_NAME_SIZE);
+      props[i].extensionVersion = XR_KHR_opengl_enable_SPEC_VERSION;
+    } else {
+      std::strncpy(props[i].extensionName, XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME, XR_MAX_EXTENSION_NAME_SIZE);
+      props[i].extensionVersion = XR_KHR_composition_layer_depth_SPEC_VERSION;
+    }
   });
 }
 
@@ -82,11 +87,17 @@ XRAPI_ATTR XrResult XRAPI_CALL CreateInstance(const XrInstanceCreateInfo* info, 
   if (XR_VERSION_MAJOR(info->applicationInfo.apiVersion) != 1 ||
       XR_VERSION_MINOR(info->applicationInfo.apiVersion) != 0)
     return XR_ERROR_API_VERSION_UNSUPPORTED;
-  for (uint32_t i = 0; i < info->enabledExtensionCount; ++i)
-    if (std::strcmp(info->enabledExtensionNames[i], XR_KHR_OPENGL_ENABLE_EXTENSION_NAME) != 0)
+  bool depthLayers = false;
+  for (uint32_t i = 0; i < info->enabledExtensionCount; ++i) {
+    if (std::strcmp(info->enabledExtensionNames[i], XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME) == 0) {
+      depthLayers = true;
+    } else if (std::strcmp(info->enabledExtensionNames[i], XR_KHR_OPENGL_ENABLE_EXTENSION_NAME) != 0) {
       return XR_ERROR_EXTENSION_NOT_PRESENT;
+    }
+  }
   if (g_instance) return XR_ERROR_LIMIT_REACHED;
   auto inst = std::make_unique<Instance>();
+  inst->depthLayersEnabled = depthLayers;
   std::string error;
   if (ReadConfig(&inst->config, &error) != XR_SUCCESS) {
     std::fprintf(stderr, "sphxr simulated headset: %s\n", error.c_str());

@@ -72,6 +72,7 @@ struct Instance {
   std::vector<std::unique_ptr<ActionSet>> actionSets;
   // Suggested bindings: profile path -> (action, binding path).
   std::map<XrPath, std::vector<std::pair<Action*, XrPath>>> suggested;
+  bool depthLayersEnabled = false;  // the application enabled XR_KHR_composition_layer_depth
   bool graphicsRequirementsQueried = false;
   bool systemQueried = false;
   bool lost = false;
@@ -126,6 +127,7 @@ struct Session {
   std::map<std::pair<Action*, XrPath>, ActionStateCache> actionStates;
   std::vector<std::unique_ptr<Space>> spaces;
   std::vector<std::unique_ptr<Swapchain>> swapchains;
+  long depthLayersReceived[2] = {0, 0};  // frames whose projection view carried a depth layer, per eye
 };
 
 inline constexpr XrSystemId kSystemId = 1;
@@ -139,6 +141,13 @@ void PushEvent(Instance* inst, const void* event, size_t size);
 void PushSessionState(Session* s, XrSessionState state);
 /// Walks a running session down to STOPPING (through VISIBLE and SYNCHRONIZED).
 void Stop(Session* s);
+/// Checks the depth layers chained to a projection layer's views (XR_KHR_composition_layer_depth):
+/// XR_SUCCESS, or the error xrEndFrame answers. `views` gets, per view, whether one was there.
+XrResult CheckDepthLayers(Session* s, const XrCompositionLayerProjection& layer, bool views[2]);
+/// Appends one line per view to <capture dir>/depth_layers.txt: the frame, the eye, whether a depth
+/// layer came, its near/far planes and what its image holds (the nearest depth, the share of texels
+/// nearer than the far plane).
+void RecordDepthLayers(Session* s, const XrCompositionLayerProjection& layer, const bool views[2]);
 XrPath InternPath(Instance* inst, const std::string& path);
 const std::string* PathString(const Instance* inst, XrPath path);
 /// Seconds of the pose script at `time`.

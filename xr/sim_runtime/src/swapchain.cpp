@@ -1,9 +1,11 @@
 // Swapchains of the simulated headset: GL textures made in the application's context (the
 // application calls these with its context current, as XR_KHR_opengl_enable requires), and the
-// capture of submitted eye images to PNG.
+// capture of submitted eye images to PNG; the depth layers chained to them (XR_KHR_composition_layer_depth).
 #include <png.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "runtime.h"
@@ -209,6 +211,83 @@ void CaptureFrame(Session* s, const XrCompositionLayerProjection& layer) {
   }
   glPixelStorei(GL_PACK_ALIGNMENT, prevAlign);
   glBindTexture(GL_TEXTURE_2D, GLuint(prevTex));
+}
+
+}  // namespace sphxr::xr::simrt
+
+namespace sphxr::xr::simrt {
+
+XrResult CheckDepthLayers(Session* s, const XrCompositionLayerProjection& layer, bool views[2]) {
+  for (uint32_t v = 0; v < layer.viewCount && v < 2; ++v) {
+    views[v] = false;
+    for (auto* next = static_cast<const XrBaseInStructure*>(layer.views[v].next); next; next = next->next) {
+      if (next->type != XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR) continue;
+      if (!s->instance->depthLayersEnabled) return XR_ERROR_VALIDATION_FAILURE;  // extension not enabled
+      const auto* d = reinterpret_cast<const XrCompositionLayerDepthInfoKHR*>(next);
+      auto* sc = Check<Swapchain>(d->subImage.swapchain, Tag::kSwapchain);
+      if (!sc) return XR_ERROR_HANDLE_INVALID;
+      if (!IsDepth(sc->format) || sc->lastReleased < 0) return XR_ERROR_LAYER_INVALID;
+      const XrRect2Di& r = d->subImage.imageRect;
+      if (r.offset.x < 0 || r.offset.y < 0 || r.extent.width <= 0 || r.extent.height <= 0 ||
+          uint32_t(r.offset.x + r.extent.width) > sc->width || uint32_t(r.offset.y + r.extent.height) > sc->height)
+        return XR_ERROR_SWAPCHAIN_RECT_INVALID;
+      // The extension's valid usage: depths in [0, 1], min below max, finite distinct planes.
+      if (!(d->minDepth >= 0.0f && d->maxDepth <= 1.0f && d->minDepth < d->maxDepth) ||
+          !(std::isfinite(d->nearZ) && std::isfinite(d->farZ) && d->nearZ != d->farZ && d->nearZ >= 0 && d->farZ >= 0))
+        return XR_ERROR_VALIDATION_FAILURE;
+      views[v] = true;
+    }
+  }
+  return XR_SUCCESS;
+}
+
+void RecordDepthLayers(Session* s, const XrCompositionLayerProjection& layer, const bool views[2]) {
+  const std::string path = s->instance->config.captureDir + "/depth_layers.txt";
+  FILE* f = std::fopen(path.c_str(), "a");
+  if (!f) return;  // the colour capture already said the folder cannot be written
+  ContextScope scope(s);
+  GLint prevTex = 0, prevAlign = 0;
+  glGetIntegerv(GL_TEXTURE_BINDING_2D, &prevTex);
+  glGetIntegerv(GL_PACK_ALIGNMENT, &prevAlign);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  for (uint32_t v = 0; v < layer.viewCount && v < 2; ++v) {
+    const char* eye = v == 0 ? "left" : "right";
+    if (!views[v]) {
+      std::fprintf(f, "frame %ld %s depth none\n", s->framesEnded, eye);
+      continue;
+    }
+    const XrCompositionLayerDepthInfoKHR* d = nullptr;
+    for (auto* next = static_cast<const XrBaseInStructure*>(layer.views[v].next); next; next = next->next) {
+      if (next->type == XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR) d = reinterpret_cast<const XrCompositionLayerDepthInfoKHR*>(next);
+    }
+    auto* sc = reinterpret_cast<Swapchain*>(d->subImage.swapchain);
+    std::vector<float> depth(size_t(sc->width) * sc->height);
+    glBindTexture(GL_TEXTURE_2D, sc->textures[size_t(sc->lastReleased)]);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+    float nearest = 1.0f;
+    size_t covered = 0;
+    for (float z : depth) {
+      nearest = std::min(nearest, z);
+      covered += z < 1.0f;
+    }
+    // The depth image itself, as raw 32-bit floats with rows top-down like the colour PNG.
+    const XrRect2Di& r = d->subImage.imageRect;
+    char name[80];
+    std::snprintf(name, sizeof name, "/frame_%06ld_%s_depth.f32", s->framesEnded, eye);
+    if (FILE* raw = std::fopen((s->instance->config.captureDir + name).c_str(), "wb")) {
+      for (int y = 0; y < r.extent.height; ++y) {
+        const int row = r.offset.y + (r.extent.height - 1 - y);
+        std::fwrite(&depth[size_t(row) * sc->width + size_t(r.offset.x)], sizeof(float), size_t(r.extent.width), raw);
+      }
+      std::fclose(raw);
+    }
+    std::fprintf(f, "frame %ld %s depth %ux%u near %g far %g nearest %.6f covered %.4f\n", s->framesEnded, eye,
+                 unsigned(d->subImage.imageRect.extent.width), unsigned(d->subImage.imageRect.extent.height), d->nearZ,
+                 d->farZ, nearest, double(covered) / double(depth.size()));
+  }
+  glPixelStorei(GL_PACK_ALIGNMENT, prevAlign);
+  glBindTexture(GL_TEXTURE_2D, GLuint(prevTex));
+  std::fclose(f);
 }
 
 }  // namespace sphxr::xr::simrt

@@ -148,6 +148,8 @@ class Session {
   int eyeHeight() const;
   int64_t colorFormat() const;  // the GL internal format chosen
   int64_t depthFormat() const;  // 0 when the runtime offered no depth format
+  /// True when each view's depth goes to the compositor (XR_KHR_composition_layer_depth).
+  bool submitsDepth() const;
 
   struct Impl;
 
