@@ -155,10 +155,13 @@ void AppendPaddleSolids(const PaddlePose& paddle, std::vector<render::SolidMesh>
   const interaction::Quat& q = paddle.pose.orientation;
   const glm::mat4 body = glm::translate(glm::mat4(1.0f), G(paddle.pose.position)) *
                          glm::mat4_cast(glm::quat(q.w, q.x, q.y, q.z));
-  const glm::vec3 color = paddle.hand >= 0 ? glm::vec3(0.95f, 0.55f, 0.15f) : glm::vec3(0.85f, 0.62f, 0.35f);
+  // A paddle as a paddle: its boxes are the blade (light, a hand's paddle painted, a scripted one pale
+  // wood), its capsules the handle (a dark grip).
+  const glm::vec3 blade = paddle.hand >= 0 ? glm::vec3(0.95f, 0.55f, 0.15f) : glm::vec3(0.85f, 0.68f, 0.45f);
+  const glm::vec3 handle(0.16f, 0.16f, 0.18f);
   for (const sim::ShapePrimitive& s : paddle.shapes) {
     render::SolidMesh solid;
-    solid.color = color;
+    solid.color = s.kind == sim::ShapePrimitive::Kind::kBox ? blade : handle;
     if (s.kind == sim::ShapePrimitive::Kind::kBox) {
       solid.model = glm::scale(glm::translate(body, G(s.a)), 2.0f * G(s.b));  // the unit cube
       out->push_back(solid);
@@ -183,6 +186,34 @@ void AppendPaddleSolids(const PaddlePose& paddle, std::vector<render::SolidMesh>
       out->push_back(solid);
     }
   }
+}
+
+void AppendControllerSolids(const interaction::Pose& grip, std::vector<render::SolidMesh>* out) {
+  const interaction::Quat& q = grip.orientation;
+  const glm::mat4 hand = glm::translate(glm::mat4(1.0f), G(grip.position)) * glm::mat4_cast(glm::quat(q.w, q.x, q.y, q.z));
+  const glm::vec3 body(0.10f, 0.10f, 0.11f), ring(0.22f, 0.23f, 0.26f);
+  // The grip: a cylinder along the grip space's z axis (OpenXR: -z points out of the hand's front),
+  // 4 cm across, from 5 cm behind the palm to 6 cm in front of it, rounded at both ends.
+  const glm::mat4 alongZ = glm::rotate(glm::mat4(1.0f), kPi / 2, glm::vec3(1, 0, 0));  // the unit cylinder's y to z
+  render::SolidMesh grip_;
+  grip_.color = body;
+  grip_.mesh = UnitCylinder().View();
+  grip_.model = glm::translate(hand, glm::vec3(0, 0, -0.06f)) * alongZ * glm::scale(glm::mat4(1.0f), glm::vec3(0.02f, 0.11f, 0.02f));
+  out->push_back(grip_);
+  for (const float z : {-0.06f, 0.05f}) {
+    render::SolidMesh end;
+    end.color = body;
+    end.mesh = UnitSphere().View();
+    end.model = glm::scale(glm::translate(hand, glm::vec3(0, 0, z)), glm::vec3(0.02f));
+    out->push_back(end);
+  }
+  // The tracking ring in front of the hand: a flat disc 9 cm across, tilted up.
+  render::SolidMesh disc;
+  disc.color = ring;
+  disc.mesh = UnitCylinder().View();
+  disc.model = glm::translate(hand, glm::vec3(0, 0.02f, -0.08f)) * glm::rotate(glm::mat4(1.0f), 0.6f, glm::vec3(1, 0, 0)) *
+               glm::scale(glm::mat4(1.0f), glm::vec3(0.045f, 0.012f, 0.045f));
+  out->push_back(disc);
 }
 
 render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMode mode, render::ParticleColor color,

@@ -69,6 +69,29 @@ interaction::HandInput ToHandInput(const xr::HandState& h, const sim::Vec3& offs
   return in;
 }
 
+/// The controllers where the hands are, and each hand's paddle in its hand: where the solver has it
+/// while it is in the water, at the hand while the hand is away from the tank (its body then waits
+/// above the water, out of the way, paddle.h).
+void DrawHandsAndPaddles(const xr::FrameInfo& info, const std::vector<interaction::HandInput>& hands,
+                         const sim::Vec3& offset, const SimSnapshot& snap, render::FrameScene* frame) {
+  frame->solids.clear();
+  for (PaddlePose paddle : snap.paddles) {
+    if (paddle.hand >= 0 && paddle.hand < static_cast<int>(hands.size())) {
+      const xr::HandState& h = info.hands[size_t(paddle.hand)];
+      const bool held = h.poseValid && h.tracked;
+      if (held && !hands[size_t(paddle.hand)].tracked) paddle.pose = hands[size_t(paddle.hand)].pose;
+    }
+    AppendPaddleSolids(paddle, &frame->solids);
+  }
+  for (const xr::HandState& h : info.hands) {
+    if (!(h.poseValid && h.tracked)) continue;
+    interaction::Pose grip;
+    grip.position = {h.grip.position.x - offset.x, h.grip.position.y - offset.y, h.grip.position.z - offset.z};
+    grip.orientation = h.grip.orientation;
+    AppendControllerSolids(grip, &frame->solids);
+  }
+}
+
 double MeanSpeed(const sim::HostFluid& fluid) {
   double sum = 0.0;
   for (const sim::Vec4& v : fluid.velocity) sum += std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
@@ -342,6 +365,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
           }
           // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
           frame = MakeFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));
+          DrawHandsAndPaddles(info, hands, app.offset, *snap, &frame);
         },
         [&](const xr::FrameInfo&, const xr::EyeView& eye) {
           // The renderer writes display-ready colour (the desktop window shows its bytes as they are):

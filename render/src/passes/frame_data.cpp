@@ -206,8 +206,10 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
         const float x = (k & 1) ? topHi.x - inset : topLo.x + inset, z = (k & 2) ? topHi.z - inset : topLo.z + inset;
         box(glm::vec3(x - 0.5f * leg, groundY, z - 0.5f * leg), glm::vec3(x + 0.5f * leg, topLo.y, z + 0.5f * leg));
       }
-      placeLo = glm::min(placeLo, topLo);
-      placeHi = glm::max(placeHi, topHi);
+      // The sun's view reaches the ground around the table, where the table's shadow falls.
+      placeLo = glm::min(placeLo, topLo - glm::vec3(table, 0.0f, table));
+      placeHi = glm::max(placeHi, topHi + glm::vec3(table, 0.0f, table));
+      placeLo.y = groundY;
     }
   }
   for (const sim::Aabb& box : scene.obstacles) {

@@ -11,15 +11,16 @@ DeviceSample DefaultSample(Device device, double t) {
   DeviceSample s;
   switch (device) {
     case Device::kHead:
-      s.pose.position = {0.0f, 1.6f, 0.5f};
-      s.pose.orientation = AxisAngle({1, 0, 0}, -0.5235988f);  // pitch 30 degrees down
+      // Standing at the table, the tank (centred at 1.0 m high, 0.4 m ahead) at arm's reach.
+      s.pose.position = {0.0f, 1.55f, 0.1f};
+      s.pose.orientation = AxisAngle({1, 0, 0}, -0.7853982f);  // pitch 45 degrees down
       break;
     case Device::kLeft:
       s.pose.position = {-0.25f, 1.1f, 0.1f};
       break;
     case Device::kRight: {
       double phase = 2.0 * M_PI * 0.5 * t;
-      s.pose.position = {0.1f + 0.1f * float(std::cos(phase)), 1.0f, -0.4f + 0.1f * float(std::sin(phase))};
+      s.pose.position = {0.1f + 0.1f * float(std::cos(phase)), 1.2f, -0.4f + 0.1f * float(std::sin(phase))};
       s.pose.orientation = AxisAngle({1, 0, 0}, -1.5707963f);  // grip axis (-z) pointing down
       s.trigger = 0.8f;  // pressed: a click binding (simple controller) reads 1
       break;

@@ -34,6 +34,8 @@ render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMod
                                   const render::InteropMesh* deviceSurface = nullptr);
 /// The solids of one paddle at its pose (appended to `out`).
 void AppendPaddleSolids(const PaddlePose& paddle, std::vector<render::SolidMesh>* out);
+/// A controller held at `grip` (scene coordinates; OpenXR's grip space): a dark handle and its ring.
+void AppendControllerSolids(const interaction::Pose& grip, std::vector<render::SolidMesh>* out);
 
 /// Renders frames of a run into PNG files without a display.
 class OfflinePictures {
