@@ -9,6 +9,7 @@
 
 #include "sphxr/app/probe_csv.h"
 #include "sphxr/app/quality.h"
+#include "sphxr/render/renderer.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
@@ -84,6 +85,7 @@ std::string UsageText() {
          "             [--export-surface-every K [--surface-format ply|obj]] [--progress | --no-progress]\n"
          "             [--screenshot FILE.png] [--frames DIR [--fps F]]\n"
          "             [--image-size WxH] [--render water|particles] [--quality auto|scene] [--gl-debug]\n"
+         "             [--render-quality high|medium|low] [--frame-stats FILE.csv]\n"
          "\n"
          "  --xr              the headset (OpenXR), with a mirror window; the default when a runtime answers.\n"
          "                    No runtime: one line, then the desktop window. --frame-limit N ends after N\n"
@@ -95,7 +97,11 @@ std::string UsageText() {
          "  --headless        run without a window (the default without a display); Ctrl-C stops it after\n"
          "                    the step in progress, keeping the summary, whole CSV rows and a last export\n"
          "  --quality Q       auto: measure this machine and pick the spacing that runs in real time\n"
-         "                    (the window's default); scene: the scene's spacing (the headless default)\n"
+         "                    (the window's default), and lower the render quality while frames do not\n"
+         "                    fit; scene: the scene's spacing (the headless default)\n"
+         "  --render-quality L  where the drawing starts: high (shadows 2048, spray and foam), medium\n"
+         "                    (shadows 1024), low (no shadows, no spray or foam); pictures use it too\n"
+         "  --frame-stats F   window and headset: a CSV row per frame with the GPU time of each pass\n"
          "  --scene FILE      JSON scene: a file, or a scene's name (stir) looked for in the current\n"
          "                    directory, then the installed scenes (PREFIX/share/sphxr/scenes) or, run\n"
          "                    from the build tree, the source tree's scenes/ (default: dam_break)\n"
@@ -297,6 +303,14 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       const std::string q = v;
       if (q != "auto" && q != "scene") return Status::Error("--quality " + ShowText(q) + ": must be auto or scene");
       out->quality = q == "auto" ? 1 : 0;
+    } else if (arg == "--render-quality") {
+      if (Status s = value(&v); !s) return s;
+      render::RenderQuality q;
+      if (!render::ParseRenderQuality(v, &q)) return Status::Error(arg + " " + ShowText(v) + ": must be high, medium or low");
+      out->renderQuality = v;
+    } else if (arg == "--frame-stats") {
+      if (Status s = value(&v); !s) return s;
+      out->frameStatsPath = v;
     } else if (arg == "--gl-debug") {
       out->glDebug = true;
     } else if (arg == "--no-vsync") {

@@ -56,6 +56,11 @@ Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* o
 
   render::RendererConfig config;
   config.debug = config.debug || options.glDebug;
+  render::ParseRenderQuality(options.renderQuality, &config.quality);
+  m.budget = std::make_unique<RenderBudget>(config.quality, options.quality != 0);
+  if (!options.frameStatsPath.empty()) {
+    if (Status s = m.frameStats.Open(options.frameStatsPath); !s) return s;
+  }
   GlWindowRequest request;
   request.width = options.windowWidth;
   request.height = options.windowHeight;
@@ -189,6 +194,7 @@ bool DesktopApp::Frame(render::Image* capture) {
   const auto now = std::chrono::steady_clock::now();
   m.frameSeconds = std::chrono::duration<float>(now - m.lastFrame).count();
   m.lastFrame = now;
+  if (m.frames > 0) m.FrameEnded(1e3 * m.frameSeconds);
 
   // The newest snapshot: drawn again with the newest camera when the simulation has not published.
   m.worker->SetHands(m.HandInputs());

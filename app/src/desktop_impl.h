@@ -22,6 +22,7 @@
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
+#include "sphxr/app/render_budget.h"
 #include "sphxr/common/log.h"
 #include "sphxr/render/renderer.h"
 
@@ -51,6 +52,8 @@ struct DesktopApp::Impl {
   GLFWwindow* window = nullptr;
   bool imguiReady = false;
   std::unique_ptr<render::Renderer> renderer;
+  std::unique_ptr<RenderBudget> budget;  // the render quality, lowered under --quality auto when frames do not fit
+  FrameStatsCsv frameStats;              // --frame-stats
   std::unique_ptr<SimWorker> worker;
   InteropSurface interop;  // the surface on the GPU path (written in place; unused on the CPU backend)
   OrbitCamera camera;
@@ -84,6 +87,19 @@ struct DesktopApp::Impl {
     interop.Reset();
     renderer.reset();
     CloseGlWindow(window, imguiReady);
+  }
+
+  /// After a displayed frame: its --frame-stats row and the render budget's judgement (a 60 Hz display).
+  void FrameEnded(double intervalMs) {
+    if (frameStats.IsOpen()) {
+      if (Status s = frameStats.Append(frames - 1, intervalMs, budget->Quality(), renderer->LastStats()); !s) {
+        SPHXR_LOG_WARN("%s", s.message().c_str());
+      }
+    }
+    if (budget->Observe(intervalMs, 1e3 / 60.0)) {
+      renderer->SetQuality(budget->Quality());
+      SPHXR_LOG_INFO("%s", budget->Why().c_str());
+    }
   }
 
   void FrameTank() {

@@ -170,6 +170,16 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     int c = static_cast<int>(color);
     ImGui::Combo("colour (c)", &c, "speed\0density error\0reuse activity\0");
     color = static_cast<render::ParticleColor>(c);
+    int q = static_cast<int>(renderer->Config().quality);
+    if (ImGui::Combo("render quality", &q, "low\0medium\0high\0")) renderer->SetQuality(static_cast<render::RenderQuality>(q));
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("high: shadows 2048, spray and foam; medium: shadows 1024; low: neither");
+    // The GPU time of each pass (GL_TIME_ELAPSED, a frame or two old).
+    const render::DrawStats& drawn = renderer->LastStats();
+    if (!drawn.passes.empty() && ImGui::TreeNodeEx("GPU per pass", ImGuiTreeNodeFlags_DefaultOpen)) {
+      for (const render::PassTime& pass : drawn.passes) ImGui::Text("%-16s %7.3f ms", pass.name.c_str(), pass.gpuMs);
+      ImGui::Text("%-16s %7.3f ms", "all", drawn.GpuMs());
+      ImGui::TreePop();
+    }
     ImGui::SliderFloat("surface cell (spacings)", &surfaceCell, 0.5f, 2.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp);
     if (ImGui::IsItemHovered()) {
       ImGui::SetTooltip("edge of a marching-cubes cell of the water surface, in particle spacings (%.4f m);\n"

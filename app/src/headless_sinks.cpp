@@ -397,7 +397,10 @@ Status PicturesSink::Create(const Options& options, std::optional<sim::SurfacePa
   if (!options.framesDir.empty()) {
     if (Status s = MakeOutputDirectory("--frames", options.framesDir); !s) return s;
   }
-  if (Status s = OfflinePictures::Create(options.imageWidth, options.imageHeight, &sink->m_pictures, options.glDebug); !s) {
+  render::RenderQuality quality = render::RenderQuality::kHigh;
+  render::ParseRenderQuality(options.renderQuality, &quality);
+  if (Status s = OfflinePictures::Create(options.imageWidth, options.imageHeight, &sink->m_pictures, options.glDebug, quality);
+      !s) {
     return Status::Error("--screenshot/--frames: " + s.message());
   }
   *out = std::move(sink);

@@ -230,13 +230,15 @@ render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMod
   return f;
 }
 
-Status OfflinePictures::Create(int width, int height, std::unique_ptr<OfflinePictures>* out, bool glDebug) {
+Status OfflinePictures::Create(int width, int height, std::unique_ptr<OfflinePictures>* out, bool glDebug,
+                               render::RenderQuality quality) {
   out->reset();
   std::unique_ptr<OfflinePictures> p(new OfflinePictures());
   p->m_width = width;
   p->m_height = height;
   render::RendererConfig config;
   config.debug = config.debug || glDebug;
+  config.quality = quality;
   if (Status s = render::HeadlessContext::Create(config.debug, &p->m_context); !s) return s;
   if (Status s = render::OffscreenTarget::Create(width, height, &p->m_target); !s) return s;
   if (Status s = render::Renderer::Create(config, &p->m_renderer); !s) return s;

@@ -28,6 +28,7 @@
 #include "sphxr/common/log.h"
 #include "sphxr/interaction/hand.h"
 #include "sphxr/render/renderer.h"
+#include "sphxr/app/render_budget.h"
 #include "sphxr/xr/session.h"
 
 // From glfw3native.h (which would also pull in Xlib.h and its macros): the X display GLFW opened.
@@ -116,6 +117,8 @@ struct XrApp {
   GLFWwindow* window = nullptr;
   bool imguiReady = false;
   std::unique_ptr<render::Renderer> renderer;
+  std::unique_ptr<RenderBudget> budget;  // the render quality, lowered under --quality auto when frames do not fit
+  FrameStatsCsv frameStats;              // --frame-stats
   std::unique_ptr<xr::Session> session;
   std::unique_ptr<SimWorker> worker;
   InteropSurface interop;  // the surface on the GPU path (written in place; unused on the CPU backend)
@@ -203,10 +206,28 @@ struct XrApp {
   }
 };
 
+/// After a displayed frame: its row of --frame-stats, and the render budget's judgement.
+void FrameEnded(XrApp& app, int64_t frame, double intervalMs, double periodMs) {
+  if (app.frameStats.IsOpen()) {
+    if (Status s = app.frameStats.Append(frame, intervalMs, app.budget->Quality(), app.renderer->LastStats()); !s) {
+      SPHXR_LOG_WARN("%s", s.message().c_str());
+    }
+  }
+  if (app.budget->Observe(intervalMs, periodMs)) {
+    app.renderer->SetQuality(app.budget->Quality());
+    SPHXR_LOG_INFO("%s", app.budget->Why().c_str());
+  }
+}
+
 Status OpenWindowAndSession(XrApp& app, XrOutcome* outcome) {
   const Options& options = app.options;
   render::RendererConfig config;
   config.debug = config.debug || options.glDebug;
+  render::ParseRenderQuality(options.renderQuality, &config.quality);
+  app.budget = std::make_unique<RenderBudget>(config.quality, options.quality != 0);
+  if (!options.frameStatsPath.empty()) {
+    if (Status s = app.frameStats.Open(options.frameStatsPath); !s) return s;
+  }
   GlWindowRequest request;
   request.width = options.windowWidth;
   request.height = options.windowHeight;
@@ -334,6 +355,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
             intervals.push_back(ms);
             if (previousPeriodNs > 0 && ms > 1.5e-6 * static_cast<double>(previousPeriodNs)) ++outcome->lateFrames;
           }
+          if (!intervals.empty()) FrameEnded(app, outcome->frames - 1, intervals.back(), 1e-6 * static_cast<double>(info.displayPeriodNs));
           previousFrame = now;
           previousPeriodNs = info.displayPeriodNs;
 
@@ -449,6 +471,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
               static_cast<long long>(outcome->lateFrames), last->last.time, static_cast<long long>(last->steps),
               outcome->meanFluidSpeed, outcome->peakMeanFluidSpeed, last->stepMs, last->surfaceMs);
   std::printf("sphxr --xr: session states %s\n", outcome->states.c_str());
+  std::printf("sphxr --xr: %s\n", RenderSummary(app.budget->Quality(), app.renderer->LastStats()).c_str());
   std::fflush(stdout);
   return Status::Ok();
 }

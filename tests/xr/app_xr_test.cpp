@@ -273,6 +273,43 @@ TEST(XrApp, EachEyesDepthReachesTheCompositorWithTheWaterSurfaceInIt) {
   }
 }
 
+TEST(XrApp, QualityAutoLowersTheRenderQualityWhenFramesDoNotFitAndFrameStatsTimeEachPass) {
+  // llvmpipe draws a frame in tens of milliseconds against the simulated headset's 11 ms period: under
+  // --quality auto the render budget lowers the quality, one level per 45 frames, to low.
+  SimHeadset headset("app_budget");
+  SetUpHeadset(headset);
+  const auto csv = headset.dir / "frames.csv";
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() +
+                                " --frame-limit 100 --quality auto --threads 1 --window-size 160x120 --frame-stats " +
+                                csv.string(),
+                            headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("render quality high -> medium: frames take"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("render quality medium -> low: frames take"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sphxr --xr: render quality low; GPU per view"), std::string::npos) << r.out;
+  std::ifstream in(csv);
+  std::string header, line;
+  ASSERT_TRUE(std::getline(in, header)) << r.out;
+  EXPECT_EQ(header.rfind("frame,interval_ms,render_quality,views,gpu_ms,gpu_shadow_ms,gpu_sky_ms,gpu_opaque_ms", 0), 0u) << header;
+  EXPECT_NE(header.find("gpu_water_ms"), std::string::npos) << header;
+  int rows = 0, high = 0, low = 0;
+  double gpu = 0.0;
+  while (std::getline(in, line)) {
+    ++rows;
+    high += line.find(",high,") != std::string::npos;
+    low += line.find(",low,") != std::string::npos;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    ASSERT_GE(cells.size(), 5u) << line;
+    gpu += std::atof(cells[4].c_str());
+  }
+  EXPECT_GE(rows, 90) << "a row per frame once the first pass times are in";
+  EXPECT_GE(high, 40);
+  EXPECT_GE(low, 1);
+  EXPECT_GT(gpu, 0.0) << "the passes' GPU times are measured";
+}
+
 /// The haptic requests of the simulated headset's log for one hand: (amplitude, stop) per line.
 std::vector<float> HapticAmplitudes(const std::filesystem::path& log, const std::string& hand) {
   std::vector<float> out;

@@ -56,6 +56,8 @@ struct Options {
   bool vsync = true;
   bool glDebug = false;         // --gl-debug: GL debug callback on in a release build (any GL error aborts)
   int quality = -1;             // --quality: -1 = auto in the desktop window, scene headless; 0 = scene; 1 = auto
+  std::string renderQuality = "high";  // --render-quality: where the window's and the headset's drawing starts
+  std::string frameStatsPath;   // --frame-stats: one CSV row per displayed frame (window, headset)
   bool help = false;
   bool printSceneReference = false;  // --print-scene-reference: print SceneParameterReference() and exit
 };

@@ -42,7 +42,8 @@ class OfflinePictures {
  public:
   /// Creates the EGL context, the renderer and a width x height target. Errors are one line
   /// ("no EGL display ...", "needs OpenGL 4.5 ...").
-  static Status Create(int width, int height, std::unique_ptr<OfflinePictures>* out, bool glDebug = false);
+  static Status Create(int width, int height, std::unique_ptr<OfflinePictures>* out, bool glDebug = false,
+                       render::RenderQuality quality = render::RenderQuality::kHigh);
   /// Draws the scene from the camera that frames the tank and writes `path`.
   Status Write(const render::FrameScene& frame, const std::string& path);
   int Width() const { return m_width; }
