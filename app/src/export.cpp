@@ -125,6 +125,26 @@ Status WritePly(const std::string& path, const sim::HostFluid& fluid, const Expo
   return Close(&f, path);
 }
 
+Status WriteDiffusePly(const std::string& path, const sim::HostDiffuse& diffuse, const ExportStamp& stamp) {
+  File f;
+  if (Status s = OpenForWrite(path, &f); !s) return s;
+  std::fprintf(f.get(), "ply\nformat binary_little_endian 1.0\ncomment sphxr diffuse particles (spray, foam, bubbles)\n");
+  PlyStamp(f.get(), stamp);
+  std::fprintf(f.get(), "element vertex %d\n", diffuse.count);
+  std::fprintf(f.get(), "property float x\nproperty float y\nproperty float z\nproperty float lifetime\n"
+                        "property float velocity_x\nproperty float velocity_y\nproperty float velocity_z\n"
+                        "property uchar kind\nend_header\n");
+  for (int i = 0; i < diffuse.count; ++i) {
+    const sim::Vec4& p = diffuse.position[i];
+    const sim::Vec4& v = diffuse.velocity[i];
+    const float values[7] = {p.x, p.y, p.z, p.w, v.x, v.y, v.z};
+    std::fwrite(values, 4, 7, f.get());
+    const uint8_t kind = static_cast<uint8_t>(sim::DiffuseKindOf(v));
+    std::fwrite(&kind, 1, 1, f.get());
+  }
+  return Close(&f, path);
+}
+
 Status WriteVtk(const std::string& path, const sim::HostFluid& fluid, const ExportStamp& stamp) {
   File f;
   if (Status s = OpenForWrite(path, &f); !s) return s;

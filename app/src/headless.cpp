@@ -111,6 +111,10 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
               "end (spray and surface particles are light)\n",
               100.0 * summary->meanDensityError, 100.0 * summary->peakMeanDensityError, 100.0 * summary->maxDensityError);
   std::printf("  max speed       %.3f m/s over the run\n", summary->maxSpeed);
+  if (summary->diffuse[0] >= 0) {
+    std::printf("  diffuse         %d spray, %d foam, %d bubbles at the end (solver.diffuse_capacity %g)\n",
+                summary->diffuse[0], summary->diffuse[1], summary->diffuse[2], scene.setup.params.diffuseCapacity);
+  }
   if (scene.setup.reuse.enabled) {
     std::printf("  reuse           on: %.1f %% of the particles computed per step on average (delta1 %g, delta2 %g, "
                 "threshold %g, idle %d)\n",
@@ -273,6 +277,12 @@ void Summarise(const SceneFile& scene, const sim::Solver& solver, const SummaryS
   summary->msPerStep = totals.steps > 0 ? 1e3 * totals.stepSeconds / totals.steps : 0.0;
   for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) {
     summary->stageMsPerStep[s] = totals.steps > 0 ? 1e3 * totals.stageSeconds[s] / totals.steps : 0.0;
+  }
+  if (solver.Scene().params.diffuse > 0.0f) {
+    sim::HostDiffuse diffuse;
+    solver.DownloadDiffuse(&diffuse);
+    for (int& k : summary->diffuse) k = 0;
+    for (const sim::Vec4& v : diffuse.velocity) ++summary->diffuse[static_cast<int>(sim::DiffuseKindOf(v))];
   }
   summary->meanDensityError = solver.LastStep().meanDensityError;
   summary->maxDensityError = solver.LastStep().maxDensityError;

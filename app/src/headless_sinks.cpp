@@ -311,6 +311,11 @@ Status ExportSink::Particles(Simulation& simulation, int64_t step) {
   const std::string path = (std::filesystem::path(m_options.outDir) / name).string();
   const ExportStamp stamp{step, simulation.Solver().Time()};
   Status s = m_options.exportFormat == "vtk" ? WriteVtk(path, m_host, stamp) : WritePly(path, m_host, stamp);
+  if (s && simulation.Solver().Scene().params.diffuse > 0.0f) {  // spray, foam and bubbles beside (always PLY)
+    simulation.Solver().DownloadDiffuse(&m_diffuse);
+    std::snprintf(name, sizeof(name), "diffuse_%06lld.ply", static_cast<long long>(step));
+    s = WriteDiffusePly((std::filesystem::path(m_options.outDir) / name).string(), m_diffuse, stamp);
+  }
   if (s) ++m_summary->exports;
   m_particlesStep = step;
   return s;

@@ -159,6 +159,7 @@ class ExportSink : public SimulationSink {
   std::optional<sim::SurfaceParams> m_surface;
   RunSummary* m_summary;
   sim::HostFluid m_host;
+  sim::HostDiffuse m_diffuse;
   sim::SurfaceMesh m_mesh;
   double m_surfaceSeconds = 0.0;
   int64_t m_nextParticles = 0, m_nextSurface = 0;      // by time: the next multiple of the interval

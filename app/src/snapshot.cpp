@@ -29,6 +29,7 @@ SurfacePath ChooseSurfacePath(sim::Device activeDevice) {
 Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* paddles, const SurfaceRequest& surface,
                        SimSnapshot* out, SurfacePath path) {
   solver.Download(&out->fluid);
+  solver.DownloadDiffuse(&out->diffuse);
   out->last = solver.LastStep();
   out->steps = solver.GetTotals().steps;
   out->fluidCount = solver.FluidCount();

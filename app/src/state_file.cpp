@@ -22,7 +22,9 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'H', 'X', 'R', 'S', 'T', '1'};
 constexpr uint32_t kByteOrder = 0x01020304u;
-constexpr uint32_t kVersion = 3;  // 2: the step count after the clock; 3: the solver method after the scene name
+// 2: the step count after the clock; 3: the solver method after the scene name; 4: the diffuse particles
+// after the fields
+constexpr uint32_t kVersion = 4;
 constexpr uint32_t kOldestVersion = 1;
 static_assert(sizeof(sim::Vec3) == 12 && sizeof(sim::Quat) == 16 && sizeof(sim::Pose) == 28,
               "state files write these structs as their bytes: they must have no padding");
@@ -241,6 +243,11 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
   w.Bytes(fluid.name.data(), fluid.name.size() * sizeof(type));
     SPHXR_FLUID_FIELDS(SPHXR_WRITE_FIELD)
 #undef SPHXR_WRITE_FIELD
+    sim::HostDiffuse diffuse;
+    solver.DownloadDiffuse(&diffuse);
+    w.Put(static_cast<uint32_t>(diffuse.count));
+    w.Bytes(diffuse.position.data(), diffuse.position.size() * sizeof(sim::Vec4));
+    w.Bytes(diffuse.velocity.data(), diffuse.velocity.size() * sizeof(sim::Vec4));
     out.close();  // errors reported only at close (quota, network filesystems) count too
     if (out.fail()) {
       std::error_code ignored;
@@ -426,6 +433,16 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
   }
   SPHXR_FLUID_FIELDS(SPHXR_CHECK_SEEN)
 #undef SPHXR_CHECK_SEEN
+  if (version >= 4) {  // (older files have none: the run starts without)
+    uint32_t diffuse = 0;
+    if (!r.Get(&diffuse)) return truncated();
+    if (static_cast<uint64_t>(diffuse) * 2 * sizeof(sim::Vec4) > r.Left()) return truncated();
+    out->diffuse.resize(static_cast<int>(diffuse));
+    if (!r.Bytes(out->diffuse.position.data(), diffuse * sizeof(sim::Vec4)) ||
+        !r.Bytes(out->diffuse.velocity.data(), diffuse * sizeof(sim::Vec4))) {
+      return truncated();
+    }
+  }
   if (r.Left() != 0) return Status::Error(Format("%s: %zu bytes after the last field: the file is damaged", path.c_str(), r.Left()));
   return Status::Ok();
 }
@@ -481,6 +498,7 @@ Status RestoreState(const StateFile& state, sim::Solver* solver) {
   }
   if (Status s = CheckAgainstScene(state, solver->Scene()); !s) return Status::Error(path + ": " + s.message());
   if (Status s = solver->Restore(state.fluid, state.clock); !s) return Status::Error(path + ": " + s.message());
+  if (Status s = solver->RestoreDiffuse(state.diffuse); !s) return Status::Error(path + ": " + s.message());
   if (static_cast<int>(state.bodies.size()) == solver->BodyCount()) {  // the same bodies: their whole motion
     for (int k = 0; k < solver->BodyCount(); ++k) {
       if (Status s = solver->SetBodyMotion(k, state.bodies[k]); !s) return Status::Error(path + ": " + s.message());

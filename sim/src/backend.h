@@ -67,12 +67,26 @@ class Backend {
   virtual void SampleProbesNow(const Physics& physics) = 0;
   /// The HPMC stages on this backend's system (surface_impl.h); building from the particles re-grids them.
   virtual SurfaceExtractor* Surface() = 0;
+  // Diffuse particles (diffuse_pool.h): a post-step stage, sized at Init from physics.diffuse.
+  virtual int DiffuseCount() const = 0;
+  /// The pool, oldest first.
+  virtual void DownloadDiffuse(HostDiffuse* out) const = 0;
+  /// Replaces the pool (a restart); keeps the newest when `in` holds more than the capacity and returns
+  /// how many it left out.
+  virtual int UploadDiffuse(const HostDiffuse& in) = 0;
+  /// The post-step stages alone, on the fluid as it is (tests: the diffuse particles over a fluid that
+  /// every backend holds alike). Step runs them after every step.
+  virtual Status AdvancePostSteps(float dt, const Physics& physics) = 0;
   /// The CPU backend's density blocks from pairs of cells only, drawn from every particle with the lanes
   /// that reuse masked: the layout before the fitted boxes and the compacted blocks (cpu/blocks.h,
   /// docs/design/simd_stages.md). The same bits; tests and sphxr_bench_blocks hold the two together.
   /// Before the first step. The other backends have no blocks and ignore it.
   virtual void UsePairDensityBlocks() {}
 };
+
+/// The constants of a step for `scene` (solver.cpp); Solver::Step sets the step's own (its number, the
+/// impulse hold's schedule). Tests that drive a backend directly take theirs from here.
+Physics MakePhysics(const SceneSetup& scene);
 
 std::unique_ptr<Backend> MakeCpuBackend(int threads);
 /// The CUDA backend's orchestration on the host (backend_cpu_reference.cpp): every stage the per-particle

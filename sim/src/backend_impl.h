@@ -3,7 +3,7 @@
 // system. backend_cpu.cpp instantiates it with thrust's OpenMP system and the CPU's launcher,
 // backend_cpu_reference.cpp and backend_cuda.cu with the plain launcher (launch/plain.h). Its step:
 //
-//   grid (cells, sort, ranges) -> bodies (place) -> solver.Step(context) -> reduction
+//   grid (cells, sort, ranges) -> bodies (place) -> solver.Step(context) -> reduction -> post-step stages
 //
 // The solver is one file in solvers/ (the method's row of the solver table); the stages it calls are
 // StepContext's (solvers/step_context.h). Sorting, fills, gathers and reductions come from thrust
@@ -17,6 +17,8 @@
 
 #include "backend.h"
 #include "backend_guard.h"
+#include "diffuse_pool.h"
+#include "post_step.h"
 #include "solvers/factory.h"
 #include "surface_impl.h"
 
@@ -45,6 +47,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
       if (Status s = m_walls.Init(boundary, physics, static_cast<size_t>(grid.Cells()), [this] { return View(); }); !s) {
         return s;
       }
+      m_diffuse.Init(physics.diffuse, static_cast<size_t>(grid.Cells()));
       return Traits::Sync("setup");
     });
   }
@@ -92,6 +95,14 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     if constexpr (requires { m_launch.UsePairBlocks(); }) m_launch.UsePairBlocks();
   }
   SurfaceExtractor* Surface() override { return &m_surface; }
+  int DiffuseCount() const override { return m_diffuse.Count(); }
+  void DownloadDiffuse(HostDiffuse* out) const override { m_diffuse.Download(out); }
+  int UploadDiffuse(const HostDiffuse& in) override { return m_diffuse.Upload(in); }
+  Status AdvancePostSteps(float dt, const Physics& physics) override {
+    return GuardBackend(Traits::kName, "the post-step stages", [&] {
+      return PostSteps(dt, physics, [](Stage stage) { return Traits::Sync(StageName(stage)); });
+    });
+  }
 
   void InitBodies(const std::vector<Vec4>& local, const std::vector<uint32_t>& bodyOf, const std::vector<float>& alpha,
                   const std::vector<ShapePrimitive>& shapes) override {
@@ -142,7 +153,19 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     out->divergenceIterations = ctx.report.divergenceIterations;
     out->densityError = ctx.report.densityError;
     out->divergenceError = ctx.report.divergenceError;
-    return lap(Stage::kIntegrate);
+    SPHXR_TRY(lap(Stage::kIntegrate));
+    // 5. the post-step stages, on the state the step ends in (they read the fluid, never write it)
+    return PostSteps(dt, physics, lap);
+  }
+
+  /// The post-step stages (post_step.h) in their order; a new one is a member and one entry here.
+  Status PostSteps(float dt, const Physics& physics, const std::function<Status(Stage)>& lap) {
+    PostStepStage* const stages[] = {&m_diffuse};
+    PostStepContext ctx{dt, physics, View(), m_fluid.View(), lap};
+    for (PostStepStage* stage : stages) {
+      if (stage->Active(physics)) SPHXR_TRY(stage->Run(ctx));
+    }
+    return Status::Ok();
   }
 
   GridView View() {
@@ -167,6 +190,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   ReuseLists<Traits> m_reuse;      // reuse: the crowding, the compacted list of the particles that compute
   ProbeArrays<Traits> m_probes;    // the probes and their last readings (empty: no probes)
   Vector<float> m_densityRate;     // per fluid particle, solver.density delta_sph (DensityRateStage)
+  DiffusePool<Traits> m_diffuse;   // spray, foam and bubbles: a post-step stage (capacity 0: off)
   typename Traits::Launcher m_launch;
   std::unique_ptr<PressureSolver<Traits>> m_solver;
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message

@@ -2,13 +2,14 @@
 #include <string>
 
 #include "sampling.h"
+#include "sphxr/sim/diffuse.h"
 #include "sphxr/sim/params.h"
 #include "sphxr/sim/solver_table.h"
 
 namespace sphxr::sim {
 namespace {
 
-const std::array<ParamInfo, 26> kParams = {{
+const std::array<ParamInfo, 41> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
     {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
@@ -54,6 +55,35 @@ const std::array<ParamInfo, 26> kParams = {{
      0.0, 10.0, &SolverParams::pbfVorticity, false, "pbf"},
     {"pbf_max_speed", "m/s", "pbf: speeds are capped here (a safety net against a runaway correction)", 0.01, 1000.0,
      &SolverParams::pbfMaxSpeed, false, "pbf"},
+    {"diffuse", "", "1: spray, foam and air bubbles (Ihmsen et al. 2012) spawned and moved after every step; they never act on the water (0 = off)",
+     0.0, 1.0, &SolverParams::diffuse, true},
+    {"diffuse_capacity", "", "diffuse particles at most (the pool, allocated once); when full the oldest are retired first",
+     1.0, 1e8, &SolverParams::diffuseCapacity, true},
+    {"diffuse_trapped_air", "1/s", "k_ta: diffuse particles a fluid particle spawns per second at full trapped-air and kinetic-energy potentials",
+     0.0, 1e7, &SolverParams::diffuseTrappedAir},
+    {"diffuse_wave_crest", "1/s", "k_wc: the same at full wave-crest and kinetic-energy potentials", 0.0, 1e7,
+     &SolverParams::diffuseWaveCrest},
+    {"diffuse_trapped_air_min", "m/s", "tau_ta min: the trapped-air potential (neighbours' relative speed toward each other, weighted) is 0 below it",
+     0.0, 1e4, &SolverParams::diffuseTrappedAirMin},
+    {"diffuse_trapped_air_max", "m/s", "tau_ta max: the trapped-air potential is 1 above it", 0.0, 1e4,
+     &SolverParams::diffuseTrappedAirMax},
+    {"diffuse_wave_crest_min", "", "tau_wc min: the wave-crest potential (surface curvature where the water moves along its normal) is 0 below it",
+     0.0, 1e4, &SolverParams::diffuseWaveCrestMin},
+    {"diffuse_wave_crest_max", "", "tau_wc max: the wave-crest potential is 1 above it", 0.0, 1e4,
+     &SolverParams::diffuseWaveCrestMax},
+    {"diffuse_energy_min", "J/kg", "tau_k min: a fluid particle with less kinetic energy (1/2 v^2) spawns nothing", 0.0, 1e6,
+     &SolverParams::diffuseEnergyMin},
+    {"diffuse_energy_max", "J/kg", "tau_k max: the kinetic-energy potential is 1 above it", 0.0, 1e6,
+     &SolverParams::diffuseEnergyMax},
+    {"diffuse_lifetime", "s", "the longest a foam particle lives (each draws 0.5 to 1 of it; spray and bubbles do not age)",
+     1e-3, 1e4, &SolverParams::diffuseLifetime},
+    {"diffuse_buoyancy", "", "k_b: an air bubble's buoyancy, in units of gravity", 0.0, 100.0, &SolverParams::diffuseBuoyancy},
+    {"diffuse_drag", "", "k_d: the share of an air bubble's velocity difference to the water that drag removes per step",
+     0.0, 1.0, &SolverParams::diffuseDrag},
+    {"diffuse_spray_below", "", "a diffuse particle with fewer fluid neighbours (within the kernel support) is spray",
+     0.0, 1000.0, &SolverParams::diffuseSprayBelow, true},
+    {"diffuse_bubble_above", "", "a diffuse particle with more fluid neighbours is an air bubble; between the two, foam",
+     0.0, 1000.0, &SolverParams::diffuseBubbleAbove, true},
 }};
 
 const std::array<ReuseParamInfo, 6> kReuseParams = {{
@@ -102,6 +132,15 @@ const char* WallFrictionName(WallFriction friction) {
   return "artificial";
 }
 
+const char* DiffuseKindName(DiffuseKind kind) {
+  switch (kind) {
+    case DiffuseKind::kSpray: return "spray";
+    case DiffuseKind::kFoam: return "foam";
+    case DiffuseKind::kBubble: return "bubble";
+  }
+  return "?";
+}
+
 const char* DensityModelName(DensityModel model) {
   return model == DensityModel::kDeltaSph ? "delta_sph" : "summation";
 }
@@ -130,6 +169,7 @@ ParticleCounts CountParticles(const SceneSetup& scene) {
   c.reuse = scene.reuse.enabled;
   c.wallDensity = scene.wallPressure == SceneSetup::WallPressure::kWallDensity;
   c.solverBytesPerFluid = SolverInfoOf(scene.method).bytesPerFluid(c.neighbourSlots);
+  c.diffuseCapacity = scene.params.diffuse > 0.0f ? static_cast<int64_t>(scene.params.diffuseCapacity) : 0;
   return c;
 }
 
@@ -145,13 +185,18 @@ int64_t EstimateMemoryBytes(const ParticleCounts& counts) {
   // with wall_density the wall-cell list's first size (4), with reuse the cells' counts and crowding (8). Bodies'
   // own particles: body frame, index and alpha (24), sorted world copies of position, velocity and
   // force (48), keys, order and owner (12). The pressure solver's own arrays: its row of the solver table.
+  // Diffuse particles (diffuse_pool.h): per fluid particle the sort's keys and order, the sorted copies of
+  // position, velocity and id, the normal, the spawn counts and their sums, the sort's storage (8 + 36 +
+  // 16 + 8 + 8); per cell two ranges and a flag (9); per pool slot two buffers of position and velocity, alive and rank (72).
+  const bool diffuse = counts.diffuseCapacity > 0;
   const int64_t perFluid = 68 + 8 + 28 + 8 + 4 + 68 + 4 * counts.neighbourSlots + 4 + (counts.reuse ? 12 : 0) +
-                           (counts.bodyParticles > 0 ? 4 : 0) +
+                           (counts.bodyParticles > 0 ? 4 : 0) + (diffuse ? 76 : 0) +
                            counts.solverBytesPerFluid;
   const int64_t perBoundary = 16 + 40 + 16 + (counts.wallDensity ? 4 : 0);
-  const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0) + (counts.reuse ? 8 : 0);
+  const int64_t perCell = 17 + (counts.bodyParticles > 0 ? 9 : 0) + (counts.wallDensity ? 4 : 0) + (counts.reuse ? 8 : 0) +
+                          (diffuse ? 9 : 0);
   return counts.fluid * perFluid + counts.boundary * perBoundary + counts.gridCells * perCell +
-         counts.bodyParticles * (24 + 48 + 12);
+         counts.bodyParticles * (24 + 48 + 12) + counts.diffuseCapacity * 72;
 }
 
 }  // namespace sphxr::sim

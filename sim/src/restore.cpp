@@ -85,6 +85,35 @@ Status Solver::Restore(const HostFluid& fluid, const SolverClock& clock) {
   return Status::Ok();
 }
 
+int Solver::DiffuseCount() const { return m_backend->DiffuseCount(); }
+void Solver::DownloadDiffuse(HostDiffuse* out) const { m_backend->DownloadDiffuse(out); }
+
+Status Solver::RestoreDiffuse(const HostDiffuse& diffuse) {
+  if (diffuse.count < 0 || diffuse.position.size() != static_cast<size_t>(diffuse.count) ||
+      diffuse.velocity.size() != static_cast<size_t>(diffuse.count)) {
+    return Status::Error(Format("restore: %d diffuse particles with %zu positions and %zu velocities", diffuse.count,
+                                diffuse.position.size(), diffuse.velocity.size()));
+  }
+  for (int i = 0; i < diffuse.count; ++i) {
+    const Vec4 p = diffuse.position[i], v = diffuse.velocity[i];
+    const bool kind = v.w == 0.0f || v.w == 1.0f || v.w == 2.0f;
+    if (!Finite(Xyz(p)) || !std::isfinite(p.w) || !Finite(Xyz(v)) || !kind) {
+      return Status::Error(Format("restore: diffuse particle %d has a non-finite position, lifetime or velocity, or a "
+                                  "kind (%g) that is not 0, 1 or 2", i, v.w));
+    }
+  }
+  if (!m_scene.params.diffuse) {
+    if (diffuse.count > 0) SPHXR_LOG_INFO("restore: %d diffuse particles left out: solver.diffuse is off", diffuse.count);
+    return Status::Ok();
+  }
+  const int left = m_backend->UploadDiffuse(diffuse);
+  if (left > 0) {
+    SPHXR_LOG_INFO("restore: the oldest %d of %d diffuse particles left out: solver.diffuse_capacity is %d", left,
+                   diffuse.count, static_cast<int>(m_scene.params.diffuseCapacity));
+  }
+  return Status::Ok();
+}
+
 Status Solver::SetReuse(const ReuseParams& reuse) {
   if (Status s = ValidateReuse(reuse); !s) return s;
   m_scene.reuse = reuse;

@@ -197,6 +197,27 @@ Status ValidateScene(const SceneSetup& scene) {
     return Status::Error(Format("solver.min_divergence_iterations = %g is above solver.max_divergence_iterations = %g",
                                 scene.params.minDivergenceIterations, scene.params.maxDivergenceIterations));
   }
+  {
+    // The diffuse particles' potential ranges (Ihmsen et al. 2012, eq. 1 divides by max - min).
+    const SolverParams& p = scene.params;
+    const struct {
+      const char* name;
+      float lo, hi;
+    } ranges[] = {{"trapped_air", p.diffuseTrappedAirMin, p.diffuseTrappedAirMax},
+                  {"wave_crest", p.diffuseWaveCrestMin, p.diffuseWaveCrestMax},
+                  {"energy", p.diffuseEnergyMin, p.diffuseEnergyMax}};
+    for (const auto& r : ranges) {
+      if (!(r.lo < r.hi)) {
+        return Status::Error(Format("solver.diffuse_%s_min = %g must be below solver.diffuse_%s_max = %g", r.name, r.lo,
+                                    r.name, r.hi));
+      }
+    }
+    if (p.diffuseSprayBelow > p.diffuseBubbleAbove + 1.0f) {
+      return Status::Error(Format("solver.diffuse_spray_below = %g is above solver.diffuse_bubble_above + 1 = %g: a "
+                                  "particle would be spray and a bubble at once",
+                                  p.diffuseSprayBelow, p.diffuseBubbleAbove + 1.0f));
+    }
+  }
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
   {
     const double gx = scene.gravity.x, gy = scene.gravity.y, gz = scene.gravity.z;

@@ -62,6 +62,7 @@ Status Solver::Settle(double seconds, SettleReport* report, const SettleProgress
     }
   }
   m_backend->FireMix(0.0f, 0.0f);
+  m_backend->UploadDiffuse(HostDiffuse{});  // the settle's spray and foam go with its clock
   r.time = m_last.time;
   for (BodyMotion& b : m_bodies) HoldBody(&b, b.pose, 0.0);  // where it is, at rest, on the restarted clock
   m_last = StepInfo{};

@@ -15,7 +15,6 @@
 #include "scene_check.h"
 
 namespace sphxr::sim {
-namespace {
 
 Physics MakePhysics(const SceneSetup& scene) {
   const SolverParams& p = scene.params;
@@ -95,10 +94,26 @@ Physics MakePhysics(const SceneSetup& scene) {
   // first layer) from a face: a quarter spacing beyond the clamp box's quarter-spacing inset.
   ph.pbfContact = 0.25f * p.spacing;
   ph.pbfMaxSpeed = p.pbfMaxSpeed;
+  DiffuseConstants& d = ph.diffuse;
+  d.enabled = p.diffuse > 0.0f;
+  d.capacity = static_cast<int>(p.diffuseCapacity);
+  d.trappedAir = p.diffuseTrappedAir;
+  d.waveCrest = p.diffuseWaveCrest;
+  d.trappedAirMin = p.diffuseTrappedAirMin;
+  d.trappedAirMax = p.diffuseTrappedAirMax;
+  d.waveCrestMin = p.diffuseWaveCrestMin;
+  d.waveCrestMax = p.diffuseWaveCrestMax;
+  d.energyMin = p.diffuseEnergyMin;
+  d.energyMax = p.diffuseEnergyMax;
+  d.lifetime = p.diffuseLifetime;
+  d.buoyancy = p.diffuseBuoyancy;
+  d.drag = p.diffuseDrag;
+  d.sprayBelow = static_cast<int>(p.diffuseSprayBelow);
+  d.bubbleAbove = static_cast<int>(p.diffuseBubbleAbove);
+  d.radius = 0.5f * p.spacing;  // the fluid particle's radius
+  ph.step = 0;  // Solver::Step sets it
   return ph;
 }
-
-}  // namespace
 
 std::string ClampSiteName(int site) {
   static const char* const kFaces[kTankFaces] = {"x- wall", "x+ wall", "floor", "top", "z- wall", "z+ wall"};
@@ -158,6 +173,7 @@ const char* StageName(Stage stage) {
     case Stage::kDivergence: return "divergence";
     case Stage::kPressure: return "pressure";
     case Stage::kProbes: return "probes";
+    case Stage::kDiffuse: return "diffuse";
     default: return "?";
   }
 }
@@ -323,6 +339,7 @@ Status Solver::Step() {
   StepReduction red;
   Physics physics = MakePhysics(m_scene);
   physics.reuseSyncStep = stepNumber % (physics.reuseIdle + 1) == 0;
+  physics.step = stepNumber;
   std::vector<BodyState> states;
   if (!m_bodies.empty()) {
     // Each body moves from its pose now to its interpolated pose at the end of the step; its particles

@@ -162,6 +162,27 @@ SPHXR_HD SPHXR_INLINE void ForEachFluidNeighbour(const GridView& grid, const Flu
   }
 }
 
+/// The diffuse particles' constants (stages/diffuse.h; Ihmsen et al. 2012 [IAAT12]), from the scene's
+/// solver.diffuse_* keys. Unused unless `enabled`.
+struct DiffuseConstants {
+  bool enabled;
+  int capacity;          // the pool's size (particles)
+  float trappedAir;      // k_ta, diffuse particles per second at I_ta = I_k = 1          [IAAT12 eq. 8]
+  float waveCrest;       // k_wc, the same for I_wc
+  float trappedAirMin;   // tau_ta: the trapped-air potential's range, m/s                [IAAT12 eq. 1-2]
+  float trappedAirMax;
+  float waveCrestMin;    // tau_wc: the wave-crest potential's range (a curvature, no unit) [IAAT12 eq. 4-6]
+  float waveCrestMax;
+  float energyMin;       // tau_k: the kinetic energy's range, J/kg (1/2 |v|^2)             [IAAT12 eq. 7]
+  float energyMax;
+  float lifetime;        // s: a particle's lifetime is drawn in [0.5, 1] x this
+  float buoyancy;        // k_b: a bubble's buoyancy, in units of -g                      [IAAT12 eq. 12]
+  float drag;            // k_d: the fraction of a bubble's velocity difference to the water removed per step
+  int sprayBelow;        // fewer fluid neighbours: spray
+  int bubbleAbove;       // more: an air bubble; between: foam
+  float radius;          // m, r_V: the spawning cylinder's radius (half a spacing)       [IAAT12 sec. 4.1]
+};
+
 /// Constants of one step, passed by value into every stage.
 struct Physics {
   CubicSpline kernel;
@@ -222,6 +243,10 @@ struct Physics {
   float pbfMaxSpeed;
   float pbfContact;             // m: the collision response's distance beyond the clamp box (the
                                 // particle radius, half a spacing from a face, less the clamp's inset)
+  // post-step stages (post_step.h)
+  DiffuseConstants diffuse;     // spray, foam and bubbles (stages/diffuse.h)
+  int64_t step;                 // this step's number since the run began (SolverClock::steps + 1): seeds the
+                                // diffuse particles' random numbers, so a restored run draws the same ones
 };
 
 }  // namespace sphxr::sim

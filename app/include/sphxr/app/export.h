@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sphxr/common/status.h"
+#include "sphxr/sim/diffuse.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/surface.h"
 
@@ -21,6 +22,9 @@ struct ExportStamp {
 
 Status WritePly(const std::string& path, const sim::HostFluid& fluid, const ExportStamp& stamp = {});
 Status WriteVtk(const std::string& path, const sim::HostFluid& fluid, const ExportStamp& stamp = {});
+/// The diffuse particles (spray, foam, bubbles; sim/diffuse.h) as binary PLY: x y z, lifetime (s),
+/// velocity_x/y/z, kind (uchar: 0 spray, 1 foam, 2 bubble), oldest first.
+Status WriteDiffusePly(const std::string& path, const sim::HostDiffuse& diffuse, const ExportStamp& stamp = {});
 /// The surface mesh (a triangle soup, sim/surface.h): binary PLY with per-vertex normals, or OBJ.
 Status WriteSurfacePly(const std::string& path, const sim::SurfaceMesh& mesh, const ExportStamp& stamp = {});
 Status WriteSurfaceObj(const std::string& path, const sim::SurfaceMesh& mesh, const ExportStamp& stamp = {});

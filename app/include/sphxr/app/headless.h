@@ -48,6 +48,7 @@ struct RunSummary {
   std::string stateSaved;            // --save-state: the file written
   int64_t checkpoints = 0;           // --checkpoint-every: states saved during the run
   double checkpointTime = -1.0;      // s on the clock of the last checkpoint (-1: none)
+  int diffuse[3] = {-1, -1, -1};     // solver.diffuse: spray, foam and bubbles at the end (-1: off)
 };
 
 /// Runs a scene headless: load, apply overrides, simulate, export, summarise. The summary is printed

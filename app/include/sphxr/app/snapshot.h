@@ -26,6 +26,8 @@ struct PaddlePose {
 
 struct SimSnapshot {
   sim::HostFluid fluid;
+  /// Spray, foam and bubbles (sphxr/sim/diffuse.h), oldest first; empty when solver.diffuse is off.
+  sim::HostDiffuse diffuse;
   sim::SceneSetup setup;
   sim::StepInfo last;
   int64_t steps = 0;
@@ -75,7 +77,7 @@ const char* SurfacePathName(SurfacePath path);
 /// kInterop exactly when the solver runs on the CUDA device (Solver::ActiveDevice()).
 SurfacePath ChooseSurfacePath(sim::Device activeDevice);
 
-/// Copies the solver's state into `out` (fluid, step info, counts), the paddles' poses and loads
+/// Copies the solver's state into `out` (fluid, diffuse particles, step info, counts), the paddles' poses and loads
 /// (`paddles` may be null) and, when `surface.enabled`, extracts the surface (timed): a host copy, or
 /// with SurfacePath::kInterop only BuildSurface (`out->surfaceOnDevice`, `out->surfaceVertices`).
 Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* paddles, const SurfaceRequest& surface,

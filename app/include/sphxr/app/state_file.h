@@ -2,8 +2,8 @@
 // State files: the fluid and the clock of a run, to restart from (`sphxr --save-state FILE`,
 // `--load-state FILE`; docs/user/scenes.md "State files"). Every field of the one field list
 // (sim/fields.h) is stored with its name and element size, so a file from a build with other fields
-// is refused by name instead of being misread. Binary, little-endian, version 3 (read too: version 2
-// lacks the method, version 1 also the step count):
+// is refused by name instead of being misread. Binary, little-endian, version 4 (read too: version 3
+// lacks the diffuse particles, version 2 also the method, version 1 also the step count):
 //
 //   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
 //   f64 time  f32 last max speed  f32 last max |a|  i64 step  f32 spacing  i32 fluid  i32 boundary
@@ -14,6 +14,8 @@
 //     f32 haptic, i64 teleports, u8 lost, f64 lostSince, f64 lastFrame (interaction::PaddleRestart);
 //     then f64 the next paddle frame's time (the runner's paddle clock)
 //   u32 fields; per field: u32 n + n bytes of name, u32 element bytes, fluid x element bytes
+//   u32 diffuse particles d; d Vec4 positions (w: lifetime left), d Vec4 velocities (w: kind), oldest
+//     first (sim::HostDiffuse)
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -28,6 +30,7 @@ namespace sphxr::app {
 
 struct StateFile {
   sim::HostFluid fluid;
+  sim::HostDiffuse diffuse;  // spray, foam and bubbles (empty in files before version 4)
   sim::SolverClock clock;
   /// Steps from the saved run's t = 0 (its first run's step 0, across continued runs), so that a run
   /// continued from the file numbers its steps, exports and CSV rows on as the whole run would; -1:

@@ -43,6 +43,23 @@ struct SolverParams {
   float pbfXsph = 0.01f;         // XSPH viscosity c
   float pbfVorticity = 0.0f;     // m/s: vorticity confinement epsilon (0 = off; docs/design/pbf.md)
   float pbfMaxSpeed = 20.0f;     // m/s, the velocity cap (a safety net)
+  // Diffuse particles: spray, foam and bubbles (Ihmsen et al. 2012, sphxr/sim/diffuse.h): the paper's
+  // potentials' ranges and rates; docs/design/diffuse.md says why and what the shipped scenes set.
+  float diffuse = 0.0f;                 // 1: spawned and moved after every step (they never act on the water)
+  float diffuseCapacity = 65536.0f;     // the pool's size; when full the oldest are retired first
+  float diffuseTrappedAir = 4000.0f;    // k_ta, per second
+  float diffuseWaveCrest = 50000.0f;    // k_wc, per second
+  float diffuseTrappedAirMin = 5.0f;    // tau_ta, m/s
+  float diffuseTrappedAirMax = 20.0f;
+  float diffuseWaveCrestMin = 2.0f;     // tau_wc
+  float diffuseWaveCrestMax = 8.0f;
+  float diffuseEnergyMin = 5.0f;        // tau_k, J/kg
+  float diffuseEnergyMax = 50.0f;
+  float diffuseLifetime = 5.0f;         // s, the longest a foam particle lives (each draws 0.5-1 of it)
+  float diffuseBuoyancy = 2.0f;         // k_b
+  float diffuseDrag = 0.8f;             // k_d
+  float diffuseSprayBelow = 6.0f;       // fluid neighbours: fewer is spray
+  float diffuseBubbleAbove = 20.0f;     // more is an air bubble
 };
 
 /// The pressure solver (`solver.method` in a scene, a name, never a number).
@@ -216,6 +233,7 @@ struct ParticleCounts {
   bool reuse = false;          // the compacted list of computing particles, the cells' crowding
   bool wallDensity = false;    // the walls' own pressure and the list of wall cells
   int64_t solverBytesPerFluid = 0;  // the pressure solver's own arrays (SolverInfo::bytesPerFluid)
+  int64_t diffuseCapacity = 0;      // the diffuse particles' pool (0: off)
 };
 ParticleCounts CountParticles(const SceneSetup& scene);
 

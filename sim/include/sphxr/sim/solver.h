@@ -10,6 +10,7 @@
 
 #include "sphxr/common/assert.h"
 #include "sphxr/common/status.h"
+#include "sphxr/sim/diffuse.h"
 #include "sphxr/sim/fields.h"
 #include "sphxr/sim/params.h"
 #include "sphxr/sim/probes.h"
@@ -40,8 +41,10 @@ struct SolverConfig {
 /// the push-out); their terms inside the density and force loops count to those stages.
 /// kDivergence, kPressure: DFSPH's two solves (its factor counts to kDensity); WCSPH leaves them 0.
 /// kProbes: the pressure sensors and level gauges (Solver::SetProbes); 0 without probes.
+/// kDiffuse: spray, foam and bubbles after the step (solver.diffuse, sphxr/sim/diffuse.h); 0 when off.
 enum class Stage : int {
-  kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kDivergence, kPressure, kProbes, kCount
+  kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kDivergence, kPressure, kProbes, kDiffuse,
+  kCount
 };
 const char* StageName(Stage stage);
 
@@ -153,6 +156,15 @@ class Solver {
   /// Copies all fluid fields to the host (current sorted order; use `id` for identity).
   void Download(HostFluid* out) const;
   void DownloadBoundary(HostBoundary* out) const;
+  // ---- diffuse particles (sphxr/sim/diffuse.h): spray, foam and bubbles, with solver.diffuse on ---------
+  /// How many there are now (0 when off).
+  int DiffuseCount() const;
+  /// Copies them to the host, oldest first.
+  void DownloadDiffuse(HostDiffuse* out) const;
+  /// Replaces them (a restart, after Restore): with more than solver.diffuse_capacity, the newest are
+  /// kept (logged); with solver.diffuse off, none (logged). Errors: sizes that do not match `count`, a
+  /// non-finite position, lifetime or velocity, a kind that is not 0, 1 or 2.
+  Status RestoreDiffuse(const HostDiffuse& diffuse);
   /// Changes the reuse parameters from the next step on (the panel, the benchmarks). Every particle
   /// starts active again (idle counts reset), so no particle reuses values from before the change.
   Status SetReuse(const ReuseParams& reuse);
