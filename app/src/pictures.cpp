@@ -227,6 +227,12 @@ render::FrameScene MakeFrameScene(const SimSnapshot& snapshot, render::RenderMod
     f.surface.vertexCount = static_cast<int>(snapshot.surface.VertexCount());
   }
   for (const PaddlePose& p : snapshot.paddles) AppendPaddleSolids(p, &f.solids);
+  if (mode == render::RenderMode::kWater && snapshot.diffuse.count > 0) {  // spray, foam and bubbles
+    f.diffuse.position = snapshot.diffuse.position.data();
+    f.diffuse.velocity = snapshot.diffuse.velocity.data();
+    f.diffuse.count = snapshot.diffuse.count;
+    f.diffuse.radius = 0.4f * snapshot.setup.params.spacing;
+  }
   return f;
 }
 

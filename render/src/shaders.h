@@ -388,7 +388,7 @@ void main() {
   vFade = clamp(p.w / 0.5, 0.0, 1.0);  // fades out over its last half second
   vec4 eye = uView * vec4(p.xyz, 1.0);
   vec3 velEye = mat3(uView) * vel.xyz;
-  float r = uParticle.z * (vKind == 0 ? 0.6 : 1.0);
+  float r = uParticle.z * (vKind == 0 ? 0.6 : (vKind == 2 ? 0.7 : 1.0));
   // Stretched along the velocity seen on the screen by the distance it moves in 1/60 s.
   vec2 dir = length(velEye.xy) > 1e-5 ? normalize(velEye.xy) : vec2(1.0, 0.0);
   float stretch = length(velEye.xy) / 60.0;
