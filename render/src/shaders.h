@@ -389,9 +389,9 @@ void main() {
   vec4 eye = uView * vec4(p.xyz, 1.0);
   vec3 velEye = mat3(uView) * vel.xyz;
   float r = uParticle.z * (vKind == 0 ? 0.6 : (vKind == 2 ? 0.7 : 1.0));
-  // Stretched along the velocity seen on the screen by the distance it moves in 1/60 s.
+  // Stretched along the velocity seen on the screen by the distance it moves in 1/90 s (a frame).
   vec2 dir = length(velEye.xy) > 1e-5 ? normalize(velEye.xy) : vec2(1.0, 0.0);
-  float stretch = length(velEye.xy) / 60.0;
+  float stretch = length(velEye.xy) / 90.0;
   vec2 along = dir * (r + 0.5 * stretch), across = vec2(-dir.y, dir.x) * r;
   eye.xy += c.x * along + c.y * across;
 #if !defined(DIFFUSE_BUBBLES)
@@ -413,7 +413,7 @@ void main() {
   // A bubble: a bright rim and a clear centre.
   float alpha = 0.55 * vFade * smoothstep(0.2, 0.9, r2) * (1.0 - smoothstep(0.9, 1.0, r2));
 #else
-  float alpha = (vKind == 1 ? 0.85 : 0.7) * soft * vFade;
+  float alpha = (vKind == 1 ? 0.85 : 0.45) * soft * vFade;  // foam dense, spray a mist of drops
 #endif
   vec3 light = vec3(0.92, 0.95, 1.0) * (0.55 + 0.45 * max(uSun.y, 0.0));
   outColor = vec4(light * alpha, alpha);  // premultiplied

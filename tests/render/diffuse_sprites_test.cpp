@@ -1,7 +1,7 @@
 // Spray, foam and bubbles as the renderer draws them (DiffusePass): a frame with them differs from the
 // same frame without them only where they are: spray and foam within their sprites' projected
 // footprints (a sprite is a disc of the diffuse radius, stretched along its velocity by the distance
-// it moves in 1/60 s), bubbles only inside the water (they are drawn behind its surface and seen through
+// it moves in 1/90 s), bubbles only inside the water (they are drawn behind its surface and seen through
 // its refraction); and at render quality low none are drawn.
 #include <cmath>
 #include <vector>
@@ -77,7 +77,7 @@ TEST_F(DiffuseSpritesTest, AFrameWithThemDiffersOnlyWhereTheyAre) {
     const glm::vec4 eyeP = v.view * glm::vec4(p, 1.0f);
     const float depth = -eyeP.z;
     const glm::vec2 c = Project(vp, p, v);
-    const float stretch = glm::length(glm::vec2(glm::mat3(v.view) * vel)) / 60.0f;
+    const float stretch = glm::length(glm::vec2(glm::mat3(v.view) * vel)) / 90.0f;
     const float reach = (radius + 0.5f * stretch) * pixelsPerMetre / std::max(depth - radius, 1e-3f) + 1.5f;
     return glm::length(glm::vec2(x + 0.5f, y + 0.5f) - c) <= reach;
   };

@@ -42,6 +42,7 @@ TEST_P(Stability, OneSecondOfDamBreak) {
   const Extreme& e = GetParam();
   app::SceneFile scene;
   ASSERT_TRUE(app::LoadScene(SPHXR_SCENES_DIR "/dam_break.json", &scene).ok());
+  scene.setup.params.diffuse = 0.0f;  // the water is the same bits without its spray (DiffuseTest), at less cost
   sim::SolverParams& p = scene.setup.params;
   p.spacing *= 2.0f * e.spacingScale;
   p.stiffness *= e.stiffnessScale;
