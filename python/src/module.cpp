@@ -1,8 +1,9 @@
 // sphxr._sphxr: the pybind11 extension under the sphxr package (python/sphxr/__init__.py wraps it).
 // docs/user/python.md describes the API. Arrays come out as NumPy arrays the module owns (copies: the
 // solver's buffers change order every step). Errors are sphxr.Error with the one-line Status message;
-// the GIL is released while the solver works, and Ctrl-C stops a long stepping call after the step in
-// progress (KeyboardInterrupt).
+// the GIL is released while the solver works, and Ctrl-C stops a long stepping call or a settle after
+// the step in progress (KeyboardInterrupt). Numbers and file names are checked by app/run_arguments.h,
+// as the command line checks them.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -11,8 +12,11 @@
 
 #include "run.h"
 #include "sphxr/app/param_registry.h"
+#include "sphxr/app/run_arguments.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
+#include "sphxr/sim/openmp_wait.h"
 
 namespace py = pybind11;
 
@@ -24,7 +28,7 @@ struct Error : std::runtime_error {
 };
 
 void Check(const Status& s) {
-  if (!s) throw Error(s.message());
+  if (!s) throw Error(app::ShownMessage(s.message()));
 }
 
 template <typename T>
@@ -34,7 +38,8 @@ py::array_t<T> Array(const std::vector<T>& v, std::vector<py::ssize_t> shape) {
   return a;
 }
 
-/// Runs `work` without the GIL; a Ctrl-C arriving meanwhile stops it (KeyboardInterrupt afterwards).
+/// Runs `work` without the GIL; a Ctrl-C arriving meanwhile stops it after the step in progress
+/// (KeyboardInterrupt afterwards, or whatever exception a signal handler raised).
 Status Unlocked(const std::function<Status(const KeepGoing&)>& work) {
   bool interrupted = false;
   Status s;
@@ -52,12 +57,7 @@ Status Unlocked(const std::function<Status(const KeepGoing&)>& work) {
 
 std::unique_ptr<Run> Make(const RunOptions& options) {
   std::unique_ptr<Run> run;
-  Status s;
-  {
-    py::gil_scoped_release release;
-    s = Run::Create(options, &run);
-  }
-  Check(s);
+  Check(Unlocked([&](const KeepGoing& go) { return Run::Create(options, &run, go); }));
   return run;
 }
 
@@ -77,6 +77,7 @@ py::dict Parameters(const sim::SceneSetup& setup) {
 }
 
 py::dict ReadState(const std::string& path) {
+  Check(app::CheckPathArgument("read_state", path));
   app::StateFile state;
   Status s;
   {
@@ -118,6 +119,8 @@ PYBIND11_MODULE(_sphxr, m) {
   m.doc() = "sphxr: SPH water runs from Python (docs/user/python.md); use the sphxr package, not _sphxr";
   py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
   m.attr("build_scenes_dir") = SPHXR_SCENES_DIR;
+  m.attr("max_scene_depth") = sphxr::app::kMaxSceneDepth;
+  m.attr("max_run_time") = sphxr::app::kMaxRunTime;
 
   py::class_<RunOptions>(m, "RunOptions")
       .def(py::init<>())
@@ -137,10 +140,11 @@ PYBIND11_MODULE(_sphxr, m) {
   py::class_<Run>(m, "Run")
       .def(py::init(&Make), py::arg("options"))
       .def("step", [](Run& r, int64_t n) {
-        if (n < 0) throw Error("step: a number of steps from 0 on");
+        Check(sphxr::app::CheckRunArgument("step", static_cast<double>(n)));
         Check(Unlocked([&](const KeepGoing& go) { return r.Step(n, 0.0, go); }));
       }, py::arg("n") = 1)
       .def("run_to", [](Run& r, double t) {
+        Check(sphxr::app::CheckRunArgument("run_to", t));
         Check(Unlocked([&](const KeepGoing& go) { return r.Step(-1, t, go); }));
       }, py::arg("time"))
       .def("run_scene", [](Run& r) { Check(Unlocked([&](const KeepGoing& go) { return r.RunScene(go); })); })
@@ -214,6 +218,7 @@ PYBIND11_MODULE(_sphxr, m) {
 
   m.def("read_state", &ReadState, py::arg("path"));
   m.def("scene_info", [](const std::string& name, const std::string& installDir, const std::vector<std::string>& sets) {
+    Check(sphxr::app::CheckPathArgument("scene_info", name));
     sphxr::app::SceneFile scene;
     std::string path;
     Check(sphxr::app::FindScene(name, &path, installDir));
@@ -231,6 +236,7 @@ PYBIND11_MODULE(_sphxr, m) {
     return d;
   }, py::arg("name"), py::arg("install_dir") = "", py::arg("sets") = std::vector<std::string>{});
   m.def("find_scene", [](const std::string& name, const std::string& installDir) {
+    Check(sphxr::app::CheckPathArgument("find_scene", name));
     std::string path;
     Check(sphxr::app::FindScene(name, &path, installDir));
     return path;
@@ -243,8 +249,22 @@ PYBIND11_MODULE(_sphxr, m) {
     for (const auto& [name, value] : kLevels) {
       if (level == name) return sphxr::SetLogLevel(value);
     }
-    throw Error("set_log_level " + level + ": must be debug, info, warn, error or off");
+    throw Error("set_log_level " + sphxr::ShowText(level) + ": must be debug, info, warn, error or off");
   }, py::arg("level"));
+  // The run arguments' one check and parser (app/run_arguments.h), for the package and the sweeps: the
+  // value (a float) when it passes, else sphxr.Error with the command line's message.
+  m.def("check_argument", [](const std::string& name, double value) {
+    Check(sphxr::app::CheckRunArgument(name, value));
+    return value;
+  }, py::arg("name"), py::arg("value"));
+  m.def("parse_argument", [](const std::string& name, const std::string& text) {
+    double value = 0.0;
+    Check(sphxr::app::ParseRunArgument(name, text, &value));
+    return value;
+  }, py::arg("name"), py::arg("text"));
+  m.def("show_text", [](const std::string& text, size_t maxBytes) { return sphxr::ShowText(text, maxBytes); },
+        py::arg("text"), py::arg("max_bytes") = sphxr::kShownLength);
+  m.def("max_threads", &sphxr::sim::MaxSolverThreads);
   m.def("parameter_names", [] {
     std::vector<std::string> names = {"method", "density"};
     for (const sphxr::app::ParamDesc& p : sphxr::app::ParamRegistry()) names.push_back(p.group == "solver" ? p.name : p.key);
