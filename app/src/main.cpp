@@ -69,6 +69,7 @@ int Main(int argc, char** argv) {
     sphxr::app::XrOutcome outcome;
     const sphxr::Status s = sphxr::app::RunXr(options, &outcome);
     const bool display = sphxr::app::DisplayAvailable();
+    if (s && outcome.interrupted) return 128 + outcome.interrupted;  // the shell's convention, as headless
     if (s && !outcome.lost) return 0;
     if (!s && !outcome.fallback) {
       std::fprintf(stderr, "sphxr: error: %s\n", sphxr::app::ShownMessage(s.message()).c_str());
