@@ -118,6 +118,10 @@ TEST(RunArguments, AMissingScenesNameIsShownOnceEscapedAndCut) {
   const Status s = FindScene(name, &path);
   ExpectOneLine(s, {"--scene x\\x1B]0;t\\x07aaa", "... (100007 bytes): no scene of that name"});
   EXPECT_EQ(s.message().find("aaaa", s.message().find("bytes)")), std::string::npos) << "the name twice: " << s.message();
+  // A path that cannot be read: the reason survives the name's length.
+  SceneFile scene;
+  const std::string far = "/no_such_folder/" + std::string(100000, 'b') + "\x1b";
+  ExpectOneLine(LoadScene(far, &scene), {"/no_such_folder/bbb", "... (100017 bytes): cannot open the scene file"});
 }
 
 #ifdef SPHXR_BINARY
