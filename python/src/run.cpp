@@ -98,7 +98,6 @@ Run::~Run() {
   if (m_probesTemporary) std::remove(m_probesPath.c_str());
 }
 
-
 Status Run::Create(const RunOptions& options, std::unique_ptr<Run>* out, const KeepGoing& keepGoing) {
   out->reset();
   if (Status s = CheckOptions(options); !s) return s;

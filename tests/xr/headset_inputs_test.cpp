@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <array>
 #include <cmath>
 
 #include "pose_script.h"
@@ -103,6 +104,21 @@ TEST(XrHeadsetInputs, SettingsThatAreNotFiniteAreRefusedInOneLine) {
     EXPECT_EQ(CountOf(r.out, name + "='" + value + "' is not a number in ["), 1) << r.out;
     EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
     EXPECT_EQ(CountOf(r.out, "sphxr --xr:"), 0) << r.out;
+  }
+}
+
+TEST(XrHeadsetInputs, AHapticsLogOrAnEyeSizeThatCannotBeUsedIsOneLine) {
+  const auto dir = TempDir("inputs_haptics");
+  const std::string fifo = MakeFifo(dir).string();
+  for (const auto& [name, value, message] : std::vector<std::array<std::string, 3>>{
+           {"SPHXR_SIM_XR_HAPTICS_LOG", fifo, "' is not a regular file"},
+           {"SPHXR_SIM_XR_EYE_SIZE", "64x48junk", "' is not WIDTHxHEIGHT (1..8192)"}}) {
+    SimHeadset headset("inputs_haptics_run");
+    headset.env.Set(name, value);
+    const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon, headset.dir);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(CountOf(r.out, name + "='" + value + message), 1) << r.out;
+    EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
   }
 }
 

@@ -50,7 +50,8 @@ XrResult ReadConfig(Config* c, std::string* error) {
       !num("SPHXR_SIM_XR_LOSE_INSTANCE_AFTER_FRAMES", 0, 1e12, &c->loseInstanceAfterFrames))
     return XR_ERROR_INITIALIZATION_FAILED;
   if (std::string size = Env("SPHXR_SIM_XR_EYE_SIZE"); !size.empty()) {
-    if (std::sscanf(size.c_str(), "%dx%d", &c->eyeWidth, &c->eyeHeight) != 2 || c->eyeWidth < 1 ||
+    char tail = 0;
+    if (std::sscanf(size.c_str(), "%dx%d%c", &c->eyeWidth, &c->eyeHeight, &tail) != 2 || c->eyeWidth < 1 ||
         c->eyeHeight < 1 || c->eyeWidth > 8192 || c->eyeHeight > 8192) {
       *error = "SPHXR_SIM_XR_EYE_SIZE='" + Shown(size) + "' is not WIDTHxHEIGHT (1..8192)";
       return XR_ERROR_INITIALIZATION_FAILED;
@@ -67,6 +68,11 @@ XrResult ReadConfig(Config* c, std::string* error) {
     return XR_ERROR_INITIALIZATION_FAILED;
   }
   c->hapticsLogPath = Env("SPHXR_SIM_XR_HAPTICS_LOG");
+  // A FIFO would block the instance's creation until a reader came; a device is no log.
+  if (struct stat st {}; !c->hapticsLogPath.empty() && stat(c->hapticsLogPath.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    *error = "SPHXR_SIM_XR_HAPTICS_LOG='" + Shown(c->hapticsLogPath) + "' is not a regular file";
+    return XR_ERROR_INITIALIZATION_FAILED;
+  }
   c->failSessionCreate = Env("SPHXR_SIM_XR_FAIL_SESSION") == "1";
   return XR_SUCCESS;
 }
