@@ -321,23 +321,31 @@ def check_out(path):
         raise SweepError("--out %s: the folder %s does not exist; make it first" % (shown(path), shown(folder)))
 
 
-def write_table(path, keys, cases, rows):
-    """The table, replaced atomically (a temporary file beside it, then os.replace): a reader or a kill
-    sees the old table or the new one, never half of one."""
+def format_table(f, keys, cases, rows):
+    """The table as CSV into the open file `f`: a row per case, its parameters and measures."""
     columns = ["case"] + [shown(k) for k in keys] + ["status", "attempts"]
     for r in rows:
         for c in r:
             if c not in columns:
                 columns.append(c)
+    w = csv.DictWriter(f, fieldnames=columns, restval="")
+    w.writeheader()
+    for k, (case, r) in enumerate(zip(cases, rows)):
+        row = {c: shown(v, 1000) if isinstance(v, str) else v for c, v in r.items()}
+        w.writerow(dict(row, case=k, **{shown(c): shown(v) for c, v in case.items()}))
+
+
+def write_table(path, keys, cases, rows):
+    """The table, replaced atomically (a temporary file beside it, then os.replace): a reader or a kill
+    sees the old table or the new one, never half of one."""
     folder, name = os.path.split(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix="." + name + ".", suffix=".tmp", dir=folder)
     try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)  # as open() would make it (mkstemp's is 0600)
         with os.fdopen(fd, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=columns, restval="")
-            w.writeheader()
-            for k, (case, r) in enumerate(zip(cases, rows)):
-                row = {c: shown(v, 1000) if isinstance(v, str) else v for c, v in r.items()}
-                w.writerow(dict(row, case=k, **{shown(c): shown(v) for c, v in case.items()}))
+            format_table(f, keys, cases, rows)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
@@ -406,7 +414,23 @@ def run_sweep(args):
 
     say = (lambda *a: None) if args.quiet else (lambda msg: print("sphxr.sweep: " + msg, file=sys.stderr, flush=True))
     stopped_by = None
+    unwritten = None  # why the table could not be written as the last case finished (a full disk)
     done = failed = 0
+
+    def save():
+        """Writes the table; a failure (a full disk) is said once, and the sweep goes on: the rows are
+        kept, and written when the table next can be, or printed at the end."""
+        nonlocal unwritten
+        try:
+            write_table(args.out, keys, cases, rows)
+            if unwritten is not None:
+                say("the table %s is written again" % shown(args.out))
+            unwritten = None
+        except OSError as e:
+            if unwritten is None:
+                say("cannot write the table %s (%s): its rows are kept" % (shown(args.out), e.strerror or e))
+            unwritten = e.strerror or str(e)
+
     cluster = client = None
 
     def stop(signum, frame):
@@ -449,7 +473,7 @@ def run_sweep(args):
             done += 1
             ok = rows[k]["status"] == "ok"
             failed += 0 if ok else 1
-            write_table(args.out, keys, cases, rows)
+            save()
             say("[%d/%d, %d failed, %.0f s] case %d %s: %s%s%s" % (
                 done, len(cases), failed, time.time() - begin, k, label(cases[k]), shown(rows[k]["status"]),
                 " in %.1f s" % rows[k]["wall_s"] if ok else "",
@@ -458,9 +482,6 @@ def run_sweep(args):
         stopped_by = signal.SIGINT
     except Stopped as e:
         stopped_by = e.signum
-    except OSError as e:  # the table could not be written as a case finished (a full disk)
-        raise SweepError("--out %s: cannot write the table (%s); %d case(s) had finished"
-                         % (shown(args.out), e.strerror or e, done)) from None
     finally:
         # Further signals wait: the table is written once more, then the cluster closes.
         for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
@@ -470,11 +491,9 @@ def run_sweep(args):
             for k in range(len(rows)):
                 if rows[k]["status"] in ("not started", "not finished"):
                     rows[k] = {"status": "not finished (the sweep was stopped by %s)" % name, "attempts": 0}
-            try:
-                write_table(args.out, keys, cases, rows)
-            except OSError as e:
-                say("cannot write the table %s (%s)" % (shown(args.out), e.strerror or e))
-            say("stopped by %s: %d of %d case(s) finished, written to %s" % (name, done, len(cases), shown(args.out)))
+            save()
+            say("stopped by %s: %d of %d case(s) finished%s" % (
+                name, done, len(cases), ", written to %s" % shown(args.out) if unwritten is None else ""))
         if client is not None:
             client.close()
         if cluster is not None:
@@ -482,8 +501,16 @@ def run_sweep(args):
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         signal.signal(signal.SIGINT, signal.default_int_handler)
+    if unwritten is not None:
+        # The rows that could not reach --out are not lost: the table goes to stdout.
+        print("sphxr.sweep: error: --out %s: cannot write the table (%s): it follows on stdout"
+              % (shown(args.out), unwritten), file=sys.stderr, flush=True)
+        format_table(sys.stdout, keys, cases, rows)
+        sys.stdout.flush()
     if stopped_by is not None:
         return 128 + int(stopped_by)
+    if unwritten is not None:
+        return 2
     say("wrote %d row(s) to %s (%d failed)" % (len(rows), shown(args.out), failed))
     return 0 if failed == 0 else 1
 

@@ -89,3 +89,41 @@ def test_control_characters_reach_neither_the_progress_line_nor_the_table(tmp_pa
     assert rows[1]["method"] == "\\x1B]0;owned\\x07\\u202E", rows[1]
     assert rows[1]["status"].startswith("failed: ") and "\\x1B]0;owned" in rows[1]["status"], rows[1]
     assert "case 1 method=\\x1B]0;owned\\x07\\u202E: failed: " in out, out
+
+
+def test_a_table_that_cannot_be_written_as_cases_finish_goes_to_stdout(tmp_path):
+    # A file limit of 400 bytes (RLIMIT_FSIZE, as a disk that fills): the first table (every case "not
+    # started") fits, a table with a finished row does not. The sweep goes on, keeps its rows, and
+    # prints the table on stdout at the end; the file on disk stays the last whole table.
+    import resource
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (400, 400))
+
+    out_csv = tmp_path / "table.csv"
+    args = ["dam_break", "--steps", 3, "--set", "spacing=0.02", "--grid", "stiffness=31000,32000", "--workers", 1,
+            "--out", out_csv]
+    r = subprocess.run([sys.executable, "-m", "sphxr.sweep"] + [str(a) for a in args], cwd=tmp_path,
+                       preexec_fn=limit, capture_output=True, text=True, timeout=240)
+    assert r.returncode == 2, r.stderr
+    assert "Traceback" not in r.stderr
+    assert r.stderr.count("cannot write the table %s (File too large): its rows are kept" % out_csv) == 1, r.stderr
+    assert ("sphxr.sweep: error: --out %s: cannot write the table (File too large): it follows on stdout" % out_csv
+            in r.stderr), r.stderr
+    rows = list(csv.DictReader(r.stdout.splitlines()))
+    assert [(row["stiffness"], row["status"], row["steps"]) for row in rows] == [("31000", "ok", "3"), ("32000", "ok", "3")]
+    on_disk = read_table(out_csv)
+    assert [row["status"] for row in on_disk] == ["not started", "not started"]
+    assert not [f for f in os.listdir(tmp_path) if f.endswith(".tmp")]
+
+
+def test_the_table_is_made_as_open_makes_a_file(tmp_path, tiny_scene_file):
+    out_csv = tmp_path / "table.csv"
+    old = os.umask(0o022)
+    try:
+        code, out = finish(start([tiny_scene_file, "--steps", 2, "--workers", 1, "--out", out_csv], tmp_path))
+    finally:
+        os.umask(old)
+    assert code == 0, out
+    assert os.stat(out_csv).st_mode & 0o777 == 0o644
