@@ -166,6 +166,19 @@ TEST(XrHeadsetInputs, ALostSessionOfALongScenesNameStillSaves) {
   EXPECT_EQ(CountOf(r.out, "save state:"), 0) << r.out;  // no failed save
 }
 
+TEST(XrHeadsetInputs, ALostSessionThatCannotSaveBesideItSavesInTheTemporaryFolder) {
+  SimHeadset headset("inputs_lost_fallback");
+  headset.env.Set("SPHXR_SIM_XR_LOSE_SESSION_AFTER_FRAMES", "5");
+  // The working directory's "<scene>-lost.state" is a folder: that save fails.
+  std::filesystem::create_directories(headset.dir / "xr_inputs_tank-lost.state");
+  std::filesystem::create_directories(headset.dir / "tmp");
+  headset.env.Set("TMPDIR", (headset.dir / "tmp").string());
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 5" + kCommon, headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "the XR session was lost"), 1) << r.out;
+  EXPECT_TRUE(std::filesystem::is_regular_file(headset.dir / "tmp" / "xr_inputs_tank-lost.state")) << r.out;
+}
+
 /// `sphxr args` in `dir`, its output to sphxr_out.txt; the child's pid.
 pid_t Spawn(const std::vector<std::string>& args, const std::filesystem::path& dir) {
   const std::string output = (dir / "sphxr_out.txt").string();
