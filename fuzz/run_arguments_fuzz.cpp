@@ -21,7 +21,7 @@ void ExpectOneLine(const sphxr::Status& s) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static constexpr const char* kNames[] = {"--time", "--steps", "--settle", "--threads", "--workers",
-                                           "run_to", "advance",  "step",     "settle",    "threads"};
+                                           "run_to", "advance", "step",     "settle",    "threads"};
   if (size == 0) return 0;
   const char* name = kNames[data[0] % (sizeof(kNames) / sizeof(kNames[0]))];
   const std::string_view text(reinterpret_cast<const char*>(data + 1), size - 1);

@@ -80,11 +80,10 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
                 static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds, summary->settle.maxAccel);
   }
   if (summary->interrupted) {
-    std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n",
-                InterruptName(summary->interrupted),
+    std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n", InterruptName(summary->interrupted),
                 summary->simulatedTime,
                 target.steps > 0 ? Format("%lld steps", static_cast<long long>(target.steps)).c_str()
-                                : Format("%.4g s", target.time).c_str());
+                                 : Format("%.4g s", target.time).c_str());
   }
   std::printf("  particles lost  %lld (clamped back into the tank: %lld times, %.3g per 1,000 particle-steps%s%s)\n",
               static_cast<long long>(summary->lost), static_cast<long long>(summary->clampedEvents),

@@ -1,7 +1,5 @@
 #include "headless_sinks.h"
 
-#include "csv_continue.h"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -14,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "csv_continue.h"
 #include "sphxr/app/export.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
@@ -194,8 +193,8 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
       if (std::filesystem::is_regular_file(m_path, ec) && std::getline(earlier, first) &&
           first.rfind("step,time,", 0) == 0 && first != header) {
         return Status::Error("--stats " + ShowText(m_path) + ": the earlier run's rows there have other columns (" +
-                             ShowText(first.substr(first.find(',', 10) + 1), 60) + "; this run's: " +
-                             ShowText(header.substr(header.find(',', 10) + 1), 60) +
+                             ShowText(first.substr(first.find(',', 10) + 1), 60) +
+                             "; this run's: " + ShowText(header.substr(header.find(',', 10) + 1), 60) +
                              "): continuing into it would rewrite them; give another --stats file");
       }
     }
@@ -207,7 +206,8 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
     m_out << header << "\n";
   }
   m_out.flush();
-  m_whole = std::filesystem::is_regular_file(m_path, ec) ? static_cast<int64_t>(std::filesystem::file_size(m_path, ec)) : -1;
+  m_whole =
+      std::filesystem::is_regular_file(m_path, ec) ? static_cast<int64_t>(std::filesystem::file_size(m_path, ec)) : -1;
   if (ec) m_whole = -1;
   return Status::Ok();
 }
@@ -251,8 +251,8 @@ Status StatsSink::Flush() {
   if (!m_out) {
     m_out.close();  // nothing more is written: what reached the file ends at its last whole row
     CutToWholeRows();
-    return Status::Error("--stats " + ShowText(m_path) + ": write failed (" + (error ? std::strerror(error) : "disk full?") +
-                         "); the file ends at its last whole row");
+    return Status::Error("--stats " + ShowText(m_path) + ": write failed (" +
+                         (error ? std::strerror(error) : "disk full?") + "); the file ends at its last whole row");
   }
   if (m_whole >= 0) m_whole += static_cast<int64_t>(written);
   return Status::Ok();
@@ -280,7 +280,8 @@ Status StatsSink::Finish(Simulation&, bool) {
     m_out.close();
     if (m_out.fail()) {
       CutToWholeRows();
-      return Status::Error("--stats " + ShowText(m_path) + ": write failed (disk full?); the file ends at its last whole row");
+      return Status::Error("--stats " + ShowText(m_path) +
+                           ": write failed (disk full?); the file ends at its last whole row");
     }
   }
   return Status::Ok();

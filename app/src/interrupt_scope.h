@@ -56,7 +56,8 @@ class InterruptScope {
   InterruptScope& operator=(const InterruptScope&) = delete;
 
  private:
-  struct sigaction m_int {}, m_term {}, m_hup {};
+  struct sigaction m_int {
+  }, m_term{}, m_hup{};
 };
 
 }  // namespace sphxr::app

@@ -3,10 +3,10 @@
 // one line saying why: no runtime -> the desktop window; no window -> headless; a session lost mid-run ->
 // the desktop window (or exit when there is no display or the --frame-limit is reached).
 #include <cstdio>
-#include <filesystem>
-#include <optional>
 #include <exception>
+#include <filesystem>
 #include <new>
+#include <optional>
 #include <string>
 
 #include "sphxr/app/desktop.h"

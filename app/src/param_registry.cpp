@@ -1,14 +1,13 @@
 #include "sphxr/app/param_registry.h"
 
-#include "sphxr/app/probe_csv.h"
-
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "sphxr/sim/solver_table.h"
+#include "sphxr/app/probe_csv.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
 namespace {

@@ -158,7 +158,8 @@ Status ProbeCsv::Flush() {
   const int error = errno;
   m_pending.clear();
   if (!ok) {
-    return Status::Error("--probes " + ShowText(m_path) + ": write failed (" + (error ? std::strerror(error) : "disk full?") + ")");
+    return Status::Error("--probes " + ShowText(m_path) + ": write failed (" +
+                         (error ? std::strerror(error) : "disk full?") + ")");
   }
   return Status::Ok();
 }

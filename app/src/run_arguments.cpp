@@ -32,8 +32,9 @@ Status Check(const RunArgumentRule& rule, const std::string& shown, double value
   if (!std::isfinite(value)) return Status::Error(name + " " + shown + ": not a finite number");
   const double max = rule.max < 0.0 ? static_cast<double>(sim::MaxSolverThreads()) : rule.max;
   if (value < rule.min || value > max) {
-    return Status::Error(Format("%s %s: must be from %s to %s%s%s", name.c_str(), shown.c_str(), ShowNumber(rule.min).c_str(),
-                                ShowNumber(max).c_str(), rule.what.empty() ? "" : " ", std::string(rule.what).c_str()));
+    return Status::Error(Format("%s %s: must be from %s to %s%s%s", name.c_str(), shown.c_str(),
+                                ShowNumber(rule.min).c_str(), ShowNumber(max).c_str(), rule.what.empty() ? "" : " ",
+                                std::string(rule.what).c_str()));
   }
   if (rule.integer && value != std::floor(value)) return Status::Error(name + " " + shown + ": not a whole number");
   return Status::Ok();
@@ -62,7 +63,8 @@ Status ParseRunArgument(std::string_view name, std::string_view text, double* ou
   const std::string shown = ShowText(text, 40), flag(name);
   const std::string copy(text);
   if (copy.size() != std::string(copy.c_str()).size()) return Status::Error(flag + " " + shown + ": not a number");
-  if (copy.find_first_of("xXpP") != std::string::npos) return Status::Error(flag + " " + shown + ": not a decimal number");
+  if (copy.find_first_of("xXpP") != std::string::npos)
+    return Status::Error(flag + " " + shown + ": not a decimal number");
   char* end = nullptr;
   double v = 0.0;
   if (rule->integer) {  // digits only, as the shell's users write a count ("1e3" is not one)
@@ -70,7 +72,8 @@ Status ParseRunArgument(std::string_view name, std::string_view text, double* ou
     const long long n = std::strtoll(copy.c_str(), &end, 10);
     v = errno == ERANGE ? (n < 0 ? -HUGE_VAL : HUGE_VAL) : static_cast<double>(n);
     if (errno == ERANGE && !copy.empty() && *end == '\0') {
-      return Status::Error(Format("%s %s: must be from %s to %s", flag.c_str(), shown.c_str(), ShowNumber(rule->min).c_str(),
+      return Status::Error(Format("%s %s: must be from %s to %s", flag.c_str(), shown.c_str(),
+                                  ShowNumber(rule->min).c_str(),
                                   ShowNumber(rule->max < 0.0 ? sim::MaxSolverThreads() : rule->max).c_str()));
     }
   } else {

@@ -23,7 +23,8 @@ Status ReadTextFile(const std::string& path, const char* what, size_t maxBytes, 
     struct stat st {};
     const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
     ::close(fd);
-    if (!regular) return Status::Error(ShowText(path) + ": not a regular file (a pipe or device): give a " + what + " on disk");
+    if (!regular)
+      return Status::Error(ShowText(path) + ": not a regular file (a pipe or device): give a " + what + " on disk");
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Error(ShowText(path) + ": cannot open the " + what);

@@ -11,11 +11,11 @@
 #include <numeric>
 #include <sstream>
 
-#include "sphxr/sim/measure.h"
 #include "sphxr/app/run_arguments.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/text_file.h"
+#include "sphxr/sim/measure.h"
 
 namespace sphxr::python {
 

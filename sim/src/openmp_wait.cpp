@@ -65,9 +65,10 @@ Status CheckThreadsCanStart(int threads, const std::string& what) {
   pthread_mutex_unlock(&gate.mutex);
   for (pthread_t t : started) pthread_join(t, nullptr);
   if (error == 0) return Status::Ok();
-  return Status::Error(Format("%s: this process cannot start %d threads (it started %zu more: %s; a limit on "
-                              "processes, ulimit -u?); give fewer threads",
-                              what.c_str(), threads, started.size(), std::strerror(error)));
+  return Status::Error(
+      Format("%s: this process cannot start %d threads (it started %zu more: %s; a limit on "
+             "processes, ulimit -u?); give fewer threads",
+             what.c_str(), threads, started.size(), std::strerror(error)));
 }
 
 }  // namespace sphxr::sim

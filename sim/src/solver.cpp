@@ -10,10 +10,10 @@
 
 #include "backend.h"
 #include "sampling.h"
+#include "scene_check.h"
 #include "sphxr/common/log.h"
 #include "sphxr/sim/openmp_wait.h"
 #include "sphxr/sim/solver_table.h"
-#include "scene_check.h"
 
 namespace sphxr::sim {
 namespace {
@@ -202,8 +202,7 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
       return Status::Error("--device cuda: no CUDA device available (no GPU or no driver); use --device cpu or auto");
     }
     solver->m_backend = MakeCudaBackend(&why);
-  } else if (Status t = CheckThreadsCanStart(config.threads, Format("threads %d", config.threads));
-             !t) {
+  } else if (Status t = CheckThreadsCanStart(config.threads, Format("threads %d", config.threads)); !t) {
     return t;
   } else if (device == Device::kCpuReference) {
     solver->m_backend = MakeCpuReferenceBackend(config.threads);

@@ -2,6 +2,8 @@
 // the sweeps: the same bounds and messages, thread counts bounded by the machine and by what the
 // process may start, range messages with the digits that put a value out, a scene name echoed once.
 // (The module's side: tests/python/test_run_arguments.py.)
+#include "sphxr/app/run_arguments.h"
+
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -13,7 +15,6 @@
 
 #include "sphxr/app/cli.h"
 #include "sphxr/app/param_registry.h"
-#include "sphxr/app/run_arguments.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/common/shown_text.h"
 #include "sphxr/sim/openmp_wait.h"
@@ -26,7 +27,8 @@ namespace {
 void ExpectOneLine(const Status& s, const std::vector<std::string>& needles, size_t longest = 400) {
   ASSERT_FALSE(s.ok()) << "accepted";
   const std::string& m = s.message();
-  for (const std::string& n : needles) EXPECT_NE(m.find(n), std::string::npos) << "no '" << n << "' in " << m.substr(0, 400);
+  for (const std::string& n : needles)
+    EXPECT_NE(m.find(n), std::string::npos) << "no '" << n << "' in " << m.substr(0, 400);
   EXPECT_LT(m.size(), longest) << m.substr(0, 400);
   EXPECT_TRUE(IsPlainText(m)) << ShowText(m, 400);
 }
@@ -59,13 +61,19 @@ TEST(RunArguments, TheCommandLineAndTheModuleShareTheBoundsAndTheMessages) {
   }
   ExpectOneLine(ParseArgs({"--time", "nan"}), {"--time nan: not a finite number"});
   ExpectOneLine(ParseArgs({"--steps", "-5"}), {"--steps -5: must be from 1 to 1099511627776"});
-  ExpectOneLine(CheckRunArgument("run_to", std::numeric_limits<double>::infinity()), {"run_to inf: not a finite number"});
+  ExpectOneLine(CheckRunArgument("run_to", std::numeric_limits<double>::infinity()),
+                {"run_to inf: not a finite number"});
   ExpectOneLine(CheckRunArgument("advance", -0.5), {"advance -0.5: must be from 0 to 1e+06 s"});
   ExpectOneLine(CheckRunArgument("step", 2.5), {"step 2.5: not a whole number"});
   double v = 0.0;
   ExpectOneLine(ParseRunArgument("--workers", "0", &v), {"--workers 0: must be from 1 to"});
   ExpectOneLine(ParseRunArgument("--time", "0x10", &v), {"--time 0x10: not a decimal number"});
-  ExpectOneLine(ParseRunArgument("--time", std::string("1\0" "2", 3), &v), {"--time 1\\x002: not a number"});
+  ExpectOneLine(ParseRunArgument("--time",
+                                 std::string("1\0"
+                                             "2",
+                                             3),
+                                 &v),
+                {"--time 1\\x002: not a number"});
   ASSERT_TRUE(ParseRunArgument("--time", "0.25", &v).ok());
   EXPECT_EQ(v, 0.25);
 }
@@ -95,17 +103,18 @@ TEST(RunArguments, AFileNameWithANulByteIsRefused) {
 TEST(RunArguments, ARangeMessageShowsTheDigitsThatPutTheValueOut) {
   // pbf_relaxation is from 1e-06 to 10: 10.0000001 printed as "10" read "10 is out of range".
   SceneFile scene;
-  ExpectOneLine(ParseScene(R"({"tank": {"min": [0, 0, 0], "max": [1, 1, 1]}, "solver": {"pbf_relaxation": 10.0000001}})",
-                           "x.json", &scene),
-                {"10.0000001 is out of range: must be from 1e-06 to 10"});
+  ExpectOneLine(
+      ParseScene(R"({"tank": {"min": [0, 0, 0], "max": [1, 1, 1]}, "solver": {"pbf_relaxation": 10.0000001}})",
+                 "x.json", &scene),
+      {"10.0000001 is out of range: must be from 1e-06 to 10"});
   // The registry's check (--set reuse.*, the panel): a value a ten-millionth past the top.
   const ParamDesc* threshold = FindParam("reuse.threshold");
   ASSERT_NE(threshold, nullptr);
   sim::SceneSetup setup;
   const double past = threshold->max * (1.0 + 1e-7);
   ExpectOneLine(SetParam(*threshold, past, "reuse.threshold", &setup),
-                {"reuse.threshold: " + ShowNumber(past) + " is out of range: must be from " + ShowNumber(threshold->min) +
-                 " to " + ShowNumber(threshold->max)});
+                {"reuse.threshold: " + ShowNumber(past) + " is out of range: must be from " +
+                 ShowNumber(threshold->min) + " to " + ShowNumber(threshold->max)});
   EXPECT_NE(ShowNumber(past), ShowNumber(threshold->max));
   EXPECT_EQ(ShowNumber(10.0000001), "10.0000001");
   EXPECT_EQ(ShowNumber(1e-6), "1e-06");
@@ -117,7 +126,8 @@ TEST(RunArguments, AMissingScenesNameIsShownOnceEscapedAndCut) {
   const std::string name = "x\x1b]0;t\x07" + std::string(100000, 'a');
   const Status s = FindScene(name, &path);
   ExpectOneLine(s, {"--scene x\\x1B]0;t\\x07aaa", "... (100007 bytes): no scene of that name"});
-  EXPECT_EQ(s.message().find("aaaa", s.message().find("bytes)")), std::string::npos) << "the name twice: " << s.message();
+  EXPECT_EQ(s.message().find("aaaa", s.message().find("bytes)")), std::string::npos)
+      << "the name twice: " << s.message();
   // A path that cannot be read: the reason survives the name's length.
   SceneFile scene;
   const std::string far = "/no_such_folder/" + std::string(100000, 'b') + "\x1b";

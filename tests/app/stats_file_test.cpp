@@ -71,9 +71,10 @@ std::vector<std::string> ErrorLines(const std::string& err) {
 TEST(StatsFileProcess, AFullDiskEndsTheFileAtAWholeRowWithOneLine) {
   test::TempDir dir("stats_full");
   const std::string scene = dir.Write("scene.json", kScene), csv = dir.File("stats.csv");
-  const Result r = RunSphxr(dir, {"--headless", "--scene", scene, "--steps", "3000", "--stats", csv, "--threads", "1",
-                             "--no-progress"},
-                       20000);
+  const Result r =
+      RunSphxr(dir,
+               {"--headless", "--scene", scene, "--steps", "3000", "--stats", csv, "--threads", "1", "--no-progress"},
+               20000);
   EXPECT_EQ(r.code, 1) << r.err;
   const std::vector<std::string> errors = ErrorLines(r.err);
   ASSERT_EQ(errors.size(), 1u) << r.err;
@@ -86,13 +87,15 @@ TEST(StatsFileProcess, AFullDiskEndsTheFileAtAWholeRowWithOneLine) {
   EXPECT_EQ(text.back(), '\n') << "a torn last row: ..." << text.substr(text.size() - 80);
   const std::vector<std::string> rows = test::Lines(text);
   const auto commas = std::count(rows[0].begin(), rows[0].end(), ',');
-  for (size_t i = 1; i < rows.size(); ++i) ASSERT_EQ(std::count(rows[i].begin(), rows[i].end(), ','), commas) << "row " << i;
+  for (size_t i = 1; i < rows.size(); ++i)
+    ASSERT_EQ(std::count(rows[i].begin(), rows[i].end(), ','), commas) << "row " << i;
 }
 
 TEST(StatsFileProcess, ContinuingUnderAnotherMethodKeepsTheEarlierRowsAndRefuses) {
   test::TempDir dir("stats_method");
   const std::string scene = dir.Write("scene.json", kScene), csv = dir.File("stats.csv"), state = dir.File("a.state");
-  const std::vector<std::string> common = {"--headless", "--scene", scene, "--threads", "1", "--no-progress", "--stats", csv};
+  const std::vector<std::string> common = {"--headless", "--scene",       scene,     "--threads",
+                                           "1",          "--no-progress", "--stats", csv};
   std::vector<std::string> first = common;
   first.insert(first.end(), {"--steps", "20", "--save-state", state});
   Result r = RunSphxr(dir, first);

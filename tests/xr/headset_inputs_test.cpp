@@ -31,8 +31,8 @@ std::string ReadText(const std::filesystem::path& path) {
 
 AppRun RunSphxr(const std::string& args, const std::filesystem::path& dir) {
   const std::filesystem::path output = dir / "sphxr_out.txt";
-  const std::string cmd = "cd '" + std::filesystem::absolute(dir).string() + "' && timeout 60 " + std::string(SPHXR_BINARY) +
-                          " " + args + " >" + output.string() + " 2>&1";
+  const std::string cmd = "cd '" + std::filesystem::absolute(dir).string() + "' && timeout 60 " +
+                          std::string(SPHXR_BINARY) + " " + args + " >" + output.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
   AppRun r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -86,20 +86,26 @@ TEST(XrHeadsetInputs, APoseScriptThatIsNotARegularFileIsOneLineThenTheDesktopWin
   for (const std::string poses : {std::string("/dev/zero"), MakeFifo(dir).string()}) {
     SimHeadset headset("inputs_poses_run");
     headset.env.Set("SPHXR_SIM_XR_POSES", poses);
-    const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon, headset.dir);
+    const AppRun r =
+        RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon, headset.dir);
     ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_EQ(CountOf(r.out, "SPHXR_SIM_XR_POSES='" + poses + "' is not a pose script (not a regular file)"), 1) << r.out;
+    EXPECT_EQ(CountOf(r.out, "SPHXR_SIM_XR_POSES='" + poses + "' is not a pose script (not a regular file)"), 1)
+        << r.out;
     EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
   }
 }
 
 TEST(XrHeadsetInputs, SettingsThatAreNotFiniteAreRefusedInOneLine) {
-  for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
-           {"SPHXR_SIM_XR_RATE_HZ", "nan"}, {"SPHXR_SIM_XR_IPD", "nan"}, {"SPHXR_SIM_XR_IPD", "-inf"},
-           {"SPHXR_SIM_XR_CAPTURE_EVERY", "inf"}, {"SPHXR_SIM_XR_EXIT_AFTER_FRAMES", "nan"}}) {
+  for (const auto& [name, value] :
+       std::vector<std::pair<std::string, std::string>>{{"SPHXR_SIM_XR_RATE_HZ", "nan"},
+                                                        {"SPHXR_SIM_XR_IPD", "nan"},
+                                                        {"SPHXR_SIM_XR_IPD", "-inf"},
+                                                        {"SPHXR_SIM_XR_CAPTURE_EVERY", "inf"},
+                                                        {"SPHXR_SIM_XR_EXIT_AFTER_FRAMES", "nan"}}) {
     SimHeadset headset("inputs_settings");
     headset.env.Set(name, value);
-    const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon, headset.dir);
+    const AppRun r =
+        RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon, headset.dir);
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_EQ(CountOf(r.out, name + "='" + value + "' is not a number in ["), 1) << r.out;
     EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
@@ -110,12 +116,14 @@ TEST(XrHeadsetInputs, SettingsThatAreNotFiniteAreRefusedInOneLine) {
 TEST(XrHeadsetInputs, AHapticsLogOrAnEyeSizeThatCannotBeUsedIsOneLine) {
   const auto dir = TempDir("inputs_haptics");
   const std::string fifo = MakeFifo(dir).string();
-  for (const auto& [name, value, message] : std::vector<std::array<std::string, 3>>{
-           {"SPHXR_SIM_XR_HAPTICS_LOG", fifo, "' is not a regular file"},
-           {"SPHXR_SIM_XR_EYE_SIZE", "64x48junk", "' is not WIDTHxHEIGHT (1..8192)"}}) {
+  for (const auto& [name, value, message] :
+       std::vector<std::array<std::string, 3>>{{"SPHXR_SIM_XR_HAPTICS_LOG", fifo, "' is not a regular file"},
+                                               {"SPHXR_SIM_XR_EYE_SIZE", "64x48junk",
+                                                "' is not WIDTHxHEIGHT (1..8192)"}}) {
     SimHeadset headset("inputs_haptics_run");
     headset.env.Set(name, value);
-    const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon, headset.dir);
+    const AppRun r =
+        RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 3" + kCommon, headset.dir);
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_EQ(CountOf(r.out, name + "='" + value + message), 1) << r.out;
     EXPECT_EQ(CountOf(r.out, "using the desktop window"), 1) << r.out;
@@ -125,7 +133,8 @@ TEST(XrHeadsetInputs, AHapticsLogOrAnEyeSizeThatCannotBeUsedIsOneLine) {
 TEST(XrHeadsetInputs, ABadCaptureFolderIsOneLine) {
   SimHeadset headset("inputs_capture");
   headset.env.Set("SPHXR_SIM_XR_CAPTURE_DIR", (headset.dir / "no_such_folder").string());
-  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 40" + kCommon, headset.dir);
+  const AppRun r =
+      RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 40" + kCommon, headset.dir);
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(CountOf(r.out, "SPHXR_SIM_XR_CAPTURE_DIR"), 1) << r.out;
   EXPECT_EQ(CountOf(r.out, "cannot write"), 0) << r.out;
@@ -157,8 +166,8 @@ TEST(XrHeadsetInputs, ALostSessionOfALongScenesNameStillSaves) {
   SimHeadset headset("inputs_long_name");
   headset.env.Set("SPHXR_SIM_XR_LOSE_SESSION_AFTER_FRAMES", "5");
   const std::string name(300, 'n');
-  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir, name).string() + " --frame-limit 5" + kCommon,
-                            headset.dir);
+  const AppRun r =
+      RunSphxr("--xr --scene " + WriteScene(headset.dir, name).string() + " --frame-limit 5" + kCommon, headset.dir);
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(CountOf(r.out, "the XR session was lost"), 1) << r.out;
   const std::filesystem::path saved = headset.dir / (std::string(100, 'n') + "-lost.state");
@@ -173,7 +182,8 @@ TEST(XrHeadsetInputs, ALostSessionThatCannotSaveBesideItSavesInTheTemporaryFolde
   std::filesystem::create_directories(headset.dir / "xr_inputs_tank-lost.state");
   std::filesystem::create_directories(headset.dir / "tmp");
   headset.env.Set("TMPDIR", (headset.dir / "tmp").string());
-  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 5" + kCommon, headset.dir);
+  const AppRun r =
+      RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 5" + kCommon, headset.dir);
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(CountOf(r.out, "the XR session was lost"), 1) << r.out;
   EXPECT_TRUE(std::filesystem::is_regular_file(headset.dir / "tmp" / "xr_inputs_tank-lost.state")) << r.out;
@@ -211,7 +221,8 @@ AppRun SignalMidSession(const std::filesystem::path& dir, const std::vector<std:
   std::this_thread::sleep_for(std::chrono::seconds(1));
   kill(pid, signal);
   int status = 0;
-  for (int k = 0; k < 300 && waitpid(pid, &status, WNOHANG) == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  for (int k = 0; k < 300 && waitpid(pid, &status, WNOHANG) == 0; ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
   if (waitpid(pid, &status, WNOHANG) == 0 && !WIFEXITED(status) && !WIFSIGNALED(status)) {
     kill(pid, SIGKILL);
     waitpid(pid, &status, 0);

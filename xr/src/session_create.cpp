@@ -28,8 +28,10 @@ Status CheckRuntimeManifest() {
   struct stat st {};
   std::string why;
   if (stat(path, &st) != 0) return Status::Ok();  // missing: the loader's own answer (no runtime)
-  if (!S_ISREG(st.st_mode)) why = "not a regular file";
-  else if (st.st_size > kMaxManifestBytes) why = Format("%lld bytes, more than a manifest's %lld", static_cast<long long>(st.st_size), kMaxManifestBytes);
+  if (!S_ISREG(st.st_mode))
+    why = "not a regular file";
+  else if (st.st_size > kMaxManifestBytes)
+    why = Format("%lld bytes, more than a manifest's %lld", static_cast<long long>(st.st_size), kMaxManifestBytes);
   if (why.empty()) return Status::Ok();
   return Status::Error("no OpenXR runtime available (XR_RUNTIME_JSON=" + ShowText(path) + " is " + why +
                        "): point XR_RUNTIME_JSON at a runtime's manifest; docs/dev/xr.md shows the simulated headset");
@@ -39,8 +41,8 @@ Status CheckRuntimeManifest() {
 
 Status ProbeRuntime() {
   if (Status s = CheckRuntimeManifest(); !s) return s;
-  // The loader prints its own "Error [...]" lines to stderr when no runtime is found; our status
-  // says it in one line. Users who want the loader's view set XR_LOADER_DEBUG themselves.
+    // The loader prints its own "Error [...]" lines to stderr when no runtime is found; our status
+    // says it in one line. Users who want the loader's view set XR_LOADER_DEBUG themselves.
 #if defined(_WIN32)
   if (!std::getenv("XR_LOADER_DEBUG")) _putenv_s("XR_LOADER_DEBUG", "none");
 #else

@@ -73,7 +73,8 @@ XRAPI_ATTR XrResult XRAPI_CALL EndFrame(XrSession handle, const XrFrameEndInfo* 
   s->frameBegun = false;
   ++s->framesEnded;
   const Config& c = s->instance->config;
-  if (projection && !c.captureDir.empty() && !s->instance->captureFailed && (s->framesEnded - 1) % c.captureEvery == 0) CaptureFrame(s, *projection);
+  if (projection && !c.captureDir.empty() && !s->instance->captureFailed && (s->framesEnded - 1) % c.captureEvery == 0)
+    CaptureFrame(s, *projection);
   if (s->state == XR_SESSION_STATE_SYNCHRONIZED && !s->exitRequested) {
     PushSessionState(s, XR_SESSION_STATE_VISIBLE);
     PushSessionState(s, XR_SESSION_STATE_FOCUSED);

@@ -1,6 +1,7 @@
 // The simulated headset's instance and system: its settings read from the environment, the
 // instance (pose script, haptics log), the event queue, result and structure names, the one HMD
 // system with its stereo view configuration and OpenGL requirements.
+#include <openxr/openxr_reflection.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,8 +11,6 @@
 #include <cstring>
 #include <string>
 #include <type_traits>
-
-#include <openxr/openxr_reflection.h>
 
 #include "runtime.h"
 
@@ -26,7 +25,6 @@ std::string Env(const char* name) {
   const char* v = std::getenv(name);
   return v ? v : "";
 }
-
 
 XrResult ReadConfig(Config* c, std::string* error) {
   auto num = [&](const char* name, double lo, double hi, auto* out) {
@@ -62,14 +60,15 @@ XrResult ReadConfig(Config* c, std::string* error) {
   c->poseScriptPath = Env("SPHXR_SIM_XR_POSES");
   c->captureDir = Env("SPHXR_SIM_XR_CAPTURE_DIR");
   // A capture folder that cannot take the pictures is one line here, not one a frame.
-  if (struct stat st {}; !c->captureDir.empty() &&
-      (stat(c->captureDir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || access(c->captureDir.c_str(), W_OK) != 0)) {
+  if (struct stat st{}; !c->captureDir.empty() && (stat(c->captureDir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) ||
+                                                   access(c->captureDir.c_str(), W_OK) != 0)) {
     *error = "SPHXR_SIM_XR_CAPTURE_DIR='" + Shown(c->captureDir) + "' is not a folder this process can write";
     return XR_ERROR_INITIALIZATION_FAILED;
   }
   c->hapticsLogPath = Env("SPHXR_SIM_XR_HAPTICS_LOG");
   // A FIFO would block the instance's creation until a reader came; a device is no log.
-  if (struct stat st {}; !c->hapticsLogPath.empty() && stat(c->hapticsLogPath.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+  if (struct stat st{};
+      !c->hapticsLogPath.empty() && stat(c->hapticsLogPath.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
     *error = "SPHXR_SIM_XR_HAPTICS_LOG='" + Shown(c->hapticsLogPath) + "' is not a regular file";
     return XR_ERROR_INITIALIZATION_FAILED;
   }

@@ -121,7 +121,8 @@ bool PoseScript::Parse(const std::string& text, PoseScript* out, std::string* er
       else if (k == "trackpad") s.trackpad = v != 0;
       else if (k == "thumbstick") s.thumbstick = v != 0;
       else if (k == "tracked") s.tracked = v != 0;
-      else return fail("unknown key '" + Shown(k) + "'");
+      else
+        return fail("unknown key '" + Shown(k) + "'");
     }
     auto& keys = script.m_keys[index];
     if (!keys.empty() && key.time < keys.back().time) return fail("times of one device must not decrease");

@@ -11,8 +11,8 @@
 
 namespace sphxr::app {
 
-inline constexpr double kMaxRunTime = 1e6;     // s of simulated time a run, or a target clock, may reach
-inline constexpr double kMaxSettle = 3600.0;   // s of settling
+inline constexpr double kMaxRunTime = 1e6;            // s of simulated time a run, or a target clock, may reach
+inline constexpr double kMaxSettle = 3600.0;          // s of settling
 inline constexpr double kMaxSteps = 1099511627776.0;  // 2^40 steps
 
 /// One argument's bounds, by the name it is given under.
