@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Fuzzing (libFuzzer, clang 14) of the three parsers of user files: the scene loader, the state-file
-# reader and the trajectory parser (fuzz/). Builds them in build-san/ (scripts/sanitize.sh --build:
+# Fuzzing (libFuzzer, clang 14) of the parsers of user input: the scene loader, the state-file reader,
+# the trajectory parser and the run arguments' parser of the command line, the module and the sweeps
+# (fuzz/). Builds them in build-san/ (scripts/sanitize.sh --build:
 # ASan+UBSan) and runs each for SECONDS (default 600) from a seed corpus: scenes/*.json, scenes/*.csv
 # and a small state file saved from a scene. A crash leaves its input in build-san/fuzz-artifacts/
 # and ends the script with an error.
@@ -17,7 +18,10 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/scri
 work="$build/fuzz-work"
 artifacts="$build/fuzz-artifacts"
 mkdir -p "$work" "$artifacts"
-for t in scene state trajectory; do mkdir -p "$work/corpus_$t" "$work/seeds_$t"; done
+for t in scene state trajectory run_arguments; do mkdir -p "$work/corpus_$t" "$work/seeds_$t"; done
+# The run arguments: the first byte picks the argument (fuzz/run_arguments_fuzz.cpp), the rest its text.
+i=0
+for text in 0.25 1e300 inf nan -1 1e3 0x10 4000 64 1000000000; do printf "\\x$(printf %02x $i)%s" "$text" >"$work/seeds_run_arguments/$i"; i=$((i + 1)); done
 cp scenes/*.json "$work/seeds_scene/"
 cp fuzz/seeds/scene/*.json "$work/seeds_scene/"  # names and keys with control and bidi characters
 cp scenes/*.csv "$work/seeds_trajectory/"
@@ -30,7 +34,7 @@ if [ ! -f "$work/seeds_state/stir.state" ]; then
 fi
 
 status=0
-for t in scene state trajectory; do
+for t in scene state trajectory run_arguments; do
   echo "fuzz.sh: sphxr_fuzz_$t for $seconds s"
   # Run in the work directory: a fuzzed scene reads trajectory files relative to it.
   # -rss_limit_mb: the scene and state readers must never need much memory for a small input.

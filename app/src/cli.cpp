@@ -9,10 +9,11 @@
 
 #include "sphxr/app/probe_csv.h"
 #include "sphxr/app/quality.h"
-#include "sphxr/render/renderer.h"
+#include "sphxr/app/run_arguments.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
+#include "sphxr/render/renderer.h"
 
 namespace sphxr::app {
 namespace {
@@ -215,24 +216,26 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
       out->scenePath = v;
     } else if (arg == "--time") {
       if (Status s = value(&v); !s) return s;
-      if (Status s = ParseDouble(arg, v, 1e-9, 1e6, &out->time); !s) return s;
+      if (Status s = ParseRunArgument(arg, v, &out->time); !s) return s;
     } else if (arg == "--settle") {
       if (Status s = value(&v); !s) return s;
-      if (Status s = ParseDouble(arg, v, 0.0, 3600.0, &out->settle); !s) return s;
+      if (Status s = ParseRunArgument(arg, v, &out->settle); !s) return s;
     } else if (arg == "--load-state" || arg == "--save-state") {
       if (Status s = value(&v); !s) return s;
       if (*v == '\0') return Status::Error(arg + ": give a file name");
       (arg == "--load-state" ? out->loadState : out->saveState) = v;
     } else if (arg == "--steps") {
       if (Status s = value(&v); !s) return s;
-      if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->steps); !s) return s;
+      double steps = 0.0;
+      if (Status s = ParseRunArgument(arg, v, &steps); !s) return s;
+      out->steps = static_cast<int64_t>(steps);
     } else if (arg == "--device") {
       if (Status s = value(&v); !s) return s;
       if (!sim::ParseDevice(v, &out->device)) return Status::Error(arg + " " + ShowText(v) + ": must be auto, cpu or cuda (or cpu-reference)");
     } else if (arg == "--threads") {
       if (Status s = value(&v); !s) return s;
-      int64_t t;
-      if (Status s = ParseInt(arg, v, 0, 1024, &t); !s) return s;
+      double t = 0.0;
+      if (Status s = ParseRunArgument(arg, v, &t); !s) return s;
       out->threads = static_cast<int>(t);
     } else if (arg == "--spacing") {
       if (Status s = value(&v); !s) return s;

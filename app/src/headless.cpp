@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "headless_sinks.h"
+#include "interrupt_scope.h"
 #include "sphxr/app/probe_csv.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/simulation.h"
@@ -20,51 +21,6 @@
 
 namespace sphxr::app {
 namespace {
-
-volatile std::sig_atomic_t g_interrupt = 0;
-
-extern "C" void OnInterrupt(int signal) { g_interrupt = signal; }
-
-/// SIGINT, SIGTERM and SIGHUP (a closed terminal, a dropped ssh session: long runs are started that
-/// way) set g_interrupt while a run steps, however many arrive: a second Ctrl-C 5 ms after the first
-/// ended the run by the default action, without its summary, cutting a row and leaving FILE.state.tmp.
-/// (SIGQUIT, Ctrl-\, still ends it at once.) The previous handlers come back afterwards.
-class InterruptScope {
- public:
-  InterruptScope() {
-    g_interrupt = 0;
-    struct sigaction action {};
-    action.sa_handler = OnInterrupt;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = 0;
-    sigaction(SIGINT, nullptr, &m_int);
-    sigaction(SIGTERM, nullptr, &m_term);
-    sigaction(SIGHUP, nullptr, &m_hup);
-    // A signal ignored on entry (a background job of a script, nohup) stays ignored.
-    if (m_int.sa_handler != SIG_IGN) sigaction(SIGINT, &action, nullptr);
-    if (m_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &action, nullptr);
-    if (m_hup.sa_handler != SIG_IGN) sigaction(SIGHUP, &action, nullptr);
-  }
-  ~InterruptScope() {
-    sigaction(SIGINT, &m_int, nullptr);
-    sigaction(SIGTERM, &m_term, nullptr);
-    // After a hang-up the terminal is gone and more SIGHUPs may follow: they are ignored until the
-    // process exits, so one arriving after the run (while the summary prints) cannot end it by default.
-    if (g_interrupt == SIGHUP) {
-      struct sigaction ignore {};
-      ignore.sa_handler = SIG_IGN;
-      sigemptyset(&ignore.sa_mask);
-      sigaction(SIGHUP, &ignore, nullptr);
-    } else {
-      sigaction(SIGHUP, &m_hup, nullptr);
-    }
-  }
-  InterruptScope(const InterruptScope&) = delete;
-  InterruptScope& operator=(const InterruptScope&) = delete;
-
- private:
-  struct sigaction m_int {}, m_term {}, m_hup {};
-};
 
 /// What the run is to reach: --time / --steps, else the scene's run.time / run.steps.
 struct Target {
@@ -128,11 +84,10 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
                 static_cast<long long>(summary->settle.steps), summary->settle.wallSeconds, summary->settle.maxAccel);
   }
   if (summary->interrupted) {
-    std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n",
-                summary->interrupted == SIGINT ? "SIGINT" : summary->interrupted == SIGHUP ? "SIGHUP" : "SIGTERM",
+    std::printf("  interrupted     by %s at t = %.4f s of the %s asked for\n", InterruptName(summary->interrupted),
                 summary->simulatedTime,
                 target.steps > 0 ? Format("%lld steps", static_cast<long long>(target.steps)).c_str()
-                                : Format("%.4g s", target.time).c_str());
+                                 : Format("%.4g s", target.time).c_str());
   }
   std::printf("  particles lost  %lld (clamped back into the tank: %lld times, %.3g per 1,000 particle-steps%s%s)\n",
               static_cast<long long>(summary->lost), static_cast<long long>(summary->clampedEvents),

@@ -1,16 +1,18 @@
 #include "headless_sinks.h"
 
-#include "csv_continue.h"
-
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
+#include "csv_continue.h"
 #include "sphxr/app/export.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
@@ -183,6 +185,19 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
                    static_cast<long long>(stepsBefore),
                    dropped > 0 ? Format(", %lld rows after it replaced", static_cast<long long>(dropped)).c_str() : "");
   } else {
+    // A continued run whose file holds the first half's rows under other columns (another method's
+    // statistics, other paddles) would rewrite them: refused, the file left as it is.
+    if (stepsBefore > 0) {
+      std::string first;
+      std::ifstream earlier(m_path, std::ios::binary);
+      if (std::filesystem::is_regular_file(m_path, ec) && std::getline(earlier, first) &&
+          first.rfind("step,time,", 0) == 0 && first != header) {
+        return Status::Error("--stats " + ShowText(m_path) + ": the earlier run's rows there have other columns (" +
+                             ShowText(first.substr(first.find(',', 10) + 1), 60) +
+                             "; this run's: " + ShowText(header.substr(header.find(',', 10) + 1), 60) +
+                             "): continuing into it would rewrite them; give another --stats file");
+      }
+    }
     if (std::filesystem::is_regular_file(m_path, ec)) {
       m_out.close();
       m_out.open(m_path, std::ios::trunc);
@@ -191,6 +206,9 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
     m_out << header << "\n";
   }
   m_out.flush();
+  m_whole =
+      std::filesystem::is_regular_file(m_path, ec) ? static_cast<int64_t>(std::filesystem::file_size(m_path, ec)) : -1;
+  if (ec) m_whole = -1;
   return Status::Ok();
 }
 
@@ -215,8 +233,8 @@ Status StatsSink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
   row << '\n';
   m_pending += row.str();
   const bool due = m_pending.size() > (size_t{1} << 20) || std::chrono::steady_clock::now() - m_last >= std::chrono::seconds(1);
-  if (due && !Flush()) {
-    return Status::Error("--stats " + ShowText(m_path) + ": write failed (disk full?) at step " + std::to_string(wholeStep));
+  if (due) {
+    if (Status s = Flush(); !s) return Status::Error(s.message() + " (at step " + std::to_string(wholeStep) + ")");
   }
   return Status::Ok();
 }
@@ -224,18 +242,47 @@ Status StatsSink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
 Status StatsSink::Flush() {
   m_last = std::chrono::steady_clock::now();
   if (m_pending.empty() || !m_out.is_open()) return Status::Ok();
+  errno = 0;
   m_out.write(m_pending.data(), static_cast<std::streamsize>(m_pending.size()));
   m_out.flush();
+  const int error = errno;
+  const size_t written = m_pending.size();
   m_pending.clear();
-  if (!m_out) return Status::Error("--stats " + ShowText(m_path) + ": write failed (disk full?)");
+  if (!m_out) {
+    m_out.close();  // nothing more is written: what reached the file ends at its last whole row
+    CutToWholeRows();
+    return Status::Error("--stats " + ShowText(m_path) + ": write failed (" +
+                         (error ? std::strerror(error) : "disk full?") + "); the file ends at its last whole row");
+  }
+  if (m_whole >= 0) m_whole += static_cast<int64_t>(written);
   return Status::Ok();
+}
+
+void StatsSink::CutToWholeRows() {
+  // A regular file only (a pipe or a device has nothing to cut): the bytes after the last whole row
+  // known to be written, up to the last newline among them, are kept.
+  if (m_whole < 0) return;
+  std::error_code ec;
+  const auto size = static_cast<int64_t>(std::filesystem::file_size(m_path, ec));
+  if (ec || size <= m_whole) return;
+  std::ifstream in(m_path, std::ios::binary);
+  in.seekg(m_whole);
+  std::string tail(static_cast<size_t>(size - m_whole), '\0');
+  in.read(tail.data(), static_cast<std::streamsize>(tail.size()));
+  const size_t newline = tail.rfind('\n', static_cast<size_t>(in.gcount() > 0 ? in.gcount() - 1 : 0));
+  const int64_t keep = m_whole + (newline == std::string::npos ? 0 : static_cast<int64_t>(newline) + 1);
+  std::filesystem::resize_file(m_path, static_cast<uintmax_t>(keep), ec);
 }
 
 Status StatsSink::Finish(Simulation&, bool) {
   if (Status s = Flush(); !s) return s;
   if (m_out.is_open()) {
-    m_out.close();  // the last rows leave the buffer here
-    if (m_out.fail()) return Status::Error("--stats " + ShowText(m_path) + ": write failed (disk full?)");
+    m_out.close();
+    if (m_out.fail()) {
+      CutToWholeRows();
+      return Status::Error("--stats " + ShowText(m_path) +
+                           ": write failed (disk full?); the file ends at its last whole row");
+    }
   }
   return Status::Ok();
 }

@@ -88,8 +88,12 @@ class StatsSink : public SimulationSink {
   Status Finish(Simulation& simulation, bool interrupted) override;
 
  private:
+  /// After a failed write: the file cut after its last whole row (a full disk leaves no half row).
+  void CutToWholeRows();
+
   std::string m_path;
   std::ofstream m_out;
+  int64_t m_whole = -1;  // bytes of the file known to end at a whole row; -1: not a regular file
   std::optional<DamBreakProbe> m_probe;
   std::span<const sim::SolverStat> m_stats;  // the method's own columns (its solver-table row)
   std::string m_pending;

@@ -3,15 +3,16 @@
 // one line saying why: no runtime -> the desktop window; no window -> headless; a session lost mid-run ->
 // the desktop window (or exit when there is no display or the --frame-limit is reached).
 #include <cstdio>
-#include <filesystem>
-#include <optional>
 #include <exception>
+#include <filesystem>
 #include <new>
+#include <optional>
 #include <string>
 
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/headless.h"
 #include "sphxr/app/param_registry.h"
+#include "sphxr/app/run_arguments.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/xr_mode.h"
 #include "sphxr/common/host_memory.h"
@@ -24,7 +25,7 @@ int Main(int argc, char** argv) {
   using sphxr::app::Mode;
   sphxr::app::Options options;
   if (sphxr::Status s = sphxr::app::ParseCommandLine(argc, argv, &options); !s) {
-    std::fprintf(stderr, "sphxr: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
+    std::fprintf(stderr, "sphxr: %s\n", sphxr::app::ShownMessage(s.message()).c_str());
     return 2;
   }
   const bool headlessAsked = options.mode == Mode::kHeadless;
@@ -47,7 +48,7 @@ int Main(int argc, char** argv) {
     const sphxr::Status s = sphxr::app::LoadSceneWithOptions(options, &scene);
     sphxr::SetLogLevel(level);
     if (!s) {
-      std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
+      std::fprintf(stderr, "sphxr: error: %s\n", sphxr::app::ShownMessage(s.message()).c_str());
       return 1;
     }
   }
@@ -68,9 +69,10 @@ int Main(int argc, char** argv) {
     sphxr::app::XrOutcome outcome;
     const sphxr::Status s = sphxr::app::RunXr(options, &outcome);
     const bool display = sphxr::app::DisplayAvailable();
+    if (s && outcome.interrupted) return 128 + outcome.interrupted;  // the shell's convention, as headless
     if (s && !outcome.lost) return 0;
     if (!s && !outcome.fallback) {
-      std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
+      std::fprintf(stderr, "sphxr: error: %s\n", sphxr::app::ShownMessage(s.message()).c_str());
       return 1;
     }
     const std::string why = s ? "the XR session was lost (" + outcome.message + ")" : s.message();
@@ -129,7 +131,7 @@ int Main(int argc, char** argv) {
     run = sphxr::app::RunHeadless(options, &summary);
   }
   if (sphxr::Status s = run; !s) {
-    std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(s.message(), std::string::npos).c_str());
+    std::fprintf(stderr, "sphxr: error: %s\n", sphxr::app::ShownMessage(s.message()).c_str());
     return 1;
   }
   return summary.interrupted ? 128 + summary.interrupted : 0;  // the shell's convention: 130 after Ctrl-C
@@ -148,7 +150,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sphxr: error: out of memory in %s\n",
                  what ? what : "the particles (use a larger --spacing or a smaller scene)");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "sphxr: error: %s\n", sphxr::ShowText(e.what(), std::string::npos).c_str());
+    std::fprintf(stderr, "sphxr: error: %s\n", sphxr::app::ShownMessage(e.what()).c_str());
   }
   return 1;
 }

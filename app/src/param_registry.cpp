@@ -1,13 +1,13 @@
 #include "sphxr/app/param_registry.h"
 
-#include "sphxr/app/probe_csv.h"
-
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "sphxr/sim/solver_table.h"
+#include "sphxr/app/probe_csv.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
 namespace {
@@ -78,8 +78,9 @@ Status SetParam(const ParamDesc& p, double value, const std::string& where, sim:
   if (!std::isfinite(value)) return Status::Error(where + ": must be finite");
   if (p.integer && value != std::floor(value)) return Status::Error(where + ": must be an integer (" + p.unit + ")");
   if (value < p.min || value > p.max) {
-    return Status::Error(Format("%s: %g is out of range: must be from %g to %g%s%s (%s)", where.c_str(), value, p.min,
-                                p.max, p.unit.empty() ? "" : " ", p.unit.c_str(), p.help.c_str()));
+    return Status::Error(Format("%s: %s is out of range: must be from %s to %s%s%s (%s)", where.c_str(),
+                                ShowNumber(value).c_str(), ShowNumber(p.min).c_str(), ShowNumber(p.max).c_str(),
+                                p.unit.empty() ? "" : " ", p.unit.c_str(), p.help.c_str()));
   }
   p.Set(s, value);
   return Status::Ok();

@@ -153,9 +153,14 @@ Status ProbeCsv::Add(const sim::ProbeSample& sample) {
 Status ProbeCsv::Flush() {
   m_lastFlush = WallSeconds();
   if (m_pending.empty()) return Status::Ok();
+  errno = 0;
   const bool ok = std::fwrite(m_pending.data(), 1, m_pending.size(), m_file) == m_pending.size() && std::fflush(m_file) == 0;
+  const int error = errno;
   m_pending.clear();
-  if (!ok) return Status::Error("--probes " + ShowText(m_path) + ": write failed (disk full?)");
+  if (!ok) {
+    return Status::Error("--probes " + ShowText(m_path) + ": write failed (" +
+                         (error ? std::strerror(error) : "disk full?") + ")");
+  }
   return Status::Ok();
 }
 

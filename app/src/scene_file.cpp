@@ -89,8 +89,10 @@ Status Reader::Solver(const json& root) {
     double v;
     if (Status st = Number(it.value(), "solver." + it.key(), &v); !st) return st;
     if (v < info->min || v > info->max) {
-      return Error("solver." + it.key(), Format("%g is out of range: must be from %g to %g%s%s (%s)", v, info->min,
-                                                info->max, info->unit[0] ? " " : "", info->unit, info->help));
+      return Error("solver." + it.key(),
+                   Format("%s is out of range: must be from %s to %s%s%s (%s)", ShowNumber(v).c_str(),
+                          ShowNumber(info->min).c_str(), ShowNumber(info->max).c_str(), info->unit[0] ? " " : "",
+                          info->unit, info->help));
     }
     if (info->integer && v != std::floor(v)) return Error("solver." + it.key(), "must be a whole number");
     s.params.*(info->member) = static_cast<float>(v);
@@ -307,8 +309,9 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
   const double v = std::strtod(value.c_str(), &end);
   if (value.empty() || *end != '\0' || !std::isfinite(v)) return Status::Error(shown + ": not a finite number");
   if (v < info->min || v > info->max) {
-    return Status::Error(Format("%s: out of range, must be from %g to %g%s%s", shown.c_str(), info->min, info->max,
-                                *info->unit ? " " : "", info->unit));
+    return Status::Error(Format("%s: out of range, must be from %s to %s%s%s", shown.c_str(),
+                                ShowNumber(info->min).c_str(), ShowNumber(info->max).c_str(), *info->unit ? " " : "",
+                                info->unit));
   }
   if (info->integer && v != std::floor(v)) return Status::Error(shown + ": must be a whole number");
   setup->params.*(info->member) = static_cast<float>(v);

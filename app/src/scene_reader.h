@@ -15,7 +15,7 @@ namespace sphxr::app::scene {
 
 using nlohmann::json;
 
-constexpr int kMaxDepth = 64;        // no scene nests deeper than 6; the cap keeps every walk shallow
+constexpr int kMaxDepth = kMaxSceneDepth;
 constexpr size_t kMaxEcho = 80;      // characters of a bad value quoted in a message
 
 // A bad value as a message quotes it: at most kMaxEcho characters, ASCII only (control characters and

@@ -2,6 +2,7 @@
 #include <filesystem>
 
 #include "sphxr/app/scene_file.h"
+#include "sphxr/common/shown_text.h"
 
 #ifndef SPHXR_SCENES_DIR
 #define SPHXR_SCENES_DIR ""
@@ -62,7 +63,8 @@ Status FindScene(const std::string& name, std::string* path, const std::string& 
   }
   std::string where;
   for (const std::string& dir : dirs) where += (where.empty() ? "" : ", ") + (dir == "." ? "the current directory" : dir);
-  return Status::Error("--scene " + name + ": no scene " + name + " or " + name + ".json in " +
+  // The name once, escaped and cut (it may be anything a user or a script passed).
+  return Status::Error("--scene " + ShowText(name) + ": no scene of that name (nor with .json) in " +
                        (where.empty() ? "the current directory" : where) + " (give a file's path, or a scene's name)");
 }
 

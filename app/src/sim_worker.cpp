@@ -310,6 +310,8 @@ std::string DefaultStatePath(const std::string& sceneName) {
     previous = c;
   }
   if (stem.find_first_not_of('_') == std::string::npos) stem = "sphxr";
+  // A file name has at most 255 bytes: a long scene name is cut (its "-lost" and ".state" still fit).
+  if (stem.size() > kMaxStateStem) stem.resize(kMaxStateStem);
   return stem + ".state";
 }
 

@@ -4,14 +4,16 @@
 #include <epoxy/gl.h>
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -21,6 +23,7 @@
 #include <vector>
 
 #include "gl_window.h"
+#include "interrupt_scope.h"
 #include "sim_worker.h"
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/pictures.h"
@@ -319,11 +322,22 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   Clock::time_point previousFrame{};
   int64_t previousPeriodNs = 0;
   const auto started = Clock::now();
+  InterruptScope interrupts;
+  Clock::time_point interruptedAt{};
   while (true) {
     glfwPollEvents();
     if (glfwWindowShouldClose(app.window) || (options.frameLimit > 0 && outcome->frames >= options.frameLimit)) {
       app.RequestExit();
     }
+    if (g_interrupt && !outcome->interrupted) {
+      outcome->interrupted = g_interrupt;
+      interruptedAt = Clock::now();
+      SPHXR_LOG_INFO("%s: ending the headset session", InterruptName(outcome->interrupted));
+      app.RequestExit();
+    }
+    // A session that does not end within two seconds of the signal (not running, a runtime that never
+    // answers the request) is left as a lost one is.
+    if (outcome->interrupted && Clock::now() - interruptedAt > std::chrono::seconds(2)) break;
     const xr::EventResult ev = app.session->PollEvents();
     for (xr::SessionState state : ev.transitions) {
       if (!outcome->states.empty()) outcome->states += ' ';
@@ -439,12 +453,25 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
   // A lost session must not lose the water stirred in it: saved (to --save-state's file, else
-  // "<scene>-lost.state"), and the window that takes over starts from it (main.cpp).
-  if (outcome->lost) {
-    const std::string path = !options.saveState.empty() ? options.saveState : LostStatePath(app.scene.name);
-    const uint64_t before = app.worker->SavesDone();
-    app.worker->SaveStateLogged(path, app.scene.name);
-    if (app.worker->SavesDone() > before) outcome->savedState = path;
+  // "<scene>-lost.state", else that name in the temporary folder), and the window that takes over starts
+  // from it (main.cpp). A session ended by a signal is saved the same way.
+  if (outcome->interrupted) {
+    outcome->message = std::string("ended by ") + InterruptName(outcome->interrupted);
+  }
+  if (outcome->lost || outcome->interrupted) {
+    std::vector<std::string> paths = {!options.saveState.empty() ? options.saveState : LostStatePath(app.scene.name)};
+    if (options.saveState.empty()) {
+      const char* tmp = std::getenv("TMPDIR");
+      paths.push_back((std::filesystem::path(tmp && *tmp ? tmp : "/tmp") / LostStatePath(app.scene.name)).string());
+    }
+    for (const std::string& path : paths) {
+      const uint64_t before = app.worker->SavesDone();
+      app.worker->SaveStateLogged(path, app.scene.name);
+      if (app.worker->SavesDone() > before) {
+        outcome->savedState = path;
+        break;
+      }
+    }
   }
   if (!options.screenshotPath.empty()) {
     if (lastMirror.width == 0) {

@@ -1,6 +1,7 @@
 #include "sphxr/common/shown_text.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 
 namespace sphxr {
@@ -87,6 +88,12 @@ std::string ShowList(const std::vector<std::string>& names, size_t maxNames) {
   for (size_t k = 0; k < names.size() && k < maxNames; ++k) out += (k ? ", " : "") + ShowText(names[k]);
   if (names.size() > maxNames) out += " and " + std::to_string(names.size() - maxNames) + " more";
   return out;
+}
+
+std::string ShowNumber(double value) {
+  char text[32];
+  const auto [end, error] = std::to_chars(text, text + sizeof(text), value);
+  return error == std::errc() ? std::string(text, end) : std::string("?");
 }
 
 bool IsPlainText(std::string_view text) {

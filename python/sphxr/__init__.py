@@ -11,6 +11,7 @@ state files, the same app::Simulation; errors are sphxr.Error carrying the progr
 Sweeps over a grid of parameters on Dask distributed: `python3 -m sphxr.sweep --help`.
 """
 import json
+import numbers
 import os
 
 import numpy as np
@@ -19,7 +20,7 @@ from . import _sphxr
 from ._sphxr import Error, set_log_level
 
 __all__ = ["Run", "Error", "read_state", "set_log_level", "find_scene", "scene_dirs", "parameter_names", "scene_info",
-           "data_dir"]
+           "data_dir", "show_text"]
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 # Installed, the package is PREFIX/lib/python3/dist-packages/sphxr and the scenes PREFIX/share/sphxr/scenes;
@@ -38,23 +39,53 @@ def data_dir():
     return os.path.normpath(os.path.join(_sphxr.build_scenes_dir, "..", "tests", "data"))
 
 
+def _path(name, path):
+    """A file name given to the module as a str (os.fspath); sphxr.Error when it is none."""
+    try:
+        path = os.fspath(path)
+    except TypeError:
+        raise Error("%s: a file name is a str or a path, not %s" % (name, type(path).__name__)) from None
+    if isinstance(path, bytes):
+        path = os.fsdecode(path)
+    return path
+
+
+def _number(name, value, integer=False):
+    """`value` checked by the command line's bounds for `name` (app/run_arguments.h): a float, or an int
+    where a whole number is wanted; sphxr.Error (one line) for anything else, NaN and infinities included."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise Error("%s %s: not a number" % (name, show_text(repr(value))))
+    try:
+        number = float(value)
+    except OverflowError:  # an int past the largest float
+        number = float("inf") if value > 0 else float("-inf")
+    _sphxr.check_argument(name, number)
+    return int(value) if integer else number
+
+
+def show_text(text, max_bytes=80):
+    """`text` as sphxr prints what a user wrote: control, bidi and other hidden characters escaped
+    (\\x1B, \\u202E), cut after max_bytes with its length."""
+    return _sphxr.show_text(str(text), max_bytes)
+
+
 def read_state(path):
     """A state file's contents (sphxr --save-state, Run.save_state) without running it: path, scene,
     method, time, step, spacing, fluid, boundary, and the fluid's positions, velocities, densities,
     pressures and ids as NumPy arrays (in the file's order; `ids` gives each row's particle)."""
-    return _sphxr.read_state(os.fspath(path))
+    return _sphxr.read_state(_path("read_state", path))
 
 
 def find_scene(name):
     """The file a scene name stands for: NAME or NAME.json in the current directory, the installed scenes,
     then the build's (a path is returned as it is)."""
-    return _sphxr.find_scene(os.fspath(name), _INSTALL_DIR)
+    return _sphxr.find_scene(_path("find_scene", name), _INSTALL_DIR)
 
 
 def scene_info(scene, set=None):
     """A scene file read (not run): path, name, run_time, run_steps, run_settle, probe_columns (the
     --probes header, or None), dam_break_column_width (or None), parameters (with the overrides)."""
-    return _sphxr.scene_info(os.fspath(scene), _INSTALL_DIR, _assignments(set))
+    return _sphxr.scene_info(_path("scene_info", scene), _INSTALL_DIR, _assignments(set))
 
 
 def scene_dirs():
@@ -70,16 +101,48 @@ def parameter_names():
 def _assignments(overrides):
     if overrides is None:
         return []
+    if isinstance(overrides, (str, bytes)):  # one "key=value", as one --set (never its characters)
+        overrides = [overrides]
     if isinstance(overrides, dict):
         items = overrides.items()
     else:  # "key=value" strings, as --set
-        items = [str(o).split("=", 1) if "=" in str(o) else (str(o), "") for o in overrides]
+        try:
+            overrides = list(overrides)
+        except TypeError:
+            raise Error("set: a dict, a list of \"key=value\" or one \"key=value\", not %s"
+                        % type(overrides).__name__) from None
+        items = []
+        for o in overrides:
+            if isinstance(o, bytes):
+                o = os.fsdecode(o)
+            if not isinstance(o, str):
+                raise Error("set: %s: an item is a \"key=value\" str" % show_text(repr(o)))
+            items.append(o.split("=", 1) if "=" in o else (o, ""))
     out = []
     for key, value in items:
         if isinstance(value, bool):
             value = int(value)
         out.append("%s=%s" % (key, repr(value) if isinstance(value, float) else value))
     return out
+
+
+def _scene_text(scene):
+    """A dict scene as the JSON text the scene loader reads; nesting past the loader's limit is refused
+    before json.dumps would recurse into it (the walk here is a loop)."""
+    limit = _sphxr.max_scene_depth
+    stack = [(scene, 1)]
+    while stack:
+        item, depth = stack.pop()
+        if depth > limit:
+            raise Error("scene: a dict nested more than %d levels deep: not a scene" % limit)
+        children = item.values() if isinstance(item, dict) else item if isinstance(item, (list, tuple)) else ()
+        for child in children:
+            if isinstance(child, (dict, list, tuple)):
+                stack.append((child, depth + 1))
+    try:
+        return json.dumps(scene)
+    except (TypeError, ValueError) as e:
+        raise Error("scene: not a JSON scene: %s" % show_text(str(e))) from None
 
 
 class Run:
@@ -101,36 +164,43 @@ class Run:
                  probes_csv=None, validate=False, base_dir=None, record_dam_break=None):
         o = _sphxr.RunOptions()
         if isinstance(scene, dict):
-            o.scene_json = json.dumps(scene)
+            o.scene_json = _scene_text(scene)
             name = scene.get("name", "scene") if isinstance(scene.get("name"), str) else "scene"
-            o.origin = os.path.join(os.path.abspath(base_dir or os.getcwd()), "<dict %s>" % name)
+            folder = os.path.abspath(_path("base_dir", base_dir) if base_dir else os.getcwd())
+            o.origin = os.path.join(folder, "<dict %s>" % show_text(name, 40))
         else:
-            o.scene = os.fspath(scene)
+            o.scene = _path("scene", scene)
         o.install_dir = _INSTALL_DIR
         o.sets = _assignments(set)
+        if not isinstance(device, str):
+            raise Error("device %s: must be auto, cpu or cuda (or cpu-reference)" % show_text(repr(device)))
         o.device = device
-        o.threads = int(threads)
+        o.threads = _number("threads", threads, integer=True)
         o.validate = bool(validate)
-        o.settle = -1.0 if settle is None else float(settle)
-        o.load_state = os.fspath(load_state) if load_state else ""
-        o.probes_csv = os.fspath(probes_csv) if probes_csv else ""
+        o.settle = -1.0 if settle is None else _number("settle", settle)
+        o.load_state = _path("load_state", load_state) if load_state else ""
+        o.probes_csv = _path("probes_csv", probes_csv) if probes_csv else ""
         o.record_dam_break = -1 if record_dam_break is None else int(bool(record_dam_break))
         self._run = _sphxr.Run(o)
 
-    # ---- stepping (the GIL is released; Ctrl-C stops after the step in progress) ----
+    # ---- stepping (the GIL is released; Ctrl-C stops after the step in progress: KeyboardInterrupt) ----
     def step(self, n=1):
-        """n solver steps."""
-        self._run.step(int(n))
+        """n solver steps (0 to 2^40)."""
+        self._run.step(_number("step", n, integer=True))
         return self
 
     def run_to(self, time):
-        """Steps until the simulated clock reaches `time` (s)."""
-        self._run.run_to(float(time))
+        """Steps until the simulated clock reaches `time` (s, 0 to 1e6)."""
+        self._run.run_to(_number("run_to", time))
         return self
 
     def advance(self, seconds):
-        """Steps for `seconds` of simulated time from now."""
-        return self.run_to(self.time + float(seconds))
+        """Steps for `seconds` of simulated time from now (the clock stays within 1e6 s)."""
+        seconds = _number("advance", seconds)
+        target = self.time + seconds
+        if target > _sphxr.max_run_time:
+            raise Error("advance %r: the clock would pass %g s (it is at %.9g s)" % (seconds, _sphxr.max_run_time, self.time))
+        return self.run_to(target)
 
     def run_scene(self):
         """The scene's own run: to its run.time (or run.steps), as `sphxr --headless` without --time."""
@@ -140,7 +210,7 @@ class Run:
     # ---- state ----
     def save_state(self, path):
         """Writes a state file (as --save-state): Run(scene, load_state=path) continues from it."""
-        self._run.save_state(os.fspath(path))
+        self._run.save_state(_path("save_state", path))
 
     @property
     def time(self):

@@ -8,6 +8,12 @@ one row per case, in grid order: its parameters, its status, attempts, wall time
 errors, the Martin & Moyce front deviation for a dam-break scene and probe errors for --compare. A case
 whose worker dies is run again on another worker (Dask reschedules it, up to --allowed-failures
 deaths); past that, or when the run itself fails, its row says so: no case is ever missing.
+
+The table is written before the first case (an --out that cannot be written is refused at once) and
+again, atomically, as each case finishes; SIGINT, SIGTERM and SIGHUP stop the sweep with the finished
+rows written and the others "not finished", and it exits 128 + the signal's number, as sphxr does.
+Arguments are checked as sphxr checks its own (the same bounds and messages), and an expected failure
+is one line, never a traceback.
 """
 import argparse
 import csv
@@ -18,6 +24,7 @@ import os
 import signal
 import socket
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -166,9 +173,9 @@ def run_case(spec):
         run = sphxr.Run(scene, set=spec["sets"], device=spec["device"], threads=spec["threads"],
                         settle=spec["settle"], base_dir=spec["base_dir"],
                         probes_csv=os.path.join(case_dir, "probes.csv") if spec["has_probes"] else None)
-        if spec["steps"] > 0:
+        if spec["steps"]:
             run.step(spec["steps"])
-        elif spec["time"] > 0:
+        elif spec["time"]:
             run.run_to(spec["time"])
         else:
             run.run_scene()
@@ -185,11 +192,23 @@ def run_case(spec):
         row.update(martin_moyce(run, spec["measured"], spec["mm_window"]))
         row.update(probe_errors(run, spec["compares"]))
     except (sphxr.Error, KeyError, ValueError) as e:
-        row.update(status="failed: %s" % str(e).replace("\n", " "), wall_s=time.perf_counter() - begin)
+        row.update(status="failed: %s" % sphxr.show_text(str(e), 1000), wall_s=time.perf_counter() - begin)
     return row
 
 
 # ---- the client -------------------------------------------------------------------------------------
+class SweepError(Exception):
+    """An expected failure of the client (a bad argument, an unwritable table, no scheduler): one line."""
+
+
+class Stopped(Exception):
+    """SIGTERM or SIGHUP to the client (SIGINT is Python's KeyboardInterrupt)."""
+
+    def __init__(self, signum):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
 def parse_args(argv):
     p = argparse.ArgumentParser(prog="python3 -m sphxr.sweep", description=__doc__.split("\n\n")[0],
                                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -197,15 +216,15 @@ def parse_args(argv):
     p.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2", help="an axis of the grid")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="an override for every case")
     length = p.add_mutually_exclusive_group()
-    length.add_argument("--time", type=float, default=0.0, help="simulated s per case (default: the scene's run)")
-    length.add_argument("--steps", type=int, default=0, help="steps per case instead of a time")
-    p.add_argument("--settle", type=float, default=None, help="s of settling first (default: the scene's run.settle)")
+    length.add_argument("--time", default=None, help="simulated s per case (default: the scene's run)")
+    length.add_argument("--steps", default=None, help="steps per case instead of a time")
+    p.add_argument("--settle", default=None, help="s of settling first (default: the scene's run.settle)")
     p.add_argument("--out", default="sweep.csv", help="the table (CSV, one row per case; default sweep.csv)")
     p.add_argument("--work-dir", default=None, help="each case's folder: attempts, probes.csv (default: OUT_cases; "
                    "on a cluster of machines, a folder every worker sees)")
     p.add_argument("--scheduler", default=None, metavar="ADDR", help="a Dask scheduler (default: a LocalCluster)")
-    p.add_argument("--workers", type=int, default=0, help="LocalCluster worker processes (default: cores / threads)")
-    p.add_argument("--threads", type=int, default=1, help="solver threads per case (default 1)")
+    p.add_argument("--workers", default=None, help="LocalCluster worker processes (default: cores / threads)")
+    p.add_argument("--threads", default="1", help="solver threads per case (default 1)")
     p.add_argument("--device", default="cpu", help="auto, cpu, cuda or cpu-reference (default cpu)")
     p.add_argument("--allowed-failures", type=int, default=2,
                    help="worker deaths a case survives before it is reported failed (default 2; with "
@@ -216,6 +235,57 @@ def parse_args(argv):
                    help="a probe column against a measured CSV (time, value; each scaled)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     return p.parse_args(argv)
+
+
+def check_numbers(args):
+    """The run arguments through sphxr's own check (app/run_arguments.h): --time inf, --steps -5,
+    --workers -1 are refused as `sphxr --time inf` is, in the same words."""
+    import sphxr
+
+    for flag in ("time", "steps", "settle", "threads", "workers"):
+        text = getattr(args, flag)
+        if text is not None:
+            value = sphxr._sphxr.parse_argument("--" + flag, text)
+            setattr(args, flag, int(value) if flag in ("steps", "threads", "workers") else value)
+    if not 0 <= args.allowed_failures <= 100:
+        raise SweepError("--allowed-failures %d: must be from 0 to 100" % args.allowed_failures)
+    args.mm_window = parse_window(args.mm_window)
+
+
+def parse_window(text):
+    """'1.0,3.3' -> [1.0, 3.3]: two finite numbers, the first below the second."""
+    import sphxr
+
+    parts = text.split(",")
+    try:
+        window = [float(x) for x in parts]
+    except ValueError:
+        window = []
+    if len(window) != 2 or not all(math.isfinite(x) for x in window) or not 0 <= window[0] < window[1]:
+        raise SweepError("--mm-window %s: expected LO,HI, two numbers from 0 with LO < HI (default 1.0,3.3)"
+                         % sphxr.show_text(text))
+    return window
+
+
+def check_scheduler(address, timeout=5.0):
+    """A scheduler's address answers a TCP connection within `timeout` s (Client would wait 30 s and
+    end in a traceback)."""
+    import sphxr
+
+    shown = sphxr.show_text(address)
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    if scheme not in ("tcp", "tls"):
+        return  # inproc:// or ucx://: Client says
+    host, _, port = rest.rpartition(":")
+    host = host.strip("[]")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise SweepError("--scheduler %s: expected tcp://HOST:PORT" % shown)
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout).close()
+    except OSError as e:
+        raise SweepError("--scheduler %s: cannot reach it (%s)" % (shown, e.strerror or e.__class__.__name__)) from None
 
 
 def load_compares(items):
@@ -231,47 +301,104 @@ def load_compares(items):
     return out
 
 
+def shown(text, max_bytes=300):
+    """Text for the progress line and the table: control, bidi and other hidden characters escaped."""
+    import sphxr
+
+    return sphxr.show_text(str(text), max_bytes)
+
+
 def label(case):
-    return " ".join("%s=%s" % kv for kv in case.items()) or "(the scene)"
+    return " ".join("%s=%s" % (shown(k, 60), shown(v, 60)) for k, v in case.items()) or "(the scene)"
 
 
-def write_table(path, keys, cases, rows):
-    columns = ["case"] + keys + ["status", "attempts"]
+def check_out(path):
+    """--out can take the table: a regular file or none yet, in a folder that exists."""
+    if os.path.lexists(path) and not os.path.isfile(path):
+        raise SweepError("--out %s: not a regular file (a folder or a device); give a file name" % shown(path))
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise SweepError("--out %s: the folder %s does not exist; make it first" % (shown(path), shown(folder)))
+
+
+def format_table(f, keys, cases, rows):
+    """The table as CSV into the open file `f`: a row per case, its parameters and measures."""
+    columns = ["case"] + [shown(k) for k in keys] + ["status", "attempts"]
     for r in rows:
         for c in r:
             if c not in columns:
                 columns.append(c)
-    tmp = path + ".tmp"
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=columns, restval="")
-        w.writeheader()
-        for k, (case, r) in enumerate(zip(cases, rows)):
-            w.writerow(dict(r, case=k, **case))
-    os.replace(tmp, path)
+    w = csv.DictWriter(f, fieldnames=columns, restval="")
+    w.writeheader()
+    for k, (case, r) in enumerate(zip(cases, rows)):
+        row = {c: shown(v, 1000) if isinstance(v, str) else v for c, v in r.items()}
+        w.writerow(dict(row, case=k, **{shown(c): shown(v) for c, v in case.items()}))
+
+
+def write_table(path, keys, cases, rows):
+    """The table, replaced atomically (a temporary file beside it, then os.replace): a reader or a kill
+    sees the old table or the new one, never half of one."""
+    folder, name = os.path.split(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix="." + name + ".", suffix=".tmp", dir=folder)
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)  # as open() would make it (mkstemp's is 0600)
+        with os.fdopen(fd, "w", newline="") as f:
+            format_table(f, keys, cases, rows)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.remove(tmp)
+        except OSError:
+            pass
+        raise
 
 
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
     import sphxr
     try:
+        return run_sweep(args)
+    except (SweepError, sphxr.Error) as e:
+        print("sphxr.sweep: error: %s" % shown(str(e), 2000), file=sys.stderr)
+        return 2
+
+
+def run_sweep(args):
+    import sphxr
+    try:
+        check_numbers(args)
         axes = [parse_axis(g) for g in args.grid]
         keys, cases = make_cases(axes)
         compares = load_compares(args.compare)
-        window = [float(x) for x in args.mm_window.split(",")]
+        window = args.mm_window
         scene_path = sphxr.find_scene(args.scene)
         info = sphxr.scene_info(scene_path, set=args.set)
         measured = None
         if info["dam_break_column_width"] is not None:
             mm_file = args.measured or os.path.join(sphxr.data_dir(), "martin_moyce_1952.csv")
             measured = {"front": read_series(mm_file, "front"), "height": read_series(mm_file, "height")}
-    except (ValueError, OSError, sphxr.Error) as e:
-        print("sphxr.sweep: error: %s" % e, file=sys.stderr)
-        return 2
+        check_out(args.out)
+        with open(scene_path) as f:
+            scene_text = f.read()
+        if args.scheduler:
+            check_scheduler(args.scheduler)
+    except (ValueError, OSError) as e:
+        raise SweepError(str(e)) from None
     has_probes = info["probe_columns"] is not None
-    with open(scene_path) as f:
-        scene_text = f.read()
+    rows = [{"status": "not started", "attempts": 0} for _ in cases]
+    try:
+        write_table(args.out, keys, cases, rows)  # before any case: the table can be written
+    except OSError as e:
+        raise SweepError("--out %s: cannot write the table (%s)" % (shown(args.out), e.strerror or e)) from None
     work_dir = os.path.abspath(args.work_dir or os.path.splitext(args.out)[0] + "_cases")
-    os.makedirs(work_dir, exist_ok=True)
+    try:
+        os.makedirs(work_dir, exist_ok=True)
+    except OSError as e:
+        raise SweepError("--work-dir %s: cannot make it (%s)" % (shown(work_dir), e.strerror or e)) from None
     specs = []
     for k, case in enumerate(cases):
         specs.append({"scene": os.path.abspath(scene_path), "scene_text": scene_text, "base_dir": os.path.dirname(os.path.abspath(scene_path)),
@@ -285,26 +412,52 @@ def main(argv=None):
         except FileNotFoundError:
             pass
 
-    import dask
-    from distributed import Client, LocalCluster, as_completed
-    dask.config.set({"distributed.scheduler.allowed-failures": args.allowed_failures})
-    cluster = None
-    if args.scheduler:
-        client = Client(args.scheduler)
-    else:
-        workers = args.workers or max(1, (os.cpu_count() or 1) // max(1, args.threads))
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
-        client = Client(cluster)
     say = (lambda *a: None) if args.quiet else (lambda msg: print("sphxr.sweep: " + msg, file=sys.stderr, flush=True))
-    say("%d case(s) of %s on %s" % (len(cases), scene_path, client.scheduler.address if args.scheduler else
-                                    "a local cluster of %d worker processes" % len(cluster.workers)))
-    rows = [None] * len(cases)
-    futures = {}
-    for k, spec in enumerate(specs):
-        futures[client.submit(run_case, spec, key="sphxr-case-%03d-%s" % (k, os.urandom(4).hex()), pure=False)] = k
+    stopped_by = None
+    unwritten = None  # why the table could not be written as the last case finished (a full disk)
     done = failed = 0
-    begin = time.time()
+
+    def save():
+        """Writes the table; a failure (a full disk) is said once, and the sweep goes on: the rows are
+        kept, and written when the table next can be, or printed at the end."""
+        nonlocal unwritten
+        try:
+            write_table(args.out, keys, cases, rows)
+            if unwritten is not None:
+                say("the table %s is written again" % shown(args.out))
+            unwritten = None
+        except OSError as e:
+            if unwritten is None:
+                say("cannot write the table %s (%s): its rows are kept" % (shown(args.out), e.strerror or e))
+            unwritten = e.strerror or str(e)
+
+    cluster = client = None
+
+    def stop(signum, frame):
+        raise Stopped(signum)
+
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGTERM, signal.SIGHUP)}
     try:
+        import dask
+        from distributed import Client, LocalCluster, as_completed
+        dask.config.set({"distributed.scheduler.allowed-failures": args.allowed_failures})
+        if args.scheduler:
+            try:
+                client = Client(args.scheduler, timeout=10)
+            except (OSError, TimeoutError) as e:
+                raise SweepError("--scheduler %s: cannot connect (%s)" % (shown(args.scheduler), shown(e))) from None
+        else:
+            workers = args.workers or max(1, (os.cpu_count() or 1) // max(1, args.threads))
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+            client = Client(cluster)
+        say("%d case(s) of %s on %s" % (len(cases), shown(scene_path), shown(client.scheduler.address) if args.scheduler else
+                                        "a local cluster of %d worker processes" % len(cluster.workers)))
+        futures = {}
+        for k, spec in enumerate(specs):
+            futures[client.submit(run_case, spec, key="sphxr-case-%03d-%s" % (k, os.urandom(4).hex()), pure=False)] = k
+        for k in range(len(rows)):
+            rows[k] = {"status": "not finished", "attempts": 0}
+        begin = time.time()
         for future in as_completed(futures):
             k = futures[future]
             try:
@@ -316,26 +469,49 @@ def main(argv=None):
                         attempts = sum(1 for _ in f)
                 except OSError:
                     pass
-                rows[k] = {"status": "failed: %s: %s" % (type(e).__name__, str(e).replace("\n", " ")[:300]),
-                           "attempts": attempts}
+                rows[k] = {"status": "failed: %s: %s" % (type(e).__name__, shown(e, 300)), "attempts": attempts}
             done += 1
             ok = rows[k]["status"] == "ok"
             failed += 0 if ok else 1
+            save()
             say("[%d/%d, %d failed, %.0f s] case %d %s: %s%s%s" % (
-                done, len(cases), failed, time.time() - begin, k, label(cases[k]), rows[k]["status"],
+                done, len(cases), failed, time.time() - begin, k, label(cases[k]), shown(rows[k]["status"]),
                 " in %.1f s" % rows[k]["wall_s"] if ok else "",
                 " (attempt %d)" % rows[k]["attempts"] if rows[k].get("attempts", 1) > 1 else ""))
     except KeyboardInterrupt:
-        say("interrupted: the cases not finished are reported as such")
+        stopped_by = signal.SIGINT
+    except Stopped as e:
+        stopped_by = e.signum
     finally:
-        for k in range(len(rows)):
-            if rows[k] is None:
-                rows[k] = {"status": "not finished (the sweep was interrupted)", "attempts": 0}
-        write_table(args.out, keys, cases, rows)
-        client.close()
+        # Further signals wait: the table is written once more, then the cluster closes.
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            signal.signal(sig, signal.SIG_IGN)
+        if stopped_by is not None:
+            name = signal.Signals(stopped_by).name
+            for k in range(len(rows)):
+                if rows[k]["status"] in ("not started", "not finished"):
+                    rows[k] = {"status": "not finished (the sweep was stopped by %s)" % name, "attempts": 0}
+            save()
+            say("stopped by %s: %d of %d case(s) finished%s" % (
+                name, done, len(cases), ", written to %s" % shown(args.out) if unwritten is None else ""))
+        if client is not None:
+            client.close()
         if cluster is not None:
             cluster.close()
-    say("wrote %d row(s) to %s (%d failed)" % (len(rows), args.out, failed))
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    if unwritten is not None:
+        # The rows that could not reach --out are not lost: the table goes to stdout.
+        print("sphxr.sweep: error: --out %s: cannot write the table (%s): it follows on stdout"
+              % (shown(args.out), unwritten), file=sys.stderr, flush=True)
+        format_table(sys.stdout, keys, cases, rows)
+        sys.stdout.flush()
+    if stopped_by is not None:
+        return 128 + int(stopped_by)
+    if unwritten is not None:
+        return 2
+    say("wrote %d row(s) to %s (%d failed)" % (len(rows), shown(args.out), failed))
     return 0 if failed == 0 else 1
 
 

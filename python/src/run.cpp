@@ -11,10 +11,11 @@
 #include <numeric>
 #include <sstream>
 
-#include "sphxr/sim/measure.h"
+#include "sphxr/app/run_arguments.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/text_file.h"
+#include "sphxr/sim/measure.h"
 
 namespace sphxr::python {
 
@@ -75,6 +76,21 @@ Status ReadScene(const RunOptions& options, app::SceneFile* scene) {
   return app::LoadScene(path, scene);
 }
 
+Status CheckOptions(const RunOptions& options) {
+  if (options.sceneJson.empty()) {
+    if (Status s = app::CheckPathArgument("scene", options.scene); !s) return s;
+  }
+  if (Status s = app::CheckPathArgument("base_dir", options.origin, false); !s) return s;
+  if (Status s = app::CheckPathArgument("load_state", options.loadState, false); !s) return s;
+  if (Status s = app::CheckPathArgument("probes_csv", options.probesCsv, false); !s) return s;
+  if (Status s = app::CheckPathArgument("install_dir", options.installDir, false); !s) return s;
+  if (Status s = app::CheckRunArgument("threads", options.threads); !s) return s;
+  if (options.settle != -1.0) {
+    if (Status s = app::CheckRunArgument("settle", options.settle); !s) return s;
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Run::~Run() {
@@ -82,8 +98,9 @@ Run::~Run() {
   if (m_probesTemporary) std::remove(m_probesPath.c_str());
 }
 
-Status Run::Create(const RunOptions& options, std::unique_ptr<Run>* out) {
+Status Run::Create(const RunOptions& options, std::unique_ptr<Run>* out, const KeepGoing& keepGoing) {
   out->reset();
+  if (Status s = CheckOptions(options); !s) return s;
   std::unique_ptr<Run> run(new Run());
   app::SceneFile& scene = run->m_scene;
   if (Status s = ReadScene(options, &scene); !s) return s;
@@ -140,7 +157,10 @@ Status Run::Create(const RunOptions& options, std::unique_ptr<Run>* out) {
 
   const double settle = options.loadState.empty() ? (options.settle >= 0.0 ? options.settle : scene.runSettle) : 0.0;
   if (settle > 0.0) {
-    if (Status s = solver.Settle(settle, &run->m_settle); !s) return Status::Error("settle: " + s.message());
+    bool stopped = false;
+    const sim::SettleProgress progress = [&](double) { return !(stopped = keepGoing && !keepGoing()); };
+    if (Status s = solver.Settle(settle, &run->m_settle, progress); !s) return Status::Error("settle: " + s.message());
+    if (stopped) return Status::Ok();
   }
   run->m_startTime = solver.Time();
   run->m_recorder = std::make_unique<Recorder>(scene, options.recordDamBreak != 0);
@@ -155,16 +175,13 @@ Status Run::Step(int64_t steps, double untilTime, const KeepGoing& keepGoing) {
   std::lock_guard<std::mutex> lock(m_mutex);
   sim::Solver& solver = m_simulation->Solver();
   const auto t0 = std::chrono::steady_clock::now();
-  auto asked = std::chrono::steady_clock::now();
   Status status;
   for (int64_t k = 0; steps >= 0 ? k < steps : solver.Time() < untilTime - 1e-9; ++k) {
-    if (keepGoing && Seconds(asked) > 0.2) {
-      asked = std::chrono::steady_clock::now();
-      if (!keepGoing()) break;
-    }
     if (status = m_simulation->Step(); !status) break;
+    if (keepGoing && !keepGoing()) break;
   }
   m_recorder->wallSeconds += Seconds(t0);
+  if (m_probes && status) status = m_probes->Flush();
   return status;
 }
 
@@ -176,7 +193,7 @@ Status Run::RunScene(const KeepGoing& keepGoing) {
 
 Status Run::SaveState(const std::string& path) {
   std::lock_guard<std::mutex> lock(m_mutex);
-  if (path.empty()) return Status::Error("save_state: give a file name");
+  if (Status s = app::CheckPathArgument("save_state", path); !s) return s;
   return m_simulation->WriteState(path, m_scene.name);
 }
 

@@ -61,11 +61,14 @@ using KeepGoing = std::function<bool()>;
 
 class Run {
  public:
-  static Status Create(const RunOptions& options, std::unique_ptr<Run>* out);
+  /// The options are checked first (app/run_arguments.h: threads, settle, the file names); `keepGoing`
+  /// is asked after every step of the settle, which stops when it says no (status ok, *out empty).
+  static Status Create(const RunOptions& options, std::unique_ptr<Run>* out, const KeepGoing& keepGoing = {});
   ~Run();
 
   /// `steps` steps; or, with steps < 0, until the clock reaches `untilTime` (s). `keepGoing` is asked
-  /// every few steps; when it says no, the loop stops after the step in progress (status ok).
+  /// after every step; when it says no, the loop stops there (status ok). The probe rows the steps made
+  /// are written before it returns: a write that fails (a full disk) is its error.
   Status Step(int64_t steps, double untilTime, const KeepGoing& keepGoing);
   /// The scene's run: to run.time (or run.steps) from the start, as `sphxr --headless` without --time.
   Status RunScene(const KeepGoing& keepGoing);

@@ -10,9 +10,10 @@
 
 #include "backend.h"
 #include "sampling.h"
-#include "sphxr/common/log.h"
-#include "sphxr/sim/solver_table.h"
 #include "scene_check.h"
+#include "sphxr/common/log.h"
+#include "sphxr/sim/openmp_wait.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::sim {
 
@@ -183,7 +184,10 @@ Solver::~Solver() = default;
 Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::unique_ptr<Solver>* out) {
   out->reset();
   if (Status s = ValidateScene(scene); !s) return s;
-  if (config.threads < 0) return Status::Error(Format("threads = %d is invalid: must be 0 (all) or more", config.threads));
+  if (config.threads < 0 || config.threads > MaxSolverThreads()) {
+    return Status::Error(Format("threads %d: must be from 0 (all cores) to %d (four per core here, at least 64)",
+                                config.threads, MaxSolverThreads()));
+  }
 
   std::unique_ptr<Solver> solver(new Solver());
   solver->m_scene = scene;
@@ -214,6 +218,8 @@ Status Solver::Create(const SceneSetup& scene, const SolverConfig& config, std::
       return Status::Error("--device cuda: no CUDA device available (no GPU or no driver); use --device cpu or auto");
     }
     solver->m_backend = MakeCudaBackend(&why);
+  } else if (Status t = CheckThreadsCanStart(config.threads, Format("threads %d", config.threads)); !t) {
+    return t;
   } else if (device == Device::kCpuReference) {
     solver->m_backend = MakeCpuReferenceBackend(config.threads);
   } else {

@@ -138,7 +138,7 @@ TEST(CommandLineTest, AScenesNameIsFoundAndANameFoundNowhereIsRefusedWhenRead) {
   SceneFile scene;
   const Status s = LoadSceneWithOptions(o, &scene);
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("--scene no_such_scene: no scene no_such_scene or no_such_scene.json in the current "
+  EXPECT_NE(s.message().find("--scene no_such_scene: no scene of that name (nor with .json) in the current "
                              "directory, " SPHXR_SCENES_DIR),
             std::string::npos)
       << s.message();

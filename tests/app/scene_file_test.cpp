@@ -528,7 +528,8 @@ TEST(SceneSearchTest, InstalledScenesReplaceTheBuildsAndTheCurrentDirectoryComes
   // The build's scenes are not an installed program's: a name only they have is not found.
   const Status s = FindScene("stir", &path, installed.path().string());
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("no scene stir or stir.json in the current directory, " + installed.path().string()),
+  EXPECT_NE(s.message().find("--scene stir: no scene of that name (nor with .json) in the current directory, " +
+                             installed.path().string()),
             std::string::npos)
       << s.message();
   EXPECT_EQ(s.message().find(SPHXR_SCENES_DIR), std::string::npos) << s.message();

@@ -77,6 +77,15 @@ prefix = os.environ["PREFIX"]
 assert sphxr.__file__.startswith(prefix), sphxr.__file__
 assert sphxr.find_scene("install_test_tank") == os.path.join(prefix, "share/sphxr/scenes/install_test_tank.json")
 assert sphxr.data_dir() == os.path.join(prefix, "share/sphxr/data"), sphxr.data_dir()
+# A name not found is one line naming the installed scenes, its control characters escaped.
+try:
+    sphxr.find_scene("no_such\x1b]0;owned\x07\u202e")
+    raise AssertionError("found")
+except sphxr.Error as e:
+    message = str(e)
+assert "no_such\\x1B]0;owned\\x07\\u202E: no scene of that name" in message, message
+assert os.path.join(prefix, "share/sphxr/scenes") in message, message
+assert all(ord(c) >= 0x20 for c in message) and "\u202e" not in message, repr(message)
 sphxr.set_log_level("warn")
 run = sphxr.Run("install_test_tank", threads=1).step(2)
 assert run.positions().shape == (run.fluid_count, 3) and run.steps == 2

@@ -28,7 +28,7 @@ def test_the_module_is_debians_build_and_loads_no_graphics_library():
 def test_a_scene_by_name_as_the_program_finds_it():
     path = sphxr.find_scene("stir")
     assert os.path.basename(path) == "stir.json" and os.path.isfile(path)
-    with pytest.raises(sphxr.Error, match=r"no scene no_such_scene or no_such_scene\.json in"):
+    with pytest.raises(sphxr.Error, match=r"--scene no_such_scene: no scene of that name \(nor with \.json\) in"):
         sphxr.find_scene("no_such_scene")
     assert "spacing" in sphxr.parameter_names() and "method" in sphxr.parameter_names()
 

@@ -151,5 +151,5 @@ def test_a_bad_grid_is_refused_before_any_cluster(tmp_path):
     code, out = finish(sweep(["dam_break", "--grid", "spacing", "--out", tmp_path / "x.csv"], tmp_path), 60)
     assert code == 2 and "--grid spacing: expected KEY=V1,V2" in out, out
     code, out = finish(sweep(["no_such_scene", "--out", tmp_path / "x.csv"], tmp_path), 60)
-    assert code == 2 and "no scene no_such_scene" in out, out
+    assert code == 2 and "--scene no_such_scene: no scene of that name" in out, out
     assert not (tmp_path / "x.csv").exists()

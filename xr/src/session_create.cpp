@@ -1,6 +1,8 @@
 // Creating an xr::Session: the runtime probe, instance, HMD system and blend mode, the session with
 // its platform binding, the play and view reference spaces (and recentring, which replaces the play
 // space), then actions and swapchains in that order; and the teardown that undoes it all.
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,12 +13,36 @@
 #include "openxr_include.h"
 #include "session_impl.h"
 #include "sphxr/common/log.h"
+#include "sphxr/common/shown_text.h"
 
 namespace sphxr::xr {
 
+namespace {
+
+/// XR_RUNTIME_JSON, when set, names a regular file under kMaxManifestBytes, checked before the loader
+/// reads it: /dev/zero grew the loader's memory without end, a FIFO blocked it for ever.
+Status CheckRuntimeManifest() {
+  constexpr long long kMaxManifestBytes = 1 << 20;
+  const char* path = std::getenv("XR_RUNTIME_JSON");
+  if (!path || !*path) return Status::Ok();
+  struct stat st {};
+  std::string why;
+  if (stat(path, &st) != 0) return Status::Ok();  // missing: the loader's own answer (no runtime)
+  if (!S_ISREG(st.st_mode))
+    why = "not a regular file";
+  else if (st.st_size > kMaxManifestBytes)
+    why = Format("%lld bytes, more than a manifest's %lld", static_cast<long long>(st.st_size), kMaxManifestBytes);
+  if (why.empty()) return Status::Ok();
+  return Status::Error("no OpenXR runtime available (XR_RUNTIME_JSON=" + ShowText(path) + " is " + why +
+                       "): point XR_RUNTIME_JSON at a runtime's manifest; docs/dev/xr.md shows the simulated headset");
+}
+
+}  // namespace
+
 Status ProbeRuntime() {
-  // The loader prints its own "Error [...]" lines to stderr when no runtime is found; our status
-  // says it in one line. Users who want the loader's view set XR_LOADER_DEBUG themselves.
+  if (Status s = CheckRuntimeManifest(); !s) return s;
+    // The loader prints its own "Error [...]" lines to stderr when no runtime is found; our status
+    // says it in one line. Users who want the loader's view set XR_LOADER_DEBUG themselves.
 #if defined(_WIN32)
   if (!std::getenv("XR_LOADER_DEBUG")) _putenv_s("XR_LOADER_DEBUG", "none");
 #else

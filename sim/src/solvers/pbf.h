@@ -51,14 +51,14 @@ class PbfSolver final : public PressureSolver<Traits> {
     // 5. XSPH viscosity                                                                   [MM13 eq. 17]
     if (ph.pbfXsph > 0.0f) {
       ctx.Launch().ForEach(ctx.n, 64, PbfXsphStage{ctx.grid, ctx.fluid, list, ph, view});
-      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, view});
+      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, ph, view});
     }
     // 5b. vorticity confinement, when the scene asks for it                            [MM13 eq. 15-16]
     if (ph.pbfVorticity > 0.0f) {
       if (m_vorticity.size() != static_cast<size_t>(ctx.n)) m_vorticity.resize(static_cast<size_t>(ctx.n));
       ctx.Launch().ForEach(ctx.n, 64, PbfVorticityStage{ctx.grid, ctx.fluid, list, ph, Raw(m_vorticity)});
       ctx.Launch().ForEach(ctx.n, 64, PbfConfinementStage{ctx.grid, ctx.fluid, list, ph, view, Raw(m_vorticity), ctx.dt});
-      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, view});
+      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, ph, view});
     }
     SPHXR_TRY(ctx.Lap(Stage::kIntegrate));
     // 6. the fluid's force on the paddles: the impulse of the corrections their particles caused

@@ -14,9 +14,9 @@
 //   collide   x* out of the tank's faces and the obstacles by the particle's radius (half a spacing),
 //             in the prediction and after every iteration's correction                 [MM13 alg. 1]
 //   finish    v = (x* - x) / dt (capped at pbf_max_speed), the clamps, the pressure estimate (below)
-//   xsph      v_i += c sum_j V (v_j - v_i) W_ij                                        [MM13 eq. 17]
+//   xsph      v_i += c sum_j V (v_j - v_i) W_ij (capped at pbf_max_speed)                [MM13 eq. 17]
 //   vorticity (pbf_vorticity > 0) omega_i = sum_j V (v_i - v_j) x grad_i W_ij, N = grad|omega| / |grad|omega||,
-//             v_i += dt eps (N x omega_i)                                         [MM13 eq. 15-16]
+//             v_i += dt eps (N x omega_i) (capped at pbf_max_speed)              [MM13 eq. 15-16]
 //
 // The pressure estimate: a step's corrections move particle i by sum over iterations of its lambda
 // terms, the displacement a pressure p_i would give in the WCSPH momentum equation over dt^2 when
@@ -63,6 +63,15 @@ SPHXR_HD SPHXR_INLINE bool PbfCollide(const Physics& ph, Vec4* x) {
   return moved;
 }
 
+/// |v| at most pbf_max_speed, its direction kept: the safety net after every change of the velocity.
+SPHXR_HD SPHXR_INLINE void PbfCapSpeed(const Physics& ph, Vec4* v) {
+  const float speed2 = v->x * v->x + v->y * v->y + v->z * v->z;
+  if (speed2 > ph.pbfMaxSpeed * ph.pbfMaxSpeed) {
+    const float s = ph.pbfMaxSpeed / sqrtf(speed2);
+    v->x *= s, v->y *= s, v->z *= s;
+  }
+}
+
 /// x* = x + dt (v + dt g) and its collision response, the start position in acceleration.xyz.
 /// Before the grid: the neighbour grid is built once per step, at the predicted positions.
 struct PbfPredictStage {
@@ -75,12 +84,7 @@ struct PbfPredictStage {
     v.x += dt * ph.gravity.x;
     v.y += dt * ph.gravity.y;
     v.z += dt * ph.gravity.z;
-    const float speed2 = v.x * v.x + v.y * v.y + v.z * v.z;
-    const float cap = ph.pbfMaxSpeed;
-    if (speed2 > cap * cap) {
-      const float s = cap / sqrtf(speed2);
-      v.x *= s, v.y *= s, v.z *= s;
-    }
+    PbfCapSpeed(ph, &v);
     fluid.acceleration[i] = Vec4{x.x, x.y, x.z, 0.0f};
     x.x += dt * v.x;
     x.y += dt * v.y;
@@ -236,11 +240,7 @@ struct PbfFinishStage {
     const float inv = 1.0f / dt;
     Vec4 v{(x.x - start.x) * inv, (x.y - start.y) * inv, (x.z - start.z) * inv, vStar.w};
     // The safety net holds for the velocity the corrections give too, not only the predicted one.
-    const float speed2 = v.x * v.x + v.y * v.y + v.z * v.z;
-    if (speed2 > ph.pbfMaxSpeed * ph.pbfMaxSpeed) {
-      const float s = ph.pbfMaxSpeed / sqrtf(speed2);
-      v.x *= s, v.y *= s, v.z *= s;
-    }
+    PbfCapSpeed(ph, &v);
     bool clamped = ph.obstacleCount > 0 && ClampOutOfObstacles(ph, &x, &v);
     clamped = ClampToDomain(ph, &x, &v) || clamped;
     // v* = v^n + dt g: the step's acceleration is (v - v^n) / dt = (v - v*) / dt + g.
@@ -276,9 +276,11 @@ struct PbfXsphStage {
   }
 };
 
-/// v_i += view.delta_i: the velocity change a pass before it left there (XSPH's, the confinement's).
+/// v_i += view.delta_i, capped: the velocity change a pass before it left there (XSPH's, the
+/// confinement's), which can push a particle past the cap the finish held it to.
 struct PbfAddVelocityChangeStage {
   FluidView fluid;
+  Physics ph;
   PbfView view;
   SPHXR_HD void operator()(int i) const {
     Vec4 v = fluid.velocity[i];
@@ -286,6 +288,7 @@ struct PbfAddVelocityChangeStage {
     v.x += d.x;
     v.y += d.y;
     v.z += d.z;
+    PbfCapSpeed(ph, &v);
     fluid.velocity[i] = v;
   }
 };

@@ -76,9 +76,9 @@ XRAPI_ATTR XrResult XRAPI_CALL EndFrame(XrSession handle, const XrFrameEndInfo* 
   ++s->framesEnded;
   const Config& c = s->instance->config;
   for (int v = 0; v < 2; ++v) s->depthLayersReceived[v] += depthViews[v];
-  if (projection && !c.captureDir.empty() && (s->framesEnded - 1) % c.captureEvery == 0) {
+  if (projection && !c.captureDir.empty() && !s->instance->captureFailed && (s->framesEnded - 1) % c.captureEvery == 0) {
     CaptureFrame(s, *projection);
-    RecordDepthLayers(s, *projection, depthViews);
+    if (!s->instance->captureFailed) RecordDepthLayers(s, *projection, depthViews);
   }
   if (s->state == XR_SESSION_STATE_SYNCHRONIZED && !s->exitRequested) {
     PushSessionState(s, XR_SESSION_STATE_VISIBLE);

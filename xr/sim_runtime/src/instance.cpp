@@ -1,12 +1,16 @@
 // The simulated headset's instance and system: its settings read from the environment, the
 // instance (pose script, haptics log), the event queue, result and structure names, the one HMD
 // system with its stereo view configuration and OpenGL requirements.
+#include <openxr/openxr_reflection.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <type_traits>
-
-#include <openxr/openxr_reflection.h>
 
 #include "runtime.h"
 
@@ -28,8 +32,8 @@ XrResult ReadConfig(Config* c, std::string* error) {
     if (v.empty()) return true;
     char* end = nullptr;
     double d = std::strtod(v.c_str(), &end);
-    if (end == v.c_str() || *end != '\0' || d < lo || d > hi) {
-      *error = std::string(name) + "='" + v + "' is not a number in [" + std::to_string(lo) + ", " +
+    if (end == v.c_str() || *end != '\0' || !std::isfinite(d) || d < lo || d > hi) {
+      *error = std::string(name) + "='" + Shown(v) + "' is not a number in [" + std::to_string(lo) + ", " +
                std::to_string(hi) + "]";
       return false;
     }
@@ -44,9 +48,10 @@ XrResult ReadConfig(Config* c, std::string* error) {
       !num("SPHXR_SIM_XR_LOSE_INSTANCE_AFTER_FRAMES", 0, 1e12, &c->loseInstanceAfterFrames))
     return XR_ERROR_INITIALIZATION_FAILED;
   if (std::string size = Env("SPHXR_SIM_XR_EYE_SIZE"); !size.empty()) {
-    if (std::sscanf(size.c_str(), "%dx%d", &c->eyeWidth, &c->eyeHeight) != 2 || c->eyeWidth < 1 ||
+    char tail = 0;
+    if (std::sscanf(size.c_str(), "%dx%d%c", &c->eyeWidth, &c->eyeHeight, &tail) != 2 || c->eyeWidth < 1 ||
         c->eyeHeight < 1 || c->eyeWidth > 8192 || c->eyeHeight > 8192) {
-      *error = "SPHXR_SIM_XR_EYE_SIZE='" + size + "' is not WIDTHxHEIGHT (1..8192)";
+      *error = "SPHXR_SIM_XR_EYE_SIZE='" + Shown(size) + "' is not WIDTHxHEIGHT (1..8192)";
       return XR_ERROR_INITIALIZATION_FAILED;
     }
   }
@@ -54,7 +59,19 @@ XrResult ReadConfig(Config* c, std::string* error) {
     c->profile = p.rfind("/interaction_profiles/", 0) == 0 ? p : "/interaction_profiles/" + p;
   c->poseScriptPath = Env("SPHXR_SIM_XR_POSES");
   c->captureDir = Env("SPHXR_SIM_XR_CAPTURE_DIR");
+  // A capture folder that cannot take the pictures is one line here, not one a frame.
+  if (struct stat st{}; !c->captureDir.empty() && (stat(c->captureDir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) ||
+                                                   access(c->captureDir.c_str(), W_OK) != 0)) {
+    *error = "SPHXR_SIM_XR_CAPTURE_DIR='" + Shown(c->captureDir) + "' is not a folder this process can write";
+    return XR_ERROR_INITIALIZATION_FAILED;
+  }
   c->hapticsLogPath = Env("SPHXR_SIM_XR_HAPTICS_LOG");
+  // A FIFO would block the instance's creation until a reader came; a device is no log.
+  if (struct stat st{};
+      !c->hapticsLogPath.empty() && stat(c->hapticsLogPath.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    *error = "SPHXR_SIM_XR_HAPTICS_LOG='" + Shown(c->hapticsLogPath) + "' is not a regular file";
+    return XR_ERROR_INITIALIZATION_FAILED;
+  }
   c->failSessionCreate = Env("SPHXR_SIM_XR_FAIL_SESSION") == "1";
   return XR_SUCCESS;
 }

@@ -1,6 +1,11 @@
 #include "pose_script.h"
 
+#include <sys/stat.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -34,9 +39,19 @@ DeviceSample DefaultSample(Device device, double t) {
 PoseScript PoseScript::Default() { return {}; }
 
 bool PoseScript::Load(const std::string& path, PoseScript* out, std::string* error) {
+  // A regular file under kMaxBytes only: /dev/zero grew without end, a FIFO waited for a writer.
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > kMaxBytes) {
+    *error = "SPHXR_SIM_XR_POSES='" + Shown(path) + "' is not a pose script (" +
+             (stat(path.c_str(), &st) != 0 ? std::string(std::strerror(errno))
+              : !S_ISREG(st.st_mode)       ? std::string("not a regular file")
+                                           : "larger than " + std::to_string(kMaxBytes) + " bytes") +
+             ")";
+    return false;
+  }
   std::ifstream in(path);
   if (!in) {
-    *error = "cannot open pose script '" + path + "'";
+    *error = "cannot open pose script '" + Shown(path) + "'";
     return false;
   }
   std::stringstream ss;
@@ -60,7 +75,8 @@ bool PoseScript::Parse(const std::string& text, PoseScript* out, std::string* er
       return false;
     };
     if (first == "loop") {
-      if (!(ls >> script.m_loopSeconds) || script.m_loopSeconds <= 0) return fail("'loop' needs a period > 0 s");
+      if (!(ls >> script.m_loopSeconds) || !std::isfinite(script.m_loopSeconds) || script.m_loopSeconds <= 0)
+        return fail("'loop' needs a period > 0 s");
       continue;
     }
     Key key;
@@ -68,29 +84,35 @@ bool PoseScript::Parse(const std::string& text, PoseScript* out, std::string* er
     try {
       key.time = std::stod(first);
     } catch (...) {
-      return fail("expected a time in seconds, got '" + first + "'");
+      return fail("expected a time in seconds, got '" + Shown(first) + "'");
     }
+    if (!std::isfinite(key.time) || key.time < 0.0) return fail("the time must be a finite number of seconds from 0");
     Pose& p = key.sample.pose;
     if (!(ls >> device >> p.position.x >> p.position.y >> p.position.z >> p.orientation.x >> p.orientation.y >>
           p.orientation.z >> p.orientation.w))
       return fail("expected <time> <head|left|right> px py pz qx qy qz qw");
     int index = device == "head" ? 0 : device == "left" ? 1 : device == "right" ? 2 : -1;
-    if (index < 0) return fail("unknown device '" + device + "' (head, left or right)");
+    if (index < 0) return fail("unknown device '" + Shown(device) + "' (head, left or right)");
+    for (float c : {p.position.x, p.position.y, p.position.z}) {
+      if (!std::isfinite(c) || std::fabs(c) > 1e4f) return fail("a position must be finite, within 10 km");
+    }
     float qn = std::sqrt(p.orientation.x * p.orientation.x + p.orientation.y * p.orientation.y +
                          p.orientation.z * p.orientation.z + p.orientation.w * p.orientation.w);
-    if (std::fabs(qn - 1.0f) > 1e-3f) return fail("orientation is not a unit quaternion");
+    if (!(std::fabs(qn - 1.0f) <= 1e-3f)) return fail("orientation is not a unit quaternion");
     p.orientation = Normalized(p.orientation);
     std::string kv;
     while (ls >> kv) {
       auto eq = kv.find('=');
-      if (eq == std::string::npos) return fail("expected key=value, got '" + kv + "'");
+      if (eq == std::string::npos) return fail("expected key=value, got '" + Shown(kv) + "'");
       std::string k = kv.substr(0, eq);
       float v = 0;
       try {
         v = std::stof(kv.substr(eq + 1));
       } catch (...) {
-        return fail("bad value in '" + kv + "'");
+        return fail("bad value in '" + Shown(kv) + "'");
       }
+      if (!std::isfinite(v) || ((k == "trigger" || k == "squeeze") && (v < 0.0f || v > 1.0f)))
+        return fail("'" + Shown(kv) + "': a value from 0 to 1 (trigger, squeeze) or a finite number");
       DeviceSample& s = key.sample;
       if (k == "trigger") s.trigger = v;
       else if (k == "squeeze") s.squeeze = v;
@@ -100,7 +122,8 @@ bool PoseScript::Parse(const std::string& text, PoseScript* out, std::string* er
       else if (k == "trackpad") s.trackpad = v != 0;
       else if (k == "thumbstick") s.thumbstick = v != 0;
       else if (k == "tracked") s.tracked = v != 0;
-      else return fail("unknown key '" + k + "'");
+      else
+        return fail("unknown key '" + Shown(k) + "'");
     }
     auto& keys = script.m_keys[index];
     if (!keys.empty() && key.time < keys.back().time) return fail("times of one device must not decrease");

@@ -12,6 +12,7 @@
 // key frame's value. Before the first / after the last key frame the device holds that frame. A
 // device with no key frame keeps its default motion. `loop <seconds>` on its own line repeats the
 // script with that period.
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -29,8 +30,27 @@ struct DeviceSample {
   bool tracked = true;
 };
 
+/// `text` for a message: bytes outside printable ASCII as \xNN, cut after 80 (a setting or a script
+/// may hold anything).
+inline std::string Shown(const std::string& text) {
+  std::string out;
+  for (const unsigned char c : text) {
+    if (out.size() >= 80) return out + "... (" + std::to_string(text.size()) + " bytes)";
+    if (c < 0x20 || c >= 0x7F) {
+      char escape[8];
+      std::snprintf(escape, sizeof escape, "\\x%02X", c);
+      out += escape;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
 class PoseScript {
  public:
+  /// The largest pose script read (SPHXR_SIM_XR_POSES), in bytes.
+  static constexpr long kMaxBytes = 16L << 20;
   /// The default motion: head at (0, 1.6, 0.5) looking 30 degrees down at a tank centred near
   /// (0, 1.0, -0.4); left controller held still; right controller circling (radius 0.1 m, 0.5 Hz)
   /// at (0.1, 1.0, -0.4) with its grip pointing down, trigger at 0.8.

@@ -78,6 +78,7 @@ struct Instance {
   bool lost = false;
   Session* session = nullptr;
   FILE* hapticsLog = nullptr;
+  bool captureFailed = false;  // a picture could not be written: said once, no more captured
 };
 
 struct Space {

@@ -206,8 +206,11 @@ void CaptureFrame(Session* s, const XrCompositionLayerProjection& layer) {
     char name[64];
     std::snprintf(name, sizeof name, "/frame_%06ld_%s.png", s->framesEnded, v == 0 ? "left" : "right");
     std::string path = s->instance->config.captureDir + name;
-    if (!WritePng(path, r.extent.width, r.extent.height, out))
-      std::fprintf(stderr, "sphxr simulated headset: cannot write '%s'\n", path.c_str());
+    if (!s->instance->captureFailed && !WritePng(path, r.extent.width, r.extent.height, out)) {
+      std::fprintf(stderr, "sphxr simulated headset: cannot write '%s': no more frames are captured\n",
+                   Shown(path).c_str());
+      s->instance->captureFailed = true;
+    }
   }
   glPixelStorei(GL_PACK_ALIGNMENT, prevAlign);
   glBindTexture(GL_TEXTURE_2D, GLuint(prevTex));

@@ -81,6 +81,8 @@ class ProbeSink : public SimulationSink {
   Status OnStart(Simulation& simulation) override;
   Status OnStep(Simulation& simulation, const sim::StepInfo& info) override;
   Status Finish(Simulation& simulation, bool interrupted) override;
+  /// Writes the rows made so far (those up to the last reading; the rest need the next step's).
+  Status Flush() { return m_csv->Flush(); }
   int64_t Rows() const { return m_csv ? m_csv->Rows() : 0; }
 
  private:

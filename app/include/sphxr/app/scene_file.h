@@ -15,6 +15,10 @@
 
 namespace sphxr::app {
 
+/// The deepest nesting a scene file may have (no scene nests deeper than 6; the cap keeps every walk of
+/// it shallow). The Python module refuses a deeper dict before turning it into text.
+inline constexpr int kMaxSceneDepth = 64;
+
 /// What the runner and the tests measure on a scene ("probe" section).
 struct DamBreakProbe {
   float columnWidth = 0.0f;   // a, m: the column's width along x from the back wall

@@ -29,6 +29,7 @@ struct XrOutcome {
   bool started = false;    // a session was created
   bool fallback = false;   // the error is the headset's (no display, no runtime, no session): fall back
   bool lost = false;       // the session or instance was lost mid-run (fall back, or exit)
+  int interrupted = 0;     // SIGINT, SIGTERM or SIGHUP ended the session (its water saved as a lost one's)
   std::string savedState;  // lost: where the running water was saved (the window continues from it)
   int64_t frames = 0;      // frames whose update ran
   int64_t rendered = 0;    // frames with eyes drawn
@@ -41,7 +42,8 @@ struct XrOutcome {
   double peakMeanFluidSpeed = 0;          // m/s, the largest mean over the snapshots drawn
 };
 
-/// Runs the headset until the session ends (the runtime, the window closing, `--frame-limit` frames).
+/// Runs the headset until the session ends (the runtime, the window closing, `--frame-limit` frames, a
+/// SIGINT, SIGTERM or SIGHUP: the session is ended as the end button ends it, then saved as a lost one).
 /// An error status means no session could be started (no display, no runtime, a runtime failing at
 /// session creation, a bad scene): one line, nothing was shown; the caller falls back.
 Status RunXr(const Options& options, XrOutcome* outcome);

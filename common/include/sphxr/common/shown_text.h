@@ -29,6 +29,10 @@ std::string ShowText(std::string_view text, size_t maxBytes = kShownLength);
 /// The first `maxNames` names, each through ShowText, joined by ", ", then "and N more".
 std::string ShowList(const std::vector<std::string>& names, size_t maxNames = kShownNames);
 
+/// `value` in the fewest digits that read back as the same double ("10.0000001", "1e-06", "3600",
+/// "nan", "inf"): a bound and a value just past it print differently, as %g's six digits did not.
+std::string ShowNumber(double value);
+
 /// Text that ShowText would leave as it is: valid UTF-8 without a hidden code point. The checks of a
 /// scene's names refuse what this refuses.
 bool IsPlainText(std::string_view text);
