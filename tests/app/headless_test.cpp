@@ -161,7 +161,8 @@ TEST(CommandLineTest, EveryFlagInTheUsageTextIsAccepted) {
       {"--screenshot", "a.png"}, {"--frames", "d"}, {"--fps", "30"}, {"--image-size", "64x48"},
       {"--window-size", "640x480"}, {"--frame-limit", "3"}, {"--render", "particles"}, {"--quality", "auto"},
       {"--checkpoint-every", "0.1"}, {"--checkpoint-keep", "3"}, {"--export-interval", "0.01"},
-      {"--export-surface-interval", "0.02"}, {"--probes", "p.csv"}};
+      {"--export-surface-interval", "0.02"}, {"--probes", "p.csv"}, {"--render-quality", "low"},
+      {"--frame-stats", "f.csv"}};
   const std::string usage = UsageText();
   std::set<std::string> flags;
   const std::regex flag("--[a-z][a-z-]*");

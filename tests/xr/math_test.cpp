@@ -136,9 +136,16 @@ TEST(SimRuntimePoseScript, InterpolatesPositionsAndSlerpsOrientations) {
   auto end = script.Sample(simrt::Device::kRight, 5.0);
   ExpectNear(end.pose.position, {1, 1, 0});
   EXPECT_TRUE(end.menu);
-  // A device without key frames keeps the default motion: the head looks at the tank.
+  // A device without key frames keeps the default motion: the head of a person standing at the table
+  // (eyes 1.55 m up) looks at the tank's centre (0, 1.0, -0.4) at arm's reach (under 0.8 m).
   auto head = script.Sample(simrt::Device::kHead, 0.0);
-  EXPECT_NEAR(head.pose.position.y, 1.6f, 1e-6f);
+  EXPECT_NEAR(head.pose.position.y, 1.55f, 1e-6f);
+  const Vec3 forward = Rotate(head.pose.orientation, {0, 0, -1});
+  const Vec3 toTank{0.0f - head.pose.position.x, 1.0f - head.pose.position.y, -0.4f - head.pose.position.z};
+  const float distance = std::sqrt(toTank.x * toTank.x + toTank.y * toTank.y + toTank.z * toTank.z);
+  EXPECT_LT(distance, 0.8f);
+  const float cosAngle = (forward.x * toTank.x + forward.y * toTank.y + forward.z * toTank.z) / distance;
+  EXPECT_GT(cosAngle, std::cos(10.0f * kPi / 180.0f)) << "the head looks more than 10 degrees away from the tank";
 }
 
 TEST(SimRuntimePoseScript, BadLinesAreNamed) {
