@@ -17,25 +17,7 @@ using ReferenceImageTest = RenderFixture;
 
 TEST_F(ReferenceImageTest, FixedSceneMatchesTheStoredImage) {
   // Water mesh: a closed box of water in the tank's corner.
-  std::vector<float> positions, normals;
-  std::vector<uint32_t> indices;
-  const glm::vec3 lo(0.02f, 0.0f, 0.02f), hi(0.25f, 0.12f, 0.2f);
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side = 0; side < 2; ++side) {
-      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-      const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
-      for (int k = 0; k < 4; ++k) {
-        glm::vec3 p, n(0.0f);
-        p[axis] = side ? hi[axis] : lo[axis];
-        p[a] = (k == 1 || k == 2) ? hi[a] : lo[a];
-        p[b] = (k >= 2) ? hi[b] : lo[b];
-        n[axis] = side ? 1.0f : -1.0f;
-        positions.insert(positions.end(), {p.x, p.y, p.z});
-        normals.insert(normals.end(), {n.x, n.y, n.z});
-      }
-      indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-  }
+  const BoxMesh water(glm::vec3(0.02f, 0.0f, 0.02f), glm::vec3(0.25f, 0.12f, 0.2f));
   std::vector<sim::Vec4> particles, velocities;
   for (int i = 0; i < 50; ++i) {
     particles.push_back({0.3f + 0.005f * (i % 10), 0.02f + 0.01f * (i / 10), 0.1f, 0});
@@ -46,8 +28,7 @@ TEST_F(ReferenceImageTest, FixedSceneMatchesTheStoredImage) {
   scene.obstacles.push_back(sim::Aabb{{0.3f, 0, 0.15f}, {0.36f, 0.08f, 0.22f}});
   scene.solids.push_back(render::SolidMesh{{}, glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.15f, 0.2f, 0.1f)),
                                                           glm::vec3(0.03f)), glm::vec3(0.95f, 0.55f, 0.15f)});
-  scene.surface = {positions.data(), normals.data(), static_cast<int>(positions.size() / 3), indices.data(),
-                   static_cast<int>(indices.size())};
+  scene.surface = water.View();
   scene.particles.position = particles.data();
   scene.particles.velocity = velocities.data();
   scene.particles.count = static_cast<int>(particles.size());

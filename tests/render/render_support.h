@@ -94,4 +94,33 @@ inline bool RayHitsBox(glm::vec3 o, glm::vec3 d, glm::vec3 lo, glm::vec3 hi, flo
   return true;
 }
 
+/// A closed box as a triangle mesh with outward normals (indexed: 24 vertices, 36 indices).
+struct BoxMesh {
+  std::vector<float> positions, normals;
+  std::vector<uint32_t> indices;
+  BoxMesh(glm::vec3 lo, glm::vec3 hi) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int side = 0; side < 2; ++side) {
+        const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+        const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
+        for (int k = 0; k < 4; ++k) {
+          glm::vec3 p;
+          p[axis] = side ? hi[axis] : lo[axis];
+          p[a] = (k == 1 || k == 2) ? hi[a] : lo[a];
+          p[b] = (k >= 2) ? hi[b] : lo[b];
+          glm::vec3 n(0.0f);
+          n[axis] = side ? 1.0f : -1.0f;
+          positions.insert(positions.end(), {p.x, p.y, p.z});
+          normals.insert(normals.end(), {n.x, n.y, n.z});
+        }
+        indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      }
+    }
+  }
+  render::MeshView View() const {
+    return {positions.data(), normals.data(), static_cast<int>(positions.size() / 3), indices.data(),
+            static_cast<int>(indices.size())};
+  }
+};
+
 }  // namespace sphxr::test

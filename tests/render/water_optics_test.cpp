@@ -179,28 +179,9 @@ TEST_F(WaterOpticsTest, RefractionShowsTheBackgroundDisplacedInsideTheWaterOnly)
 
 TEST_F(WaterOpticsTest, FresnelReflectsTheSkyAtGrazingIncidenceAndLittleHeadOn) {
   // Deep flat water (1 m) over a black floor under the sky; the sun behind the camera (no glint).
-  std::vector<float> positions, normals;
-  std::vector<uint32_t> indices;
-  const glm::vec3 lo(-20.0f, -1.0f, -20.0f), hi(20.0f, 0.0f, 20.0f);
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side = 0; side < 2; ++side) {
-      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-      const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
-      for (int k = 0; k < 4; ++k) {
-        glm::vec3 p, n(0.0f);
-        p[axis] = side ? hi[axis] : lo[axis];
-        p[a] = (k == 1 || k == 2) ? hi[a] : lo[a];
-        p[b] = (k >= 2) ? hi[b] : lo[b];
-        n[axis] = side ? 1.0f : -1.0f;
-        positions.insert(positions.end(), {p.x, p.y, p.z});
-        normals.insert(normals.end(), {n.x, n.y, n.z});
-      }
-      indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-  }
+  const BoxMesh box(glm::vec3(-20.0f, -1.0f, -20.0f), glm::vec3(20.0f, 0.0f, 20.0f));
   render::FrameScene scene = Bare();
-  scene.surface = {positions.data(), normals.data(), static_cast<int>(positions.size() / 3), indices.data(),
-                   static_cast<int>(indices.size())};
+  scene.surface = box.View();
   render::SolidMesh floor;
   floor.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0, -1.05f, 0)), glm::vec3(60.0f, 0.1f, 60.0f));
   floor.color = glm::vec3(0.0f);
@@ -298,27 +279,9 @@ TEST_F(WaterOpticsTest, AbsorptionThroughAWedgeIsBeerLambertAndTakesRedFirst) {
 
 TEST_F(WaterOpticsTest, TheWaterLeavesItsSurfaceDepthInTheViewsDepthBuffer) {
   const glm::vec3 lo(-0.3f, 0.2f, -0.2f), hi(0.3f, 0.7f, 0.1f);
-  std::vector<float> positions, normals;
-  std::vector<uint32_t> indices;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side = 0; side < 2; ++side) {
-      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-      const uint32_t base = static_cast<uint32_t>(positions.size() / 3);
-      for (int k = 0; k < 4; ++k) {
-        glm::vec3 p, n(0.0f);
-        p[axis] = side ? hi[axis] : lo[axis];
-        p[a] = (k == 1 || k == 2) ? hi[a] : lo[a];
-        p[b] = (k >= 2) ? hi[b] : lo[b];
-        n[axis] = side ? 1.0f : -1.0f;
-        positions.insert(positions.end(), {p.x, p.y, p.z});
-        normals.insert(normals.end(), {n.x, n.y, n.z});
-      }
-      indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-  }
+  const BoxMesh box(lo, hi);
   render::FrameScene scene = Bare();
-  scene.surface = {positions.data(), normals.data(), static_cast<int>(positions.size() / 3), indices.data(),
-                   static_cast<int>(indices.size())};
+  scene.surface = box.View();
   const glm::vec3 eye(0.6f, 1.1f, 1.8f);
   const render::View v = FullView(glm::lookAt(eye, glm::vec3(0.0f, 0.45f, 0.0f), glm::vec3(0, 1, 0)), Perspective());
   DrawAndRead(scene, std::span(&v, 1));
