@@ -1,5 +1,6 @@
 #include "sphxr/app/cli.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -486,6 +487,13 @@ Status ApplyAutoQuality(const Options& options, bool wanted, const StateFile* st
   setup->params.spacing = choice.spacing;
   setup->method = choice.method;
   if (choice.pbfSubsteps > 0.0f) setup->params.pbfSubsteps = choice.pbfSubsteps;
+  const bool diffuseSet = std::any_of(options.sets.begin(), options.sets.end(),
+                                      [](const std::string& kv) { return kv.rfind("diffuse=", 0) == 0; });
+  if (TurnOffDiffuseOutOfRealTime(choice.realtime, diffuseSet, &setup->params)) {
+    SPHXR_LOG_INFO("--quality auto: spray, foam and bubbles off (the water runs at %.2f of real time here without "
+                   "them); --set diffuse=1 keeps them",
+                   choice.realtime);
+  }
   return Status::Ok();
 }
 

@@ -108,4 +108,10 @@ Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& conf
   return Status::Ok();
 }
 
+bool TurnOffDiffuseOutOfRealTime(double realtime, bool setByUser, sim::SolverParams* params) {
+  if (params->diffuse <= 0.0f || setByUser || !(realtime < 1.0)) return false;
+  params->diffuse = 0.0f;
+  return true;
+}
+
 }  // namespace sphxr::app

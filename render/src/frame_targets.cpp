@@ -64,7 +64,7 @@ void FrameTargets::EnsureView(int w, int h) {
   ReleaseView();
   m_w = std::max(w, m_w);
   m_h = std::max(h, m_h);
-  m_sceneColor = Texture(GL_RGBA16F, m_w, m_h, GL_LINEAR);
+  m_sceneColor = Texture(GL_RGBA8, m_w, m_h, GL_LINEAR);  // the views are 8-bit too: no precision lost
   m_sceneDepth = Texture(GL_DEPTH_COMPONENT32F, m_w, m_h, GL_NEAREST);
   glCreateFramebuffers(1, &m_sceneFbo);
   glNamedFramebufferTexture(m_sceneFbo, GL_COLOR_ATTACHMENT0, m_sceneColor, 0);

@@ -1,7 +1,7 @@
 #pragma once
 // The textures the passes draw into and read from. Grown to the largest view seen (never shrunk); a
 // view draws into their lower-left corner.
-//   scene       the opaque scene: colour (RGBA16F, linear) and depth (32F), kept as textures so that the
+//   scene       the opaque scene: colour (RGBA8, as the views) and depth (32F), kept as textures so that the
 //               water can refract what lies behind it
 //   thickness   the water's length along each pixel's ray (R32F, additive)
 //   shadow      the sun's depth maps: opaque casters (compared, 2x2 PCF) and the nearest water surface

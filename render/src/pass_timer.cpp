@@ -1,12 +1,21 @@
 #include "pass_timer.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace sphxr::render {
 
+namespace {
+double NowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
 PassTimer::~PassTimer() {
   for (Frame& f : m_frames) {
-    for (const Query& q : f.queries) glDeleteQueries(1, &q.id);
+    for (const Query& q : f.queries) {
+      if (q.id) glDeleteQueries(1, &q.id);
+    }
   }
   if (!m_free.empty()) glDeleteQueries(static_cast<GLsizei>(m_free.size()), m_free.data());
 }
@@ -31,24 +40,37 @@ GLuint PassTimer::TakeQuery() {
 
 PassTimer::Scope::Scope(PassTimer* timer, const char* name) : m_timer(timer) {
   Frame& f = timer->m_frames[static_cast<size_t>(timer->m_current)];
+  if (timer->m_finishEachPass) {
+    glFinish();
+    f.queries.push_back({timer->NameIndex(name), 0, 0.0});
+    m_started = NowSeconds();
+    return;
+  }
   const GLuint q = timer->TakeQuery();
-  f.queries.push_back({timer->NameIndex(name), q});
+  f.queries.push_back({timer->NameIndex(name), q, 0.0});
   glBeginQuery(GL_TIME_ELAPSED, q);
 }
 
-PassTimer::Scope::~Scope() { glEndQuery(GL_TIME_ELAPSED); }
+PassTimer::Scope::~Scope() {
+  if (m_timer->m_finishEachPass) {
+    glFinish();
+    m_timer->m_frames[static_cast<size_t>(m_timer->m_current)].queries.back().ms = 1e3 * (NowSeconds() - m_started);
+    return;
+  }
+  glEndQuery(GL_TIME_ELAPSED);
+}
 
 bool PassTimer::Collect(Frame* f, bool wait, DrawStats* stats) {
   if (!f->pending) return false;
-  if (!wait && !f->queries.empty()) {
+  if (!wait && !f->queries.empty() && f->queries.back().id) {
     GLuint available = 0;
     glGetQueryObjectuiv(f->queries.back().id, GL_QUERY_RESULT_AVAILABLE, &available);
     if (!available) return false;
   }
   stats->passes.clear();
   for (const Query& q : f->queries) {
-    GLuint64 ns = 0;
-    glGetQueryObjectui64v(q.id, GL_QUERY_RESULT, &ns);
+    GLuint64 ns = static_cast<GLuint64>(q.ms * 1e6);
+    if (q.id) glGetQueryObjectui64v(q.id, GL_QUERY_RESULT, &ns);
     const std::string& name = m_names[static_cast<size_t>(q.name)];
     auto it = std::find_if(stats->passes.begin(), stats->passes.end(), [&](const PassTime& p) { return p.name == name; });
     if (it == stats->passes.end()) {
@@ -56,7 +78,7 @@ bool PassTimer::Collect(Frame* f, bool wait, DrawStats* stats) {
       it = stats->passes.end() - 1;
     }
     it->gpuMs += static_cast<double>(ns) * 1e-6;
-    m_free.push_back(q.id);
+    if (q.id) m_free.push_back(q.id);
   }
   stats->views = f->views;
   f->queries.clear();

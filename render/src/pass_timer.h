@@ -1,6 +1,9 @@
 #pragma once
 // GPU time per pass from GL_TIME_ELAPSED queries, read a frame or two late so that reading never waits
-// for the GPU. Passes of the same name in one frame (one per view) are summed.
+// for the GPU. Passes of the same name in one frame (one per view) are summed. With `finishEachPass`
+// (RendererConfig::finishEachPass, the benchmarks) each pass is finished before and after and timed on
+// the clock instead: exact on a software rasteriser, which draws binned commands whenever it flushes,
+// so that a query can hold another pass's work.
 #include <epoxy/gl.h>
 
 #include <array>
@@ -13,7 +16,7 @@ namespace sphxr::render {
 
 class PassTimer {
  public:
-  PassTimer() = default;
+  explicit PassTimer(bool finishEachPass = false) : m_finishEachPass(finishEachPass) {}
   ~PassTimer();
   PassTimer(const PassTimer&) = delete;
   PassTimer& operator=(const PassTimer&) = delete;
@@ -28,6 +31,7 @@ class PassTimer {
 
    private:
     PassTimer* m_timer;
+    double m_started = 0.0;  // s, with finishEachPass
   };
 
   void BeginFrame();
@@ -37,7 +41,8 @@ class PassTimer {
  private:
   struct Query {
     int name = 0;  // index into m_names
-    GLuint id = 0;
+    GLuint id = 0;  // 0: `ms` holds the time (finishEachPass)
+    double ms = 0.0;
   };
   struct Frame {
     std::vector<Query> queries;
@@ -54,6 +59,7 @@ class PassTimer {
   std::vector<std::string> m_names;
   std::vector<GLuint> m_free;
   DrawStats m_latest;
+  bool m_finishEachPass = false;
 };
 
 }  // namespace sphxr::render

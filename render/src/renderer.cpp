@@ -97,6 +97,7 @@ Camera FrameBox(const sim::Aabb& box, float aspect) {
 }
 
 struct Renderer::Impl {
+  explicit Impl(bool finishEachPass) : timer(finishEachPass) {}
   ErrorSink sink;
   RenderSettings settings;
   FrameData data;
@@ -120,7 +121,7 @@ struct Renderer::Impl {
   }
 };
 
-Renderer::Renderer(const RendererConfig& config) : m_config(config), m_impl(std::make_unique<Impl>()) {
+Renderer::Renderer(const RendererConfig& config) : m_config(config), m_impl(std::make_unique<Impl>(config.finishEachPass)) {
   m_impl->settings = SettingsFor(config.quality);
 }
 
@@ -181,13 +182,13 @@ void Renderer::Draw(const FrameScene& scene, std::span<const View> views) {
   for (const View& v : views) {
     if (v.width <= 0 || v.height <= 0) continue;
     m.targets.EnsureView(v.width, v.height);
-    m.data.BindView(scene, v, m_config, glm::vec2(m.targets.Width(), m.targets.Height()), m.settings.shadowMapSize > 0);
+    m.data.BindView(scene, v, m_config, glm::vec2(m.targets.Width(), m.targets.Height()));
     const PassContext ctx{scene, v, m.data, m.targets, m.settings};
     if (drawn++ == 0) timed("shadow", [&] { m.shadow.Run(scene, m.data, m.targets, m.settings); });
     // Into the frame targets: the opaque scene, kept as textures.
     BeginScene(ctx);
-    timed("sky", [&] { m.sky.Run(ctx); });
     timed("opaque", [&] { m.opaque.Run(ctx); });
+    timed("sky", [&] { m.sky.Run(ctx); });
     timed("glass", [&] { m.glass.RunFar(ctx); });
     timed("bubbles", [&] { m.diffuse.RunBubbles(ctx); });
     timed("water thickness", [&] { m.thickness.Run(ctx); });

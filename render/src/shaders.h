@@ -21,7 +21,7 @@ layout(std140, binding = 0) uniform ViewBlock {
   vec4 uAbsorption;     // rgb: Beer-Lambert coefficients, 1/m (scene scale included)
   vec4 uWaterColor;     // rgb: inscattered colour
   vec4 uParticle;       // x: radius (m), y: pixels per (m / eye depth) for point sizes, z: diffuse radius (m)
-  vec4 uOptics;         // x: Fresnel F0 of water, y: index of refraction, z: shadows on (1/0), w: shadow depth range (m)
+  vec4 uOptics;         // x: Fresnel F0 of water, y: index of refraction, w: shadow depth range (m)
   vec4 uTarget;         // xy: size in texels of the frame targets (the views use their lower-left corner)
   vec4 uTankMin;        // xyz: the tank's lower corner, w: the absorption's scene scale
   vec4 uTankMax;        // xyz: the tank's upper corner
@@ -64,24 +64,22 @@ inline constexpr const char* kViewPixel = R"(
 ivec2 ViewPixel() { return ivec2(gl_FragCoord.xy - uViewport.xy); }
 )";
 
-// The sun's light on a receiver: the shadow of the opaque casters (a 2x2 hardware PCF tap on a 4-tap
-// ring) and, for receivers inside the tank, Beer-Lambert over the water between them and the sun.
+// The sun's light on a receiver. With SUN_SHADOWS (the programs' shadowed variants, used when the
+// render quality has a shadow map): the shadow of the opaque casters (one hardware PCF tap: the 2x2
+// texels around the point, compared and blended) and, for receivers inside the tank, Beer-Lambert over
+// the water between them and the sun. Without it, full sunlight: a software rasteriser runs a branch's
+// texture fetches even where no pixel takes it, so "shadows off" must not be a uniform.
+inline constexpr const char* kDefineShadows = "#define SUN_SHADOWS 1\n";
 inline constexpr const char* kSunLight = R"(
+#if defined(SUN_SHADOWS)
 layout(binding = 4) uniform sampler2DShadow uShadowMap;
 layout(binding = 5) uniform sampler2D uWaterShadowMap;
 vec3 SunVisibility(vec3 world, vec3 n) {
-  if (uOptics.z < 0.5) return vec3(1.0);
   vec4 c = uShadowViewProj * vec4(world + n * 0.002 * uOptics.w, 1.0);
   vec3 p = c.xyz / c.w * 0.5 + 0.5;
   if (any(lessThan(p, vec3(0.0))) || any(greaterThan(p, vec3(1.0)))) return vec3(1.0);
-  vec2 texel = 1.0 / vec2(textureSize(uShadowMap, 0));
-  float bias = 0.0015;
-  float lit = 0.0;
-  lit += texture(uShadowMap, vec3(p.xy + vec2(-0.75, -0.75) * texel, p.z - bias));
-  lit += texture(uShadowMap, vec3(p.xy + vec2(0.75, -0.75) * texel, p.z - bias));
-  lit += texture(uShadowMap, vec3(p.xy + vec2(-0.75, 0.75) * texel, p.z - bias));
-  lit += texture(uShadowMap, vec3(p.xy + vec2(0.75, 0.75) * texel, p.z - bias));
-  vec3 light = vec3(0.25 * lit);
+  const float bias = 0.0015;
+  vec3 light = vec3(texture(uShadowMap, vec3(p.xy, p.z - bias)));
   // Light that crossed water to reach a receiver in the tank: real water's absorption (the scene scale
   // is for the colour seen along the eye's path); light leaving through the glass walls is refocused
   // into caustics, which are not drawn, so receivers outside the tank see no water shadow.
@@ -93,13 +91,16 @@ vec3 SunVisibility(vec3 world, vec3 n) {
   }
   return light;
 }
+#else
+vec3 SunVisibility(vec3 world, vec3 n) { return vec3(1.0); }
+#endif
 )";
 
-// ---- sky: one full-screen triangle ---------------------------------------------------------------
+// ---- sky: one full-screen triangle at the far plane (drawn where nothing else is) ---------------
 inline constexpr const char* kFullScreenVs = R"(
 void main() {
   vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+  gl_Position = vec4(p * 2.0 - 1.0, 1.0, 1.0);
 }
 )";
 inline constexpr const char* kSkyFs = R"(
@@ -433,16 +434,23 @@ inline const std::vector<ProgramSource>& Programs() {
       {"sky", {kCommon, kFullScreenVs}, {kCommon, kSkyFs}},
       {"present", {kCommon, kFullScreenVs}, {kCommon, kViewPixel, kPresentFs}},
       {"solid", {kCommon, kSolidVs}, {kCommon, kSunLight, kSolidFs}},
+      {"solid (shadowed)", {kCommon, kSolidVs}, {kCommon, kDefineShadows, kSunLight, kSolidFs}},
       {"shadow", {kCommon, kShadowVs}, {kCommon, kShadowFs}},
       {"glass", {kCommon, kSolidVs}, {kCommon, kGlassFs}},
       {"particles", {kCommon, kSpriteVs}, {kCommon, kSphere, kParticleFs}},
       {"water thickness (mesh)", {kCommon, kMeshVs}, {kCommon, kDefineThickness, kMeshFs}},
+      {"water thickness (sprites)", {kCommon, kSpriteVs}, {kCommon, kDefineThickness, kSphere, kWaterSpriteFs}},
       {"water depth (mesh)", {kCommon, kMeshVs}, {kCommon, kDefineDepth, kMeshFs}},
       {"water shade (mesh)", {kCommon, kMeshVs}, {kCommon, kDefineShade, kViewPixel, kSunLight, kWaterShade, kMeshFs}},
-      {"water thickness (sprites)", {kCommon, kSpriteVs}, {kCommon, kDefineThickness, kSphere, kWaterSpriteFs}},
+      {"water shade (mesh, shadowed)",
+       {kCommon, kMeshVs},
+       {kCommon, kDefineShade, kDefineShadows, kViewPixel, kSunLight, kWaterShade, kMeshFs}},
       {"water shade (sprites)",
        {kCommon, kSpriteVs},
        {kCommon, kDefineShade, kViewPixel, kSunLight, kWaterShade, kSphere, kWaterSpriteFs}},
+      {"water shade (sprites, shadowed)",
+       {kCommon, kSpriteVs},
+       {kCommon, kDefineShade, kDefineShadows, kViewPixel, kSunLight, kWaterShade, kSphere, kWaterSpriteFs}},
       {"diffuse (bubbles)", {kCommon, kDefineBubbles, kDiffuseVs}, {kCommon, kDefineBubbles, kDiffuseFs}},
       {"diffuse (spray and foam)", {kCommon, kDiffuseVs}, {kCommon, kDiffuseFs}},
   };

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "sphxr/app/quality.h"
 #include "sphxr/app/render_budget.h"
 #include "support.h"
 
@@ -92,6 +93,22 @@ TEST(RenderSummary, NamesTheQualityAndEachPassPerView) {
   EXPECT_EQ(app::RenderSummary(RenderQuality::kLow, render::DrawStats{}), "render quality low");
   EXPECT_EQ(app::RenderSummary(RenderQuality::kHigh, Stats(0.5, 0.25)),
             "render quality high; GPU per view 0.38 ms: shadow 0.25, water thickness 0.12");
+}
+
+TEST(QualityAuto, TurnsSprayFoamAndBubblesOffOnlyWhenTheWaterCannotKeepRealTime) {
+  sim::SolverParams on;
+  on.diffuse = 1.0f;
+  sim::SolverParams p = on;
+  EXPECT_TRUE(app::TurnOffDiffuseOutOfRealTime(0.95, false, &p));
+  EXPECT_EQ(p.diffuse, 0.0f);
+  p = on;
+  EXPECT_FALSE(app::TurnOffDiffuseOutOfRealTime(1.0, false, &p)) << "real time kept: they stay";
+  EXPECT_EQ(p.diffuse, 1.0f);
+  EXPECT_FALSE(app::TurnOffDiffuseOutOfRealTime(0.5, true, &p)) << "the command line's own choice stays";
+  EXPECT_EQ(p.diffuse, 1.0f);
+  EXPECT_FALSE(app::TurnOffDiffuseOutOfRealTime(std::nan(""), false, &p)) << "no measurement: nothing changes";
+  sim::SolverParams off;
+  EXPECT_FALSE(app::TurnOffDiffuseOutOfRealTime(0.1, false, &off));
 }
 
 }  // namespace

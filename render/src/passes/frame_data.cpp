@@ -176,16 +176,8 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
   const glm::vec3 centre = 0.5f * (lo + hi);
   glm::vec3 placeLo = lo, placeHi = hi;
 
+  const size_t groundDraw = solids.size();
   if (scene.drawFloor) {
-    SolidDraw ground;
-    ground.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(centre.x, groundY, centre.z)),
-                              glm::vec3(extent, 1.0f, extent));
-    ground.color = glm::vec3(0.80f, 0.76f, 0.68f);
-    ground.material = Material::kGround;
-    ground.buffer = quad.id;
-    ground.count = 6;
-    ground.castsShadow = false;
-    solids.push_back(ground);
     if (table > 0.0f) {  // a wooden table: a top a little wider than the tank, four legs
       const float margin = std::max(0.1f, 0.35f * std::max(size.x, size.z));
       const float thickness = std::clamp(0.12f * table, 0.02f, 0.05f), leg = std::clamp(0.06f * table, 0.02f, 0.06f);
@@ -211,6 +203,30 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
       placeHi = glm::max(placeHi, topHi + glm::vec3(table, 0.0f, table));
       placeLo.y = groundY;
     }
+  }
+  if (scene.drawFloor) {
+    // The ground: the part under the sun's shadow map (around the tank and where the table's shadow
+    // falls) with the shadowed program, the rest to the horizon without it, in five quads.
+    auto ground = [&](glm::vec2 a, glm::vec2 b, bool shadowed) {
+      if (b.x <= a.x || b.y <= a.y) return;
+      SolidDraw d;
+      d.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.5f * (a.x + b.x), groundY, 0.5f * (a.y + b.y))),
+                           glm::vec3(b.x - a.x, 1.0f, b.y - a.y));
+      d.color = glm::vec3(0.80f, 0.76f, 0.68f);
+      d.material = Material::kGround;
+      d.buffer = quad.id;
+      d.count = 6;
+      d.castsShadow = false;
+      d.receivesShadow = shadowed;
+      solids.insert(solids.begin() + static_cast<std::ptrdiff_t>(groundDraw), d);
+    };
+    const glm::vec2 lo2(placeLo.x, placeLo.z), hi2(placeHi.x, placeHi.z);
+    const glm::vec2 far0(centre.x - 0.5f * extent, centre.z - 0.5f * extent), far1(centre.x + 0.5f * extent, centre.z + 0.5f * extent);
+    ground(lo2, hi2, true);
+    ground(far0, glm::vec2(far1.x, lo2.y), false);                 // in front of the tank's region
+    ground(glm::vec2(far0.x, hi2.y), far1, false);                 // behind it
+    ground(glm::vec2(far0.x, lo2.y), glm::vec2(lo2.x, hi2.y), false);  // to its left
+    ground(glm::vec2(hi2.x, lo2.y), glm::vec2(far1.x, hi2.y), false);  // to its right
   }
   for (const sim::Aabb& box : scene.obstacles) {
     SolidDraw d;
@@ -283,8 +299,7 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
   shadowRange = 4.0f * m_shadowRadius;
 }
 
-void FrameData::BindView(const FrameScene& scene, const View& v, const RendererConfig& config, glm::vec2 targetSize,
-                         bool shadows) {
+void FrameData::BindView(const FrameScene& scene, const View& v, const RendererConfig& config, glm::vec2 targetSize) {
   const glm::vec3 sun = glm::normalize(config.sunDirection);
   // The sun's camera (the same for every view).
   const glm::vec3 lo = V(scene.tank.min), hi = V(scene.tank.max);
@@ -307,7 +322,7 @@ void FrameData::BindView(const FrameScene& scene, const View& v, const RendererC
   u.particle = glm::vec4(scene.particles.radius, 0.5f * v.projection[1][1] * v.height, scene.diffuse.radius, 0.0f);
   const float ior = std::max(config.waterIor, 1.0f);
   const float f0 = ((ior - 1.0f) / (ior + 1.0f)) * ((ior - 1.0f) / (ior + 1.0f));
-  u.optics = glm::vec4(f0, ior, shadows ? 1.0f : 0.0f, shadowRange);
+  u.optics = glm::vec4(f0, ior, 0.0f, shadowRange);
   u.target = glm::vec4(targetSize, 0.0f, 0.0f);
   u.tankMin = glm::vec4(lo, std::max(scene.absorptionScale, 1e-6f));
   u.tankMax = glm::vec4(hi, 0.0f);

@@ -28,6 +28,7 @@ struct SolidDraw {
   GLuint buffer = 0;
   int first = 0, count = 0;
   bool castsShadow = true;
+  bool receivesShadow = true;  // false: drawn with the unshadowed program (the ground beyond the sun's map)
 };
 
 /// A glass part of the tank: panes (the box without its top) or one edge bar.
@@ -48,8 +49,7 @@ struct FrameData {
   /// Uploads what `scene` shows (once for all views) and lays out the place around the tank.
   void Upload(const FrameScene& scene, const RenderSettings& settings);
   /// The uniform block for `view` (the sun's matrix included), uploaded and bound to binding 0.
-  void BindView(const FrameScene& scene, const View& view, const RendererConfig& config, glm::vec2 targetSize,
-                bool shadows);
+  void BindView(const FrameScene& scene, const View& view, const RendererConfig& config, glm::vec2 targetSize);
 
   // Static meshes.
   Buffer cube;  // unit cube centred at the origin: 36 vertices of position + normal (faces x+, x-, y+, y-, z+, z-)

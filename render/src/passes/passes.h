@@ -53,7 +53,7 @@ class OpaquePass {
   void Run(const PassContext& ctx) const;
 
  private:
-  Program m_solid, m_particles;
+  Program m_solid, m_solidShadowed, m_particles;
 };
 
 /// The tank's glass: the panes turned away from the eye (and the far edge bars) into the opaque scene,
@@ -109,7 +109,7 @@ class WaterPass {
   void Run(const PassContext& ctx) const;
 
  private:
-  Program m_depthMesh, m_shadeMesh, m_shadeSprites;
+  Program m_depthMesh, m_shadeMesh, m_shadeMeshShadowed, m_shadeSprites, m_shadeSpritesShadowed;
 };
 
 }  // namespace sphxr::render

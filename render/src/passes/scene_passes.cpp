@@ -26,13 +26,16 @@ void BeginViewFramebuffer(const PassContext& ctx) {
 }
 
 void SkyPass::Run(const PassContext& ctx) const {
-  (void)ctx;
+  // After the opaque scene, at the far plane with the depth test: only the pixels nothing covers.
   glDisable(GL_BLEND);
-  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
   glDepthMask(GL_FALSE);
   glUseProgram(m_program.id);
   glBindVertexArray(ctx.data.emptyVao);
   glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
 }
 
 void ShadowPass::Run(const FrameScene& scene, const FrameData& data, FrameTargets& targets,
@@ -72,6 +75,7 @@ void ShadowPass::Run(const FrameScene& scene, const FrameData& data, FrameTarget
 
 Status OpaquePass::Create() {
   if (Status s = LinkProgram("solid", &m_solid.id); !s) return s;
+  if (Status s = LinkProgram("solid (shadowed)", &m_solidShadowed.id); !s) return s;
   return LinkProgram("particles", &m_particles.id);
 }
 
@@ -82,12 +86,13 @@ void OpaquePass::Run(const PassContext& ctx) const {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   ctx.targets.BindShadowMaps();
-  glUseProgram(m_solid.id);
   glBindVertexArray(data.solidVao);
   for (const SolidDraw& d : data.solids) {
-    glProgramUniformMatrix4fv(m_solid.id, 0, 1, GL_FALSE, glm::value_ptr(d.model));
-    glProgramUniform4f(m_solid.id, 1, d.color.r, d.color.g, d.color.b, 1.0f);
-    glProgramUniform1i(m_solid.id, 2, static_cast<int>(d.material));
+    const GLuint solid = ctx.settings.shadowMapSize > 0 && d.receivesShadow ? m_solidShadowed.id : m_solid.id;
+    glUseProgram(solid);
+    glProgramUniformMatrix4fv(solid, 0, 1, GL_FALSE, glm::value_ptr(d.model));
+    glProgramUniform4f(solid, 1, d.color.r, d.color.g, d.color.b, 1.0f);
+    glProgramUniform1i(solid, 2, static_cast<int>(d.material));
     glVertexArrayVertexBuffer(data.solidVao, 0, d.buffer, 0, 6 * sizeof(float));
     glDrawArrays(GL_TRIANGLES, d.first, d.count);
   }

@@ -28,7 +28,9 @@ void WaterThicknessPass::Run(const PassContext& ctx) const {
 Status WaterPass::Create() {
   if (Status s = LinkProgram("water depth (mesh)", &m_depthMesh.id); !s) return s;
   if (Status s = LinkProgram("water shade (mesh)", &m_shadeMesh.id); !s) return s;
-  return LinkProgram("water shade (sprites)", &m_shadeSprites.id);
+  if (Status s = LinkProgram("water shade (mesh, shadowed)", &m_shadeMeshShadowed.id); !s) return s;
+  if (Status s = LinkProgram("water shade (sprites)", &m_shadeSprites.id); !s) return s;
+  return LinkProgram("water shade (sprites, shadowed)", &m_shadeSpritesShadowed.id);
 }
 
 void WaterPass::Run(const PassContext& ctx) const {
@@ -36,6 +38,7 @@ void WaterPass::Run(const PassContext& ctx) const {
   if (!data.waterFromMesh && !data.waterFromSprites) return;
   ctx.targets.BindSceneTextures();
   ctx.targets.BindShadowMaps();
+  const bool shadows = ctx.settings.shadowMapSize > 0;
   glDisable(GL_BLEND);
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
@@ -43,7 +46,7 @@ void WaterPass::Run(const PassContext& ctx) const {
   if (data.waterFromSprites) {
     // Sprites compute their depth per fragment, and two programs need not round it alike: shaded in one
     // pass with the depth test, so that the nearest sphere's shading is what stays.
-    glUseProgram(m_shadeSprites.id);
+    glUseProgram(shadows ? m_shadeSpritesShadowed.id : m_shadeSprites.id);
     data.DrawWater();
     return;
   }
@@ -55,7 +58,7 @@ void WaterPass::Run(const PassContext& ctx) const {
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_FALSE);
   glDepthFunc(GL_LEQUAL);
-  glUseProgram(m_shadeMesh.id);
+  glUseProgram(shadows ? m_shadeMeshShadowed.id : m_shadeMesh.id);
   data.DrawWater();
   glDepthMask(GL_TRUE);
   glDepthFunc(GL_LESS);

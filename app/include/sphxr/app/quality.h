@@ -31,6 +31,12 @@ float SpacingForRealtime(float spacing, double realtime, double target, float mi
 /// scene's compression and stability with fewer substeps, and a finer one needs more.
 float PbfSubstepsForSpacing(float sceneSubsteps, float sceneSpacing, float spacing);
 
+/// Under --quality auto, spray, foam and bubbles are a luxury: when the water cannot keep real time at
+/// the chosen spacing (`realtime` < 1 simulated s per wall s) the diffuse stage is turned off (its cost
+/// grows with the particles it spawns, faster the further behind the water falls), unless the command
+/// line set `diffuse` itself. True when it turned them off.
+bool TurnOffDiffuseOutOfRealTime(double realtime, bool setByUser, sim::SolverParams* params);
+
 /// Times the scene for about `budgetSeconds` of wall time (twice at most) and picks the spacing. The
 /// finest spacing tried is half the scene's, the coarsest four times it.
 Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& config, double target,

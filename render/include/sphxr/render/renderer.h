@@ -7,8 +7,8 @@
 //   upload          surface mesh, particles, diffuse particles, solids (once per frame)
 //   shadow          the sun's depth maps of the opaque casters and of the water (once per frame)
 //   per view, into the frame targets (the opaque scene kept as textures):
-//     sky, opaque (ground, table, obstacles, paddles; particles in particle mode), glass (far panes),
-//     bubbles, water thickness
+//     opaque (ground, table, obstacles, paddles; particles in particle mode), sky (where nothing is),
+//     glass (far panes), bubbles, water thickness
 //   per view, into the view's framebuffer:
 //     present (the opaque scene's colour and depth), water (refraction of the scene behind, Fresnel
 //     reflection, Beer-Lambert absorption; writes its depth), glass (near panes), spray and foam
@@ -145,6 +145,9 @@ struct RendererConfig {
   glm::vec3 waterColor{0.0023f, 0.017f, 0.13f};
   float waterIor = kWaterIor;                   // 1: no refraction, and F0 = 0
   RenderQuality quality = RenderQuality::kHigh;
+  /// Finish the GL work before and after each pass and time it on the clock (the benchmarks): exact on
+  /// a software rasteriser, where a GL_TIME_ELAPSED query can hold another pass's binned work; slow.
+  bool finishEachPass = false;
 };
 
 /// One pass's GPU time (GL_TIME_ELAPSED), summed over the views of a frame.
