@@ -402,6 +402,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
           // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
           frame = MakeFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));
           DrawHandsAndPaddles(info, hands, app.offset, *snap, &frame);
+          frame.frameKey = info.frameIndex + 1;  // both eyes share one upload and one shadow pass
         },
         [&](const xr::FrameInfo&, const xr::EyeView& eye) {
           // The renderer writes display-ready colour (the desktop window shows its bytes as they are):

@@ -101,6 +101,7 @@ struct Renderer::Impl {
   ErrorSink sink;
   RenderSettings settings;
   FrameData data;
+  uint64_t uploadedKey = 0;  // FrameScene::frameKey of the last upload
   FrameTargets targets;
   PassTimer timer;
   SkyPass sky;
@@ -135,6 +136,7 @@ int Renderer::ErrorCount() const { return m_impl->sink.count.load(); }
 void Renderer::SetQuality(RenderQuality quality) {
   m_config.quality = quality;
   m_impl->settings = SettingsFor(quality);
+  m_impl->uploadedKey = 0;  // the next frame uploads and casts its shadows at the new settings
 }
 
 Status Renderer::Create(const RendererConfig& config, std::unique_ptr<Renderer>* out) {
@@ -168,7 +170,10 @@ void Renderer::Draw(const FrameScene& scene, std::span<const View> views) {
   Impl& m = *m_impl;
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  m.data.Upload(scene, m.settings);  // once for all views
+  // Once for all views, and once for the calls that draw the views of one frame (FrameScene::frameKey).
+  const bool sameFrame = scene.frameKey != 0 && scene.frameKey == m.uploadedKey;
+  if (!sameFrame) m.data.Upload(scene, m.settings);
+  m.uploadedKey = scene.frameKey;
   const auto t1 = Clock::now();
   auto timed = [&](const char* name, auto&& pass) {
     PassTimer::Scope scope(&m.timer, name);
@@ -184,7 +189,7 @@ void Renderer::Draw(const FrameScene& scene, std::span<const View> views) {
     m.targets.EnsureView(v.width, v.height);
     m.data.BindView(scene, v, m_config, glm::vec2(m.targets.Width(), m.targets.Height()));
     const PassContext ctx{scene, v, m.data, m.targets, m.settings};
-    if (drawn++ == 0) timed("shadow", [&] { m.shadow.Run(scene, m.data, m.targets, m.settings); });
+    if (drawn++ == 0 && !sameFrame) timed("shadow", [&] { m.shadow.Run(scene, m.data, m.targets, m.settings); });
     // Into the frame targets: the opaque scene, kept as textures.
     BeginScene(ctx);
     timed("opaque", [&] { m.opaque.Run(ctx); });

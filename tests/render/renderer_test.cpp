@@ -421,3 +421,36 @@ TEST(RendererDeathTest, GlErrorWithoutAHandlerAbortsNamingTheError) {
 
 }  // namespace
 }  // namespace sphxr::test
+
+namespace sphxr::test {
+namespace {
+
+TEST_F(RendererTest, DrawCallsOfOneFrameShareItsUploadAndANewFrameUploadsAgain) {
+  // A headset draws its eyes one call each: the calls that carry the same FrameScene::frameKey reuse
+  // the first call's upload (here: the second call's scene has no water, and the water is still drawn);
+  // the next frame's key uploads again.
+  const BoxMesh water(glm::vec3(-0.3f, 0.2f, -0.2f), glm::vec3(0.3f, 0.7f, 0.1f));
+  render::FrameScene scene = EmptyScene();
+  scene.surface = water.View();
+  scene.frameKey = 7;
+  const render::View v = FullView(glm::lookAt(glm::vec3(0.0f, 0.5f, 2.0f), glm::vec3(0, 0.45f, 0), glm::vec3(0, 1, 0)),
+                                  Perspective(float(kW) / kH));
+  const render::Image first = DrawAndRead(scene, std::span(&v, 1));
+  render::FrameScene dry = EmptyScene();
+  dry.frameKey = 7;
+  const render::Image sameFrame = DrawAndRead(dry, std::span(&v, 1));
+  dry.frameKey = 8;
+  const render::Image nextFrame = DrawAndRead(dry, std::span(&v, 1));
+  int differsSame = 0, differsNext = 0;
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      differsSame += MaxDiff(Rgb(first, x, y), Rgb(sameFrame, x, y)) > 0.0f;
+      differsNext += MaxDiff(Rgb(first, x, y), Rgb(nextFrame, x, y)) > 3.0f / 255.0f;
+    }
+  }
+  EXPECT_EQ(differsSame, 0) << "the second call of frame 7 did not draw frame 7's upload";
+  EXPECT_GT(differsNext, 1000) << "frame 8 still shows frame 7's water";
+}
+
+}  // namespace
+}  // namespace sphxr::test

@@ -106,6 +106,9 @@ struct FrameScene {
   /// so a picture of it raises this: app::MakeFrameScene sets it from the tank's size so that its
   /// smallest extent keeps 9 % of the red light; the default makes a decimetre read as water.
   float absorptionScale = 15.0f;
+  /// Non-zero: the frame this scene belongs to. Draw calls with the same key (a headset's two eyes,
+  /// drawn one swapchain image at a time) share one upload and one pass of the sun's shadow maps.
+  uint64_t frameKey = 0;
 };
 
 /// What the renderer spends per frame: `--quality auto` lowers it with the simulation.
