@@ -189,7 +189,7 @@ void Renderer::Draw(const FrameScene& scene, std::span<const View> views) {
     m.targets.EnsureView(v.width, v.height);
     m.data.BindView(scene, v, m_config, glm::vec2(m.targets.Width(), m.targets.Height()));
     const PassContext ctx{scene, v, m.data, m.targets, m.settings};
-    if (drawn++ == 0 && !sameFrame) timed("shadow", [&] { m.shadow.Run(scene, m.data, m.targets, m.settings); });
+    if (drawn++ == 0 && !sameFrame) timed("shadow", [&] { m.shadow.Run(m.data, m.targets, m.settings); });
     // Into the frame targets: the opaque scene, kept as textures.
     BeginScene(ctx);
     timed("opaque", [&] { m.opaque.Run(ctx); });

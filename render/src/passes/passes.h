@@ -39,7 +39,7 @@ class SkyPass {
 class ShadowPass {
  public:
   Status Create() { return LinkProgram("shadow", &m_program.id); }
-  void Run(const FrameScene& scene, const FrameData& data, FrameTargets& targets, const RenderSettings& settings) const;
+  void Run(const FrameData& data, FrameTargets& targets, const RenderSettings& settings) const;
 
  private:
   Program m_program;

@@ -38,8 +38,7 @@ void SkyPass::Run(const PassContext& ctx) const {
   glDepthMask(GL_TRUE);
 }
 
-void ShadowPass::Run(const FrameScene& scene, const FrameData& data, FrameTargets& targets,
-                     const RenderSettings& settings) const {
+void ShadowPass::Run(const FrameData& data, FrameTargets& targets, const RenderSettings& settings) const {
   targets.EnsureShadow(settings.shadowMapSize);
   if (settings.shadowMapSize <= 0) return;
   const int size = targets.ShadowSize();
@@ -70,7 +69,6 @@ void ShadowPass::Run(const FrameScene& scene, const FrameData& data, FrameTarget
     glProgramUniformMatrix4fv(m_program.id, 0, 1, GL_FALSE, glm::value_ptr(identity));
     data.DrawWater();
   }
-  (void)scene;
 }
 
 Status OpaquePass::Create() {
