@@ -22,7 +22,7 @@ fi
 # Only what the job runs: the tests of sim, app and interaction, the binary the app tests run, and the
 # fuzz targets.
 cmake --build "$build" -j "$jobs" --target sphxr sphxr_sim_tests sphxr_app_tests sphxr_interaction_tests \
-  sphxr_fuzz_scene sphxr_fuzz_state sphxr_fuzz_trajectory
+  sphxr_fuzz_scene sphxr_fuzz_state sphxr_fuzz_trajectory sphxr_fuzz_run_arguments
 [ "${1:-}" = "--build" ] && exit 0
 
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0"
