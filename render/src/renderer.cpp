@@ -102,6 +102,7 @@ struct Renderer::Impl {
   RenderSettings settings;
   FrameData data;
   uint64_t uploadedKey = 0;  // FrameScene::frameKey of the last upload
+  int timedViews = -1;       // views drawn in the pass timer's open frame (-1: none open)
   FrameTargets targets;
   PassTimer timer;
   SkyPass sky;
@@ -180,7 +181,13 @@ void Renderer::Draw(const FrameScene& scene, std::span<const View> views) {
     pass();
   };
 
-  m.timer.BeginFrame();
+  // The pass times of a frame: one call, or the calls that share its frameKey (the frame then ends
+  // when the next one's first call begins).
+  if (!sameFrame) {
+    if (m.timedViews >= 0) m.timer.EndFrame(m.timedViews, &m_stats);
+    m.timer.BeginFrame();
+    m.timedViews = 0;
+  }
   glEnable(GL_SCISSOR_TEST);
   glEnable(GL_PROGRAM_POINT_SIZE);  // sprites size themselves
   int drawn = 0;
@@ -207,7 +214,11 @@ void Renderer::Draw(const FrameScene& scene, std::span<const View> views) {
   glDisable(GL_SCISSOR_TEST);
   glBindVertexArray(0);
   glUseProgram(0);
-  m.timer.EndFrame(drawn, &m_stats);
+  m.timedViews += drawn;
+  if (scene.frameKey == 0) {
+    m.timer.EndFrame(m.timedViews, &m_stats);
+    m.timedViews = -1;
+  }
   if (m_config.debug) {
     for (GLenum e = glGetError(); e != GL_NO_ERROR; e = glGetError()) {
       DebugCallback(GL_DEBUG_SOURCE_API, GL_DEBUG_TYPE_ERROR, e, GL_DEBUG_SEVERITY_HIGH, -1,

@@ -107,7 +107,8 @@ struct FrameScene {
   /// smallest extent keeps 9 % of the red light; the default makes a decimetre read as water.
   float absorptionScale = 15.0f;
   /// Non-zero: the frame this scene belongs to. Draw calls with the same key (a headset's two eyes,
-  /// drawn one swapchain image at a time) share one upload and one pass of the sun's shadow maps.
+  /// drawn one swapchain image at a time) share one upload and one pass of the sun's shadow maps, and
+  /// their pass times add up to the frame's (DrawStats, complete once the next frame has begun).
   uint64_t frameKey = 0;
 };
 
