@@ -314,8 +314,10 @@ inline bool WaitForFileSize(const std::string& path, uintmax_t bytes, std::chron
 #ifdef SPHXR_BINARY
 /// Starts the real binary with `args` in a child whose stdout and stderr go to the two files. SIGINT,
 /// SIGTERM and SIGHUP start at their defaults, as from a terminal: a signal this test's own parent
-/// ignores (a background job, nohup, a CI runner) must not stay ignored.
-inline pid_t SpawnSphxr(const std::vector<std::string>& args, const std::string& outPath, const std::string& errPath) {
+/// ignores (a background job, nohup, a CI runner) must not stay ignored. `inChild` runs in the child
+/// just before the program starts (a resource limit, another user; it calls _exit(126) when it fails).
+inline pid_t SpawnSphxr(const std::vector<std::string>& args, const std::string& outPath, const std::string& errPath,
+                        const std::function<void()>& inChild = {}) {
   std::vector<char*> argv{const_cast<char*>(SPHXR_BINARY)};
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -328,6 +330,7 @@ inline pid_t SpawnSphxr(const std::vector<std::string>& args, const std::string&
     ::signal(SIGINT, SIG_DFL);
     ::signal(SIGTERM, SIG_DFL);
     ::signal(SIGHUP, SIG_DFL);
+    if (inChild) inChild();
     execv(SPHXR_BINARY, argv.data());
     _exit(127);
   }

@@ -140,19 +140,13 @@ TEST(RunArguments, AMissingScenesNameIsShownOnceEscapedAndCut) {
 TEST(RunArgumentsProcess, ThreadsTheProcessMayNotStartAreOneLine) {
   test::TempDir dir("run_arguments_threads");
   const std::string outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(o, 1);
-    dup2(e, 2);
-    if (getuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(126);
-    const rlimit limit{8, 8};
-    if (setrlimit(RLIMIT_NPROC, &limit) != 0 || chdir("/") != 0) _exit(126);
-    execl(SPHXR_BINARY, SPHXR_BINARY, "--headless", "--scene", SPHXR_SCENES_DIR "/dam_break.json", "--steps", "1",
-          "--threads", "60", "--no-progress", static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  const pid_t pid = test::SpawnSphxr({"--headless", "--scene", SPHXR_SCENES_DIR "/dam_break.json", "--steps", "1",
+                                      "--threads", "60", "--no-progress"},
+                                     outPath, errPath, [] {
+                                       if (getuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(126);
+                                       const rlimit limit{8, 8};
+                                       if (setrlimit(RLIMIT_NPROC, &limit) != 0 || chdir("/") != 0) _exit(126);
+                                     });
   int status = 0;
   ASSERT_EQ(waitpid(pid, &status, 0), pid);
   const std::string err = test::ReadFile(errPath);

@@ -34,23 +34,13 @@ struct Result {
 // that fills: RLIMIT_FSIZE, its signal ignored so that the write fails with EFBIG).
 Result RunSphxr(const test::TempDir& dir, const std::vector<std::string>& args, rlim_t fileLimit = 0) {
   const std::string outPath = dir.File("out.txt"), errPath = dir.File("err.txt");
-  std::vector<char*> argv{const_cast<char*>(SPHXR_BINARY)};
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int o = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int e = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(o, 1);
-    dup2(e, 2);
+  const pid_t pid = test::SpawnSphxr(args, outPath, errPath, [fileLimit] {
     if (fileLimit > 0) {
       ::signal(SIGXFSZ, SIG_IGN);
       const rlimit limit{fileLimit, fileLimit};
       if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(126);
     }
-    execv(SPHXR_BINARY, argv.data());
-    _exit(127);
-  }
+  });
   int status = 0;
   waitpid(pid, &status, 0);
   Result r;
