@@ -31,6 +31,13 @@ void GLAPIENTRY DebugCallback(GLenum source, GLenum type, GLuint id, GLenum seve
 
 namespace {
 
+/// A shader or program info log as one line.
+std::string OneLine(const char* log) {
+  std::string text(log);
+  for (char& c : text) c = (c == '\n') ? ' ' : c;
+  return text;
+}
+
 GLuint Compile(GLenum stage, const std::vector<const char*>& parts, std::string* log) {
   GLuint shader = glCreateShader(stage);
   glShaderSource(shader, static_cast<GLsizei>(parts.size()), parts.data(), nullptr);
@@ -40,7 +47,7 @@ GLuint Compile(GLenum stage, const std::vector<const char*>& parts, std::string*
   if (!ok) {
     char buffer[4096];
     glGetShaderInfoLog(shader, sizeof(buffer), nullptr, buffer);
-    *log += buffer;
+    *log += OneLine(buffer);
     glDeleteShader(shader);
     return 0;
   }
@@ -60,7 +67,6 @@ Status LinkProgram(const char* name, GLuint* out) {
   if (!v || !f) {
     glDeleteShader(v);
     glDeleteShader(f);
-    for (char& c : log) c = (c == '\n') ? ' ' : c;  // one line
     return Status::Error(Format("shader %s does not compile: %s", name, log.c_str()));
   }
   GLuint program = glCreateProgram();
@@ -75,8 +81,7 @@ Status LinkProgram(const char* name, GLuint* out) {
     char buffer[4096];
     glGetProgramInfoLog(program, sizeof(buffer), nullptr, buffer);
     glDeleteProgram(program);
-    for (char* c = buffer; *c; ++c) *c = (*c == '\n') ? ' ' : *c;
-    return Status::Error(Format("shader %s does not link: %s", name, buffer));
+    return Status::Error(Format("shader %s does not link: %s", name, OneLine(buffer).c_str()));
   }
   *out = program;
   return Status::Ok();
