@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   const std::string header = "machine,gl,load_avg_start,scene,eye_px,quality,fluid,triangles,diffuse,pass,gpu_ms_median";
   if (std::string why = bench::CsvRefusal(csvPath, header); !why.empty()) return std::fprintf(stderr, "%s\n", why.c_str()), 2;
 
+  const double load = bench::LoadAverage();  // before this bench's own work raises it
   std::unique_ptr<render::HeadlessContext> context;
   if (Status s = render::HeadlessContext::Create(false, &context); !s) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
   // Two states: stir at 0.5 s (still water: the table, the glass, the paddle-less tank) and the dam
@@ -82,7 +83,6 @@ int main(int argc, char** argv) {
     return std::fprintf(stderr, "%s\n", why.c_str()), 2;
   }
   const std::string machine = bench::CpuModel();
-  const double load = bench::LoadAverage();
   std::printf("machine: %s, load %.2f; GL %s\n\n", machine.c_str(), load, render::GlDescription());
   for (const State& st : states) {
     const render::FrameScene frame = app::MakeFrameScene(st.snap, render::RenderMode::kWater);

@@ -17,11 +17,13 @@ while [ $# -gt 0 ]; do
 done
 [ ${#builds[@]} -gt 0 ] || builds=(build)
 machine=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/,/ /g')
-echo "machine,cores,load_avg_start,build,round,fluid,spacing_m,method,diffuse,frames,wall_s,simulated_s,realtime,frame_p50_ms,render_quality_end" > "$csv"
+echo "machine,cores,load_avg_start,build,round,fluid,spacing_m,method,diffuse_turned_off,frames,wall_s,simulated_s,realtime,frame_p50_ms,render_quality_end" > "$csv"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 for round in $(seq 1 "$rounds"); do
   for b in "${builds[@]}"; do
+    # Each run starts on a quiet machine: the load average under 0.5 (waiting at most 3 minutes).
+    for _ in $(seq 1 36); do awk '{exit !($1 < 0.5)}' /proc/loadavg && break; sleep 5; done
     load=$(cut -d' ' -f1 /proc/loadavg)
     dir=$(cd "$b" && pwd)
     XR_RUNTIME_JSON="$dir/xr/sim_runtime/sphxr_sim_runtime.json" SPHXR_SIM_XR_EYE_SIZE=512x512 \
@@ -33,7 +35,7 @@ text = open(out).read()
 q = re.search(r"quality auto: method (\w+), spacing ([\d.]+) m .*?, (\d+) fluid particles", text)
 end = re.search(r"after (\d+) frames .*? in ([\d.]+) s; frame interval p50 ([\d.]+).*?simulation at t = ([\d.]+) s", text)
 quality = re.search(r"render quality (\w+); GPU", text)
-diffuse = "off" if "spray, foam and bubbles off" in text else "on"
+diffuse = "yes" if "spray, foam and bubbles off" in text else "no"
 frames, wall, p50, sim = end.groups()
 print(",".join([machine, cores, load, build, rnd, q.group(3), q.group(2), q.group(1), diffuse, frames, wall, sim,
                 f"{float(sim) / float(wall):.3f}", p50, quality.group(1) if quality else "-"]))
