@@ -1,8 +1,9 @@
 // DFSPH (sim/src/solvers/dfsph.h, Bender & Koschier 2017): each solve does what it claims, checked
 // against sums computed here by brute force over every particle pair; the iteration cap warns instead of
-// failing; the step follows the flow. (Bit-identical reruns, thread counts and restores on every
-// backend: tests/backend; hydrostatics, walls and Martin & Moyce: tests/validation; the 5 m/s paddle:
-// tests/interaction.)
+// failing; the step follows the flow. (What every solver does, still water, a splash, a paddle, walls,
+// restores, thread counts and cpu-reference: conformance_test.cpp; bit-identical reruns on every backend:
+// tests/backend; hydrostatics, walls and Martin & Moyce at full size: tests/validation; the 5 m/s
+// paddle: tests/interaction.)
 #include <gtest/gtest.h>
 
 #include <cmath>
