@@ -33,8 +33,8 @@ TEST(Cli, ACommandLineGivesEachOptionOnceAndOneMode) {
   EXPECT_TRUE(parse({"--set", "cfl=0.3", "--set", "stiffness=1e5", "--headless"}).ok()) << "--set repeats";
 }
 
-// `--save-state link.csv --stats z.csv` with link.csv -> z.csv, z.csv not there yet: the state
-// overwrote the statistics.
+// `--save-state link.csv --stats z.csv` with link.csv -> z.csv, z.csv not there yet: the state would
+// overwrite the statistics.
 TEST(Cli, ADanglingSymlinkDoesNotDefeatTheOutputClashCheck) {
   test::TempDir dir("cli_link");
   const std::string scene = dir.Write("scene.json", test::kSmallTankScene);

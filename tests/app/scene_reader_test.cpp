@@ -26,7 +26,7 @@ const char* kTank = R"("tank": {"min": [0, 0, 0], "max": [1, 1, 1]})";
 std::string SceneWith(const std::string& body) { return std::string("{") + kTank + ", " + body + "}"; }
 
 TEST(SceneReader, DeepNestingIsRefusedNotACrash) {
-  // 100,000 levels: the message printed the value with a recursive dump and overflowed the stack.
+  // 100,000 levels: a message that dumped the value recursively would overflow the stack.
   const std::string deep = R"({"tank": {"min": )" + std::string(100000, '[') + std::string(100000, ']') +
                            R"(, "max": [1,1,1]}})";
   SceneFile scene;
@@ -98,14 +98,14 @@ TEST(SceneReader, NamesWithControlBidiOrLineSeparatorsAreRefused) {
     const std::string paddle = std::string(R"("paddles": {"list": [{"name": ")") + bad + R"(", "hand": "left", "shapes": "blade_on_handle"}]})";
     ExpectCleanRefusal(Parse(SceneWith(paddle), &scene), "paddles.list[0].name");
   }
-  // A newline in a probe name forged a second "sphxr: error:" line.
+  // A newline in a probe name would forge a second "sphxr: error:" line.
   const std::string forged = R"("probes": {"level": [{"name": "g\nsphxr: error: forged", "x": 0.5, "z": 0.5}]})";
   ExpectCleanRefusal(Parse(SceneWith(forged), &scene), "probes.level[0].name");
   // Plain UTF-8 is a name.
   EXPECT_TRUE(Parse(SceneWith("\"name\": \"Becken \\u00fcber \\u6c34\""), &scene).ok());
 }
 
-// The JSON parser's own message quotes the bytes it read last: invalid UTF-8 (the fuzzer's find: a
+// The JSON parser's own message quotes the bytes it read last: invalid UTF-8 (a fuzz target's input: a
 // Latin-1 byte pair after a number), an escape sequence and a C1 control must reach the user escaped.
 TEST(SceneReader, TheJsonParsersMessageIsShownEscaped) {
   SceneFile scene;

@@ -213,7 +213,7 @@ TEST(StateFile, RecordsTheSolverMethod) {
   EXPECT_EQ(log.Count("saved under solver.method dfsph", LogLevel::kWarn), 1) << log.All();
 }
 
-// Version 1 (the first session's files) had no step count: it is still read, with the step unknown
+// Version 1 files have no step count: it is still read, with the step unknown
 // (-1: a continued run numbers from 0), and the fluid as saved.
 TEST(StateFile, AVersionOneFileIsReadWithoutItsStepCount) {
   test::TempDir dir("state_v1");
@@ -337,8 +337,8 @@ TEST(StateFile, AnotherSceneOrSpacingIsRefused) {
 }
 
 // The file is renamed into place, which would replace whatever is there: a pipe or device is refused
-// and left alone (--save-state /dev/null, as root, replaced the system's /dev/null), and a symbolic link
-// is followed: the link stays, its target gets the state.
+// and left alone (--save-state /dev/null, as root, must not replace the system's /dev/null), and a
+// symbolic link is followed: the link stays, its target gets the state.
 TEST(StateFile, APipeIsRefusedAndALinkIsFollowed) {
   test::TempDir dir("state_nodes");
   auto solver = SteppedSolver(2);
@@ -361,7 +361,7 @@ TEST(StateFile, APipeIsRefusedAndALinkIsFollowed) {
 }
 
 // Without --save-state the window and the headset save to "<scene name>.state": a scene's name from a
-// shared file must not name a path (it saved "../escape_dir/evil.state").
+// shared file must not name a path ("../escape_dir/evil" would save outside the folder).
 TEST(StateFile, TheDefaultSaveNameStaysInTheWorkingDirectory) {
   EXPECT_EQ(DefaultStatePath("dam_break"), "dam_break.state");
   EXPECT_EQ(DefaultStatePath("deep tank v1.2"), "deep_tank_v1.2.state");
@@ -388,8 +388,8 @@ TEST(StateFile, AFailedWriteLeavesTheEarlierFile) {
   EXPECT_EQ(Bytes(path), before) << "the earlier state file is unchanged";
 }
 
-// State files are checked as scenes are: finite but absurd values were restored (every particle
-// outside the tank, a body at y = 1e9 m, a particle at 1e9 m/s, two particles with one id).
+// State files are checked as scenes are: finite but absurd values (every particle outside the tank, a
+// body at y = 1e9 m, a particle at 1e9 m/s, two particles with one id) are refused, not restored.
 class StateChecks : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -411,7 +411,7 @@ class StateChecks : public ::testing::Test {
 
 TEST_F(StateChecks, TheSavedStateRestores) { EXPECT_TRUE(Restore(m_state).ok()); }
 
-// Found by the fuzz target: a damaged field name was quoted raw, newlines and all.
+// A damaged field name is refused in one line, not quoted raw with its newlines (a fuzz target's input).
 TEST_F(StateChecks, ADamagedFieldNameIsRefusedInOneLine) {
   std::string bytes = test::ReadFile(m_dir.File("a.state"));
   const size_t at = bytes.find("velocity");

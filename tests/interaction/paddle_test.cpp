@@ -503,8 +503,8 @@ TEST(PaddleFluid, ParticlesNearAPaddleStayActiveUnderReuse) {
   EXPECT_EQ(test::FirstNonFinite(test::DownloadFluid(*rig.solver)), "");
 }
 
-// A paddle far larger than the tank was sampled (8.9 GB for a capsule of radius 100 m) before its
-// size was checked.
+// A paddle far larger than the tank is refused before it is sampled (a capsule of radius 100 m would
+// take 8.9 GB).
 TEST(PaddleSystem, AHugePaddleIsRefusedBeforeItIsSampled) {
   const sim::SceneSetup scene = test::SmallDamBreak(0.01f);
   for (const sim::ShapePrimitive& shape :

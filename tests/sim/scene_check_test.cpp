@@ -36,8 +36,9 @@ sim::SceneSetup ManyBlocks(int n) {
 TEST(SceneCheck, AHundredThousandBlocksAreCheckedInLinearTime) {
   sim::SceneSetup s = ManyBlocks(47);  // 103,823 blocks
   s.fluid.resize(100000);
-  // The pairwise check took 34 s for 97,336 blocks; sorted, it is a fraction of a second. The bound is
-  // 10x that, far below the quadratic time on any machine that runs these tests.
+  // Sorted, the check takes a fraction of a second; a pairwise check is quadratic, tens of seconds at
+  // this count. The bound is 10x the sorted time, far below the quadratic time on any machine that runs
+  // these tests.
   Status status;
   const double seconds = test::Seconds([&] { status = sim::ValidateScene(s); });
   EXPECT_TRUE(status.ok()) << status.message();
@@ -61,7 +62,7 @@ TEST(SceneCheck, OverlapsAreFoundWhateverTheOrder) {
 }
 
 TEST(SceneCheck, ManyBlocksLogOneLineNotOnePerBlock) {
-  // 97,336 blocks printed 194,675 lines: a cut-block line and a thin-block warning each.
+  // Not a cut-block line and a thin-block warning for each block (two lines a block).
   const sim::SceneSetup s = ManyBlocks(20);  // 8,000 blocks of 0.04 m at spacing 0.02: thin and cut
   test::LogCapture log;
   sim::LogCutBlocks(s);
@@ -70,7 +71,7 @@ TEST(SceneCheck, ManyBlocksLogOneLineNotOnePerBlock) {
 }
 
 TEST(SceneCheck, ABlockFasterThanTheSoundSpeedIsRefusedUnderWcsph) {
-  // At 1,000 m/s (67x the sound speed) the block reached 203,387 m/s and 906 % compression in 3 steps.
+  // At 1,000 m/s (67x the sound speed) the step cannot resolve the start: the block blows up in a few steps.
   sim::SceneSetup s = test::SmallDamBreak(0.02f);
   s.fluid[0].velocity = {1000.0f, 0.0f, 0.0f};
   s.method = sim::SolverMethod::kWcsph;
@@ -82,14 +83,14 @@ TEST(SceneCheck, ABlockFasterThanTheSoundSpeedIsRefusedUnderWcsph) {
   s.method = sim::SolverMethod::kDfsph;
   EXPECT_TRUE(sim::ValidateScene(s).ok());
   // PBF holds every speed to pbf_max_speed (20 m/s): a faster block would start slower than the scene
-  // says, silently (it ran at 20 m/s).
+  // says, silently.
   s.method = sim::SolverMethod::kPbf;
   ExpectCleanRefusal(sim::ValidateScene(s), "pbf_max_speed");
   s.fluid[0].velocity = {15.0f, 0.0f, 0.0f};
   EXPECT_TRUE(sim::ValidateScene(s).ok());
 }
 
-// With an obstacle the particle count walked a lattice of 1.7e9 sites (20 s) before refusing it.
+// With an obstacle, counting the particles would walk a lattice of 1.7e9 sites: refused from its bound first.
 TEST(SceneCheck, ATinySpacingWithObstaclesIsRefusedAtOnce) {
   sim::SceneSetup scene = test::TankScene({0, 0, 0}, {0.3f, 0.25f, 0.3f}, 0.0002f);
   scene.fluid.push_back(test::Block({0, 0, 0}, {0.3f, 0.15f, 0.3f}));

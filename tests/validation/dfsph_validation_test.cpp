@@ -78,7 +78,7 @@ TEST(DfsphStillWater, PressureIsHydrostaticOverTheLowerEightyPercent) {
   // particles (a sheet half a spacing below the floor, sampling.cpp), whose kernel sums are cut by the
   // wall (the boundary model's own error: recorded, not held to the interior's 5 %). The distance is the
   // layer's measured mean height, not the lattice's: DFSPH's first layer sinks into the wall's zone
-  // (issue 47), and the layer above it then reaches within the support too.
+  // (docs/design/dfsph.md), and the layer above it then reaches within the support too.
   const int deepest = layers.rbegin()->first;
   const double sheet = scene.setup.tank.min.y - 0.5 * dx;
   const double support = scene.setup.params.supportFactor * dx;
