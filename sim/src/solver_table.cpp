@@ -53,11 +53,11 @@ float DfsphStableDt(const StableDtInput& in) {
 float PbfStableDt(const StableDtInput& in) { return in.scene.params.pbfFrame / in.scene.params.pbfSubsteps; }
 
 int64_t NoBytes(int64_t) { return 0; }
-/// sim/src/solvers/dfsph.h: a kernel gradient per neighbour slot (12; on the CPU lane-blocked, in batches
+/// sim/src/solvers/dfsph/dfsph.h: a kernel gradient per neighbour slot (12; on the CPU lane-blocked, in batches
 /// of 16 slots: PairCacheStride), the boundary terms (16), factor, increment, neighbour count and the two
 /// stiffnesses (20), the step's start velocity (16) and the error terms (8).
 int64_t DfsphBytes(int64_t slots) { return 12 * ((slots + 15) / 16 * 16) + 16 + 20 + 16 + 8; }
-/// sim/src/solvers/pbf.h: lambda and its sum over the step (8), the position corrections (16), the
+/// sim/src/solvers/pbf/pbf.h: lambda and its sum over the step (8), the position corrections (16), the
 /// boundary gradients (16); on the CPU the own terms (16) and the pair cache (12 a slot, in batches of
 /// 16 slots: PairCacheStride). The step's start positions live in the acceleration field.
 int64_t PbfBytes(int64_t slots) { return 4 + 4 + 16 + 16 + 16 + 12 * ((slots + 15) / 16 * 16); }

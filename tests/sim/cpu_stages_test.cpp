@@ -4,7 +4,7 @@
 // over-full sets (more than kLanes particles in a cell, more neighbours than list slots), with and without
 // reuse masking some particles out, and with walls (their kernel sums). Forces: the neighbour-list sum
 // and the wall terms (mirrored and wall density). Wall pressure: the blocks of 16 wall particles.
-// Position-based fluids: the lambda, correction and XSPH passes (cpu/pbf.h).
+// Position-based fluids: the lambda, correction and XSPH passes (solvers/pbf/pbf_simd.h).
 // Reuse's crowding (CellCountStage, CellBoxSumStage, ActivityStage; both backends' stages) against counting by brute force.
 #include <gtest/gtest.h>
 
@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "cpu/stages.h"
+#include "solvers/dfsph/dfsph_simd.h"
+#include "solvers/pbf/pbf_simd.h"
 #include "stages/integrate.h"
 #include "morton.h"
 
@@ -533,8 +535,8 @@ TEST(CpuStages, ForcesOfOverflowingListsMatch) {
   CompareForces(Clustered(), 24, "clustered, lists overflowing");
 }
 
-/// Position-based fluids' three neighbour passes (cpu/pbf.h) against the per-particle stages
-/// (solvers/pbf_stages.h) and against the pass's sums in double over every fluid and wall particle: the
+/// Position-based fluids' three neighbour passes (solvers/pbf/pbf_simd.h) against the per-particle stages
+/// (solvers/pbf/pbf_stages.h) and against the pass's sums in double over every fluid and wall particle: the
 /// density and lambda, the position correction (with the artificial pressure s_corr), XSPH.
 void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what,
                 const std::vector<Vec3>& walls = {}) {
@@ -676,7 +678,7 @@ TEST(CpuStages, PbfPassesMatchPerParticleAndBruteForce) {
   ComparePbf(Clustered(), 24, "clustered, lists overflowing");
 }
 
-/// DFSPH's three neighbour passes (cpu/dfsph.h) against the per-particle stages (solvers/dfsph_stages.h)
+/// DFSPH's three neighbour passes (solvers/dfsph/dfsph_simd.h) against the per-particle stages (solvers/dfsph/dfsph_stages.h)
 /// and against their sums in double over every fluid and wall particle: the factor alpha_i with the
 /// walls' gradient gB_i and the neighbour count, Predict's increment delta_i (the density solve's from
 /// the compressed set's rho_i and D rho_i/Dt, the divergence solve's from D rho_i/Dt), and Correct's

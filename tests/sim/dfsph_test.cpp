@@ -1,4 +1,4 @@
-// DFSPH (sim/src/solvers/dfsph.h, Bender & Koschier 2017): each solve does what it claims, checked
+// DFSPH (sim/src/solvers/dfsph/dfsph.h, Bender & Koschier 2017): each solve does what it claims, checked
 // against sums computed here by brute force over every particle pair; the iteration cap warns instead of
 // failing; the step follows the flow. (Bit-identical reruns, thread counts and restores on every
 // backend: tests/backend; hydrostatics, walls and Martin & Moyce: tests/validation; the 5 m/s paddle:

@@ -1,4 +1,4 @@
-// Position-based fluids (sim/src/solvers/pbf.h, Macklin & Müller 2013): one step against the paper's
+// Position-based fluids (sim/src/solvers/pbf/pbf.h, Macklin & Müller 2013): one step against the paper's
 // algorithm written out here by brute force over every particle pair, in double; still water from the
 // lattice; the extremes of the iteration count; the same bits at every thread count. (cpu against
 // cpu-reference and CUDA: tests/backend/agreement_test.cpp.)

@@ -214,7 +214,7 @@ SPHXR_INLINE void GatherXyz(const float* base, LaneInts index, Lanes* x, Lanes* 
 }
 
 /// SimdForm<Stage>::type: the SIMD form CpuLauncher::ForEach runs in place of a scalar stage (where
-/// one is declared, beside the form: cpu/pbf.h).
+/// one is declared, beside the form: solvers/pbf/pbf_simd.h).
 template <class Stage>
 struct SimdForm {};
 

@@ -225,14 +225,14 @@ struct Physics {
   bool contactBelowRestOnly;  // the contact acts only on particles lighter than rho0 (DFSPH; contact.h)
   bool closedTop;
   float volume;                 // m / rho0, each fluid particle's rest volume
-  // dfsph (solvers/dfsph.h)
+  // dfsph (solvers/dfsph/dfsph.h)
   float densityTolerance;       // mean compression (fraction) at which the density solve stops
   float divergenceTolerance;    // mean compression per step (fraction) at which the divergence solve stops
   int minIterations;
   int maxIterations;
   int minDivergenceIterations;
   int maxDivergenceIterations;  // 0: no divergence solve
-  // pbf (solvers/pbf.h)
+  // pbf (solvers/pbf/pbf.h)
   int pbfIterations;
   float pbfRelaxation;          // epsilon, absolute (the relative scene value times the rest lattice's sum)
   float pbfCorrK;               // m^2: k over the rest lattice's sum |grad C|^2 (s_corr enters beside lambda)

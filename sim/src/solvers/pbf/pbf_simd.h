@@ -1,5 +1,5 @@
 #pragma once
-// The SIMD forms of position-based fluids' three neighbour passes (solvers/pbf_stages.h): the lambda
+// The SIMD forms of position-based fluids' three neighbour passes (solvers/pbf/pbf_stages.h): the lambda
 // pass, the correction pass and XSPH, per particle over its neighbour list kLanes neighbours at a time
 // (as ForceListStage), and the wall particles of its cells kLanes at a time. The physics is the scalar
 // stage's; the sums' order differs (rounding only), a list that overflowed falls back to the scalar
@@ -18,7 +18,7 @@
 
 #include "cpu/lists.h"
 #include "cpu/simd.h"
-#include "solvers/pbf_stages.h"
+#include "solvers/pbf/pbf_stages.h"
 
 namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {

@@ -2,13 +2,13 @@
 // Position-based fluids (Macklin & Müller, "Position Based Fluids", ACM TOG 32(4), SIGGRAPH 2013
 // [MM13]): the real-time solver. A fixed number of Jacobi iterations of the density constraint on
 // predicted positions per step, so a step costs the same at any speed and the water can advance by
-// one displayed frame per step (docs/design/pbf.md). The stages: solvers/pbf_stages.h.
+// one displayed frame per step (docs/design/pbf.md). The stages: solvers/pbf/pbf_stages.h.
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/transform_reduce.h>
 
-#include "solvers/pbf_stages.h"
+#include "solvers/pbf/pbf_stages.h"
 #include "solvers/step_context.h"
 
 namespace sphxr::sim {
@@ -81,7 +81,7 @@ class PbfSolver final : public PressureSolver<Traits> {
 
  private:
   /// Whether the backend's launcher runs the SIMD passes that keep the lambda pass's pair terms (the
-  /// CPU's, cpu/pbf.h); the others recompute them and need no pair array.
+  /// CPU's, solvers/pbf/pbf_simd.h); the others recompute them and need no pair array.
   static constexpr bool kPairCache = kLauncherPairCache<Traits>;
 
   void Size(int n) {

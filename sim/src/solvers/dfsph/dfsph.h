@@ -1,11 +1,11 @@
 #pragma once
 // Divergence-free SPH (Bender & Koschier 2015, 2017 [BK17]): the accurate solver, whose step follows the
 // flow speed instead of the sound speed. Two Jacobi solves per step, on the velocities: the divergence
-// (before the non-pressure forces) and the density (after them). The stages: solvers/dfsph_stages.h.
+// (before the non-pressure forces) and the density (after them). The stages: solvers/dfsph/dfsph_stages.h.
 #include <thrust/fill.h>
 #include <thrust/reduce.h>
 
-#include "solvers/dfsph_stages.h"
+#include "solvers/dfsph/dfsph_stages.h"
 #include "solvers/step_context.h"
 
 namespace sphxr::sim {
@@ -125,7 +125,7 @@ class DfsphSolver final : public PressureSolver<Traits> {
                      m_pairStride};
   }
 
-  /// Whether the launcher's SIMD passes keep G_ij lane-blocked (the CPU's, cpu/dfsph.h) in place of the
+  /// Whether the launcher's SIMD passes keep G_ij lane-blocked (the CPU's, solvers/dfsph/dfsph_simd.h) in place of the
   /// scalar stages' Vec3 a slot.
   static constexpr bool kPairCache = kLauncherPairCache<Traits>;
 

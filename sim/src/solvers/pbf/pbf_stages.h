@@ -1,6 +1,6 @@
 #pragma once
 // The stages of position-based fluids (Macklin & Müller, "Position Based Fluids", ACM TOG 32(4), 2013
-// [MM13]), host+device functors for both backends; their order is PbfSolver::Step (solvers/pbf.h).
+// [MM13]), host+device functors for both backends; their order is PbfSolver::Step (solvers/pbf/pbf.h).
 //
 //   predict   v* = v + dt g (capped at pbf_max_speed), x* = x + dt v*; the step's start position x
 //             is kept in acceleration.xyz until the finish (the field list sorts it with the particle)
@@ -34,7 +34,7 @@ struct PbfView {
   Vec4* delta;         // this iteration's position correction (xsph: the velocity change)
   Vec4* boundaryGrad;  // B_i = sum_b (Psi_b / rho0) grad W_ib over the walls and paddles, from the lambda
                        // pass: the correction's boundary term is lambda_i B_i (positions do not move between)
-  // The CPU's SIMD passes only (cpu/pbf.h; nullptr on the other backends): the lambda pass keeps
+  // The CPU's SIMD passes only (solvers/pbf/pbf_simd.h; nullptr on the other backends): the lambda pass keeps
   // V grad W_ij of each list slot, and lambda_i (sum_j V grad W_ij + B_i) + sum_j s_corr V grad W_ij of each
   // particle, so the correction pass adds sum_j lambda_j V grad W_ij without evaluating the kernel again.
   float* pairGrad;     // pairStride floats a particle: per kLanes slots, the x, y and z of kLanes pairs
@@ -168,7 +168,7 @@ struct PbfLambdaStage {
     gradI += gradB;
     Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
   }
-  /// rho_i, and lambda_i from it and sum_k |grad_k C_i|^2 (also the CPU's SIMD form's end, cpu/pbf.h).
+  /// rho_i, and lambda_i from it and sum_k |grad_k C_i|^2 (also the CPU's SIMD form's end, solvers/pbf/pbf_simd.h).
   SPHXR_HD SPHXR_INLINE float Finish(int i, float rho, float gradSum2) const {
     fluid.density[i] = rho;
     const float c = AtLeast(rho * ph.invRestDensity - 1.0f, 0.0f);
