@@ -390,23 +390,7 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
                    "errors above 1%% (WCSPH wants 10x); solver.stiffness >= %.3g Pa would give that",
                    soundSpeed, soundSpeed / vRef, vRef, needB);
   }
-  // PBF's steady compression under a column of depth D is about K (1 + eps) g D dt^2 / (N s^2) at
-  // spacing s: each substep's fall g dt^2 is carried up the column by N Jacobi iterations that reach one
-  // support each. K = 0.195 from tank_rest (S^2 N x the mean compression 94-98.5 % over seven settings
-  // at eps = 1; bench/pbf_still_water.py, docs/design/pbf.md).
-  if (scene.method == SolverMethod::kPbf && height > 0.0f) {
-    const SolverParams& p = scene.params;
-    const float dt = p.pbfFrame / p.pbfSubsteps, s = p.spacing;
-    const float compression = 0.195f * (1.0f + p.pbfRelaxation) * g * height * dt * dt / (p.pbfIterations * s * s);
-    if (compression > 0.05f) {
-      const float substeps = std::ceil(p.pbfSubsteps * std::sqrt(compression / 0.02f));
-      const std::string fix = substeps <= 16.0f ? Format("pbf_substeps %g would give about 2 %%", substeps)
-                                                : std::string("more iterations or a coarser spacing would lower it");
-      SPHXR_LOG_WARN("pbf: expect about %.0f%% mean compression at rest under the %.3g m column (%g substeps of %g "
-                     "iterations a %.3g s frame at %.3g m spacing; it falls as 1 / (substeps^2 iterations)): %s",
-                     100.0f * compression, height, p.pbfSubsteps, p.pbfIterations, p.pbfFrame, s, fix.c_str());
-    }
-  }
+  if (method.warnAtStart) method.warnAtStart(scene, height);  // the method's own (its row)
   const bool deltaSph = scene.density == DensityModel::kDeltaSph;
   if (!method.deltaSph && deltaSph) {
     SPHXR_LOG_WARN("solver.density delta_sph is not a model of solver.method %s, which sums the density (the setting "

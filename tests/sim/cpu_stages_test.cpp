@@ -544,11 +544,12 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   Setup s(points, maxNeighbours, walls);
   Physics& ph = s.ph;
   ph.volume = kSpacing * kSpacing * kSpacing;
-  ph.pbfRelaxation = 1.0f / (kSpacing * kSpacing);  // eps of the order of sum |grad C|^2 (units 1/m^2)
-  ph.pbfCorrK = 0.1f;
-  ph.pbfCorrN = 4;
-  ph.pbfInvCorrW = 1.0f / ph.kernel.W(0.2f * kSupport);
-  ph.pbfXsph = 0.01f;
+  PbfConstants pbf{};
+  pbf.relaxation = 1.0f / (kSpacing * kSpacing);  // eps of the order of sum |grad C|^2 (units 1/m^2)
+  pbf.corrK = 0.1f;
+  pbf.corrN = 4;
+  pbf.invCorrW = 1.0f / ph.kernel.W(0.2f * kSupport);
+  pbf.xsph = 0.01f;
   s.RunBlocked(false, 0);  // the neighbour lists
   const size_t n = s.position.size();
   const ForceStage f = s.Forces();
@@ -603,7 +604,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
       for (int a = 0; a < 3; ++a) g[a] += d[a] * c;
       if (j >= 0) sum2 += c * c * r * r;
     });
-    const double denom = sum2 + g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + ph.pbfRelaxation;
+    const double denom = sum2 + g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + pbf.relaxation;
     const double lam = -std::max(rho * invRho0 - 1.0, 0.0) / denom;
     // float rounding: a sum of `terms` positive terms in any order is within terms * u of the exact one
     // (u = 2^-24; doubled for the kernel's own rounding), and lambda's numerator rho/rho0 - 1 carries that
@@ -631,7 +632,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
     pairs(i, [&](long j, const double* d, double r, double psi) {
       double c;
       if (j >= 0) {
-        const double corr = -ph.pbfCorrK * std::pow(kernelW(r) * ph.pbfInvCorrW, ph.pbfCorrN);
+        const double corr = -pbf.corrK * std::pow(kernelW(r) * pbf.invCorrW, pbf.corrN);
         c = (li + lambda[static_cast<size_t>(j)] + corr) * ph.volume * grad(r);
       } else {
         c = li * psi * invRho0 * grad(r);
@@ -659,7 +660,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
     pairs(i, [&](long j, const double*, double r, double) {
       if (j < 0) return;
       const Vec4 vj = s.velocity[static_cast<size_t>(j)], vi = s.velocity[i];
-      const double w = ph.pbfXsph * ph.volume * kernelW(r);
+      const double w = pbf.xsph * ph.volume * kernelW(r);
       dv[0] += (double(vj.x) - vi.x) * w, dv[1] += (double(vj.y) - vi.y) * w, dv[2] += (double(vj.z) - vi.z) * w;
       scale += 2.0 * std::abs(w);  // |v| <= sqrt(3) m/s here
     });
