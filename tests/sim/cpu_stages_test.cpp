@@ -560,7 +560,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   const int stride = PairCacheStride(maxNeighbours);
   std::vector<float> pairGrad(n * static_cast<size_t>(stride), std::numeric_limits<float>::quiet_NaN());
   const PbfView view{lambda.data(), lambdaSum.data(), delta.data(), boundaryGrad.data(), pairGrad.data(), own.data(), stride};
-  const PbfLambdaStage lambdaStage{f.grid, f.fluid, f.list, ph, view};
+  const PbfLambdaStage lambdaStage{f.grid, f.fluid, f.list, ph, pbf, view};
   const CubicSpline k = ph.kernel;
   const double invRho0 = ph.invRestDensity;
   // 1. lambda
@@ -619,7 +619,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   // 2. the correction, from the same lambdas: the scalar stage, and the SIMD one from the pair cache and
   // own terms the SIMD lambda pass above left (with these lambdas: run it again on them)
   lambda = lambdaRef;
-  const PbfCorrectStage correct{f.grid, f.fluid, f.list, ph, view};
+  const PbfCorrectStage correct{f.grid, f.fluid, f.list, ph, pbf, view};
   for (size_t i = 0; i < n; ++i) correct(static_cast<int>(i));
   deltaRef = delta;
   for (size_t i = 0; i < n; ++i) PbfLambdaListStage{lambdaStage}(static_cast<int>(i));  // lambda_i again (same values)
@@ -650,7 +650,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   }
   EXPECT_GT(moved, n / 20) << "the set must be compressed somewhere, or the correction is not tested";
   // 3. XSPH
-  const PbfXsphStage xsph{f.grid, f.fluid, f.list, ph, view};
+  const PbfXsphStage xsph{f.grid, f.fluid, f.list, ph, pbf, view};
   for (size_t i = 0; i < n; ++i) xsph(static_cast<int>(i));
   deltaRef = delta;
   std::fill(delta.begin(), delta.end(), Vec4{9.0f, 9.0f, 9.0f, 9.0f});

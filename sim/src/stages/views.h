@@ -1,6 +1,6 @@
 #pragma once
-// What every stage reads: plain views of raw pointers (FluidView, GridView, NeighbourList), the step's
-// constants (Physics), passed by value into host+device functors, and the loop over the 27 cells
+// What every stage reads: plain views of raw pointers (FluidView, GridView, NeighbourList), the constants
+// every stage shares (Physics), passed by value into host+device functors, and the loop over the 27 cells
 // around a point. The stages themselves are one header each beside this one (stages.h lists them in
 // the order of a step).
 #include <cstdint>
