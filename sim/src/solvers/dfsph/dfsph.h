@@ -32,7 +32,8 @@ class DfsphSolver final : public PressureSolver<Traits> {
     SPHXR_TRY(ctx.Lap(Stage::kDensity));
     // 3. divergence-free solve on the velocities at the start of the step        [BK17 §4.2, alg. 2]
     if (m_c.maxDivergenceIterations > 0) {
-      const Result r = Solve(ctx, false, m_c.minDivergenceIterations, m_c.maxDivergenceIterations, m_c.divergenceTolerance);
+      const Result r =
+          Solve(ctx, false, m_c.minDivergenceIterations, m_c.maxDivergenceIterations, m_c.divergenceTolerance);
       ctx.report.divergenceIterations = r.iterations;
       ctx.report.divergenceError = r.error;
     }

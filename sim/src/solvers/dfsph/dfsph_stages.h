@@ -40,8 +40,8 @@ struct DfsphView {
   float* delta;           // this iteration's stiffness increment
   uint64_t* error;        // this iteration's residual of each particle, fixed point (ErrorToFixed)
   Vec4* velocityStart;    // v* (after the non-pressure forces), for the step's acceleration
-  // The CPU's SIMD passes (solvers/dfsph/dfsph_simd.h) keep G_ij here, lane-blocked (PairCacheStride floats a particle),
-  // in place of `grad`; nullptr on the backends that run the scalar stages.
+  // The CPU's SIMD passes (dfsph_simd.h) keep G_ij here, lane-blocked (PairCacheStride floats a
+  // particle), in place of `grad`; nullptr on the backends that run the scalar stages.
   float* pairGrad = nullptr;
   int pairStride = 0;
 };

@@ -61,7 +61,8 @@ class PbfSolver final : public PressureSolver<Traits> {
     if (m_c.vorticity > 0.0f) {
       if (m_vorticity.size() != static_cast<size_t>(ctx.n)) m_vorticity.resize(static_cast<size_t>(ctx.n));
       ctx.Launch().ForEach(ctx.n, 64, PbfVorticityStage{ctx.grid, ctx.fluid, list, ph, Raw(m_vorticity)});
-      ctx.Launch().ForEach(ctx.n, 64, PbfConfinementStage{ctx.grid, ctx.fluid, list, ph, m_c, view, Raw(m_vorticity), ctx.dt});
+      ctx.Launch().ForEach(ctx.n, 64,
+                           PbfConfinementStage{ctx.grid, ctx.fluid, list, ph, m_c, view, Raw(m_vorticity), ctx.dt});
       ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, m_c, view});
     }
     SPHXR_TRY(ctx.Lap(Stage::kIntegrate));
