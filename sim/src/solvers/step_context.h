@@ -13,8 +13,8 @@
 #include <functional>
 
 #include "probe_arrays.h"
-#include "sphxr/sim/solve_report.h"
 #include "reuse_lists.h"
+#include "sphxr/sim/solve_report.h"
 #include "stages.h"
 #include "store/boundary_store.h"
 #include "store/fluid_store.h"
