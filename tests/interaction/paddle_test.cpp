@@ -457,7 +457,7 @@ TEST(PaddleFluid, HeldStillInWaterFeelsArchimedesBuoyancy) {
 
 TEST(PaddleFluid, HeldStillInPbfWaterFeelsArchimedesBuoyancy) {
   // Under PBF the force is the impulse of the constraint corrections the cube's boundary particles
-  // cause, read through the pressure estimate (solvers/pbf_stages.h). The same truth in WCSPH's band.
+  // cause, read through the pressure estimate (solvers/pbf/pbf_stages.h). The same truth in WCSPH's band.
   HeldCubeFeelsArchimedesBuoyancy(sim::SolverMethod::kPbf, 0.30);
 }
 

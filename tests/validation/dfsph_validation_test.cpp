@@ -29,7 +29,7 @@ std::unique_ptr<sim::Solver> RestTankAfterOneSecond(app::SceneFile* scene) {
 }
 
 TEST(DfsphStillWater, WallsHoldItWithoutTheDomainClamp) {
-  // The walls mirror each fluid particle's stiffness (solvers/dfsph.h): the first layer then rests on the
+  // The walls mirror each fluid particle's stiffness (solvers/dfsph/dfsph.h): the first layer then rests on the
   // wall instead of sliding to the domain clamp, which caught 12 % of the particles every step when the
   // walls pushed with the particle's stiffness alone. At most one clamp per 1,000 particle-steps.
   app::SceneFile scene;

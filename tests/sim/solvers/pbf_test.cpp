@@ -1,4 +1,4 @@
-// Position-based fluids (sim/src/solvers/pbf.h, Macklin & Müller 2013): one step against the paper's
+// Position-based fluids (sim/src/solvers/pbf/pbf.h, Macklin & Müller 2013): one step against the paper's
 // algorithm written out here by brute force over every particle pair, in double; still water from the
 // lattice; the extremes of the iteration count. (The same bits at every thread count, a restore, cpu
 // against cpu-reference: the conformance suite, conformance_test.cpp; against CUDA:
