@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <string>
 
@@ -77,28 +78,36 @@ TEST(SolverTable, EveryMethodHasARow) {
   EXPECT_EQ(SolverTable().size(), 3u) << "a new method: add it to the list above";
 }
 
-TEST(SolverTable, StatsHaveColumnNamesAndReadTheirStepField) {
-  std::set<std::string> columns;
-  for (const SolverStat stat : {SolverStat::kDensityIterations, SolverStat::kDivergenceIterations,
-                                SolverStat::kDensityError, SolverStat::kDivergenceError}) {
-    EXPECT_TRUE(columns.insert(SolverStatName(stat)).second) << SolverStatName(stat);
-    EXPECT_STRNE(SolverStatName(stat), "?");
-  }
-  StepInfo info;
-  info.densityIterations = 7;
-  info.divergenceIterations = 5;
-  info.solverDensityError = 0.25f;
-  info.solverDivergenceError = 0.125f;
-  EXPECT_EQ(SolverStatValue(info, SolverStat::kDensityIterations), 7.0);
-  EXPECT_EQ(SolverStatValue(info, SolverStat::kDivergenceIterations), 5.0);
-  EXPECT_EQ(SolverStatValue(info, SolverStat::kDensityError), 0.25);
-  EXPECT_EQ(SolverStatValue(info, SolverStat::kDivergenceError), 0.125);
+TEST(SolverTable, StatsHaveColumnNamesAndReadTheirReportField) {
+  SolveReport report;
+  report.densityIterations = 7;
+  report.divergenceIterations = 5;
+  report.densityError = 0.25f;
+  report.divergenceError = 0.125f;
+  // A column's name means one field of the report in every row that has it (the stats CSV of a run
+  // continued under another method, and the panel, read it by name).
+  std::map<std::string, double> valueOf;
   for (const SolverInfo& row : SolverTable()) {
-    std::set<SolverStat> seen;
-    for (const SolverStat stat : row.stats) EXPECT_TRUE(seen.insert(stat).second) << row.name << ": a column twice";
-    // A solve that may stop at its cap reports its iterations (the warning names them).
-    if (row.iterationCap) {
-      EXPECT_TRUE(seen.count(SolverStat::kDensityIterations)) << row.name;
+    std::set<std::string> seen;
+    for (const SolveColumn& column : row.columns) {
+      EXPECT_TRUE(seen.insert(column.name).second) << row.name << ": " << column.name << " twice";
+      EXPECT_TRUE((column.count != nullptr) != (column.fraction != nullptr)) << row.name << ": " << column.name
+                                                                            << " reads one field";
+      const double value = column.Value(report);
+      EXPECT_TRUE(value == 7.0 || value == 5.0 || value == 0.25 || value == 0.125) << column.name << " " << value;
+      auto [it, fresh] = valueOf.emplace(column.name, value);
+      if (!fresh) {
+        EXPECT_EQ(it->second, value) << column.name << " reads another field in " << row.name;
+      }
+    }
+  }
+  // An iteration count is a count, an error a fraction.
+  for (const auto& [name, value] : valueOf) {
+    if (name.find("iterations") != std::string::npos) {
+      EXPECT_GE(value, 1.0) << name;
+    }
+    if (name.find("error") != std::string::npos) {
+      EXPECT_LT(value, 1.0) << name;
     }
   }
 }
@@ -114,7 +123,9 @@ TEST(SolverTable, ParametersNamedByARowAreInTheRegistryAndNameRows) {
   }
   // The registry's method column names rows only (the panel shows a parameter with its row's method).
   for (const ParamInfo& p : SolverParamInfos()) {
-    if (p.method) EXPECT_NE(FindSolver(p.method), nullptr) << p.key << " belongs to " << p.method;
+    if (p.method) {
+      EXPECT_NE(FindSolver(p.method), nullptr) << p.key << " belongs to " << p.method;
+    }
   }
 }
 
