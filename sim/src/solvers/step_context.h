@@ -132,8 +132,8 @@ class PressureSolver {
  public:
   virtual ~PressureSolver() = default;
   /// Computes its own constants from the scene, once (the backend's Init), and again only when the
-  /// scene changes at run time (Solver::SetReuse).
-  virtual void Init(const SceneSetup& scene, const Physics& physics) = 0;
+  /// scene changes at run time (Solver::SetReuse); a solver whose stages read only Physics has none.
+  virtual void Init(const SceneSetup& /*scene*/, const Physics& /*physics*/) {}
   /// One step of ctx.dt, after the grid and the bodies' placement; leaves every particle integrated
   /// (positions, velocities, accelerations with the clamp flags of stages/integrate.h).
   virtual Status Step(StepContext<Traits>& ctx) = 0;

@@ -10,9 +10,7 @@ namespace sphxr::sim {
 template <class Traits>
 class WcsphSolver final : public PressureSolver<Traits> {
  public:
-  /// No constants of its own: the Tait equation's are the shared Physics (the density stage's pressure).
-  void Init(const SceneSetup& /*scene*/, const Physics& /*physics*/) override {}
-
+  // No constants of its own (no Init): the Tait equation's are the shared Physics.
   Status Step(StepContext<Traits>& ctx) override {
     const Physics& ph = ctx.physics;
     ctx.computing = ctx.n;
