@@ -8,7 +8,7 @@
 #include <string_view>
 #include <thread>
 
-#include "sphxr/app/probe_csv.h"
+#include "sphxr/app/probe_config.h"
 #include "sphxr/app/quality.h"
 #include "sphxr/app/run_arguments.h"
 #include "sphxr/app/state_file.h"

@@ -9,7 +9,9 @@
 #include <optional>
 #include <string>
 
+#include "sphxr/app/cli.h"
 #include "sphxr/app/desktop.h"
+#include "sphxr/app/display.h"
 #include "sphxr/app/headless.h"
 #include "sphxr/app/param_registry.h"
 #include "sphxr/app/run_arguments.h"

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "sphxr/app/probe_csv.h"
+#include "sphxr/app/probe_config.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
 #include "sphxr/sim/solver_table.h"

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "sphxr/app/cli.h"
 #include "sphxr/app/headless.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/state_file.h"

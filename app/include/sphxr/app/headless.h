@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "sphxr/app/cli.h"
+#include "sphxr/app/options.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/solver.h"
 
