@@ -8,8 +8,18 @@
 #include <cstdio>
 #include <memory>
 
-#include "headless_sinks.h"
+#include "checkpoint_sink.h"
+#include "dam_break_measure.h"
+#include "export_sink.h"
+#include "output_files.h"
+#include "pictures_sink.h"
+#include "progress.h"
+#include "progress_sink.h"
+#include "save_state_sink.h"
+#include "stats_sink.h"
+#include "summary_sink.h"
 #include "interrupt_scope.h"
+#include "sphxr/app/cli.h"
 #include "sphxr/app/probe_csv.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/simulation.h"
