@@ -16,6 +16,7 @@
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
 #include "sphxr/sim/params.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
 namespace {
@@ -336,7 +337,8 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
     std::string method;
     if (!r.String(&method, 64)) return truncated();
     if (!sim::ParseSolverMethod(method, &out->method)) {
-      return Status::Error(path + ": its solver method is not wcsph or dfsph: the file is damaged or from a newer build");
+      return Status::Error(path + ": its solver method is not one of " + sim::SolverNames() +
+                           ": the file is damaged or from a newer build");
     }
   }
   // The scene's name is shown in messages and the log: control characters (a damaged file, or a name
