@@ -21,7 +21,7 @@ namespace {
 
 Status ParseDouble(const std::string& flag, const char* text, double lo, double hi, double* out) {
   char* end = nullptr;
-  // Decimal only: strtod also reads hexadecimal ("0x10" was 16 s) and "inf".
+  // Decimal only: strtod also reads hexadecimal ("0x10" would be 16 s) and "inf".
   const std::string_view t(text);
   const std::string shown = ShowText(text);
   if (t.find_first_of("xXpP") != std::string_view::npos) return Status::Error(flag + " " + shown + ": not a decimal number");
@@ -46,8 +46,8 @@ Status ParseInt(const std::string& flag, const char* text, int64_t lo, int64_t h
   return Status::Ok();
 }
 
-// An option that does nothing in the run asked for is refused in one line, naming what it needs (each
-// of these was silently ignored).
+// An option that does nothing in the run asked for is refused in one line, naming what it needs
+// (ignoring it silently would let a user believe it acted).
 Status CheckOptionsTakeEffect(const Options& o, const std::vector<std::string>& seen) {
   auto given = [&](const char* flag) {
     for (const std::string& s : seen) {
@@ -396,7 +396,7 @@ bool SameFile(const std::string& a, const std::string& b) {
 }
 
 // An output that is one of the run's inputs, or another output, would be destroyed by it (a typo in
-// --stats wiped a state file that took minutes to settle): refused before anything runs. A state saved
+// --stats would wipe a state file that took minutes to settle): refused before anything runs. A state saved
 // over the one the run started from is allowed: it was read whole at the start, and is replaced
 // atomically (a checkpoint carried forward).
 Status CheckOutputsAreNotInputs(const Options& options, const SceneFile& scene) {

@@ -28,7 +28,7 @@ std::string Shown(const std::string& key);
 bool Printable(const std::string& text);
 
 // What nlohmann's parser does not say: nesting deeper than kMaxDepth, and a key given twice in one
-// object (the parser keeps the last, so a second "solver" silently replaced the first). A scan of the
+// object (the parser keeps the last, so a second "solver" would silently replace the first). A scan of the
 // raw text, so that the message can give the line of each; run on text the parser accepted.
 class StructureScan {
  public:

@@ -173,8 +173,8 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
 
 void SimWorker::Run() {
   // The CPU backend's team size is an OpenMP setting of the thread that made the solver (Start ran on
-  // the caller's thread): without this the worker's steps ran with the default team, whose spinning
-  // threads fought the renderer's for the cores (a 3.5 ms step took 650 ms under Xvfb + llvmpipe).
+  // the caller's thread): without this the worker's steps run with the default team, whose spinning
+  // threads fight the renderer's (a software GL's above all) for the cores.
   omp_set_num_threads(m_config.threads > 0 ? m_config.threads : omp_get_num_procs());
   // Real-time pacing: simulated time may not run ahead of wall time (anchored again after a pause).
   Clock::time_point anchorWall = Clock::now();
