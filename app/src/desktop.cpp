@@ -21,7 +21,7 @@
 
 #include "desktop_impl.h"
 #include "gl_window.h"
-#include "sphxr/app/cli.h"
+#include "sphxr/app/run_start.h"
 #include "sphxr/app/display.h"
 #include "sphxr/app/param_registry.h"
 #include "sim_worker.h"

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "sphxr/app/cli.h"
+#include "sphxr/app/run_start.h"
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/display.h"
 #include "sphxr/app/headless.h"

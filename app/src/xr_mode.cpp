@@ -25,7 +25,7 @@
 #include "gl_window.h"
 #include "interrupt_scope.h"
 #include "sim_worker.h"
-#include "sphxr/app/cli.h"
+#include "sphxr/app/run_start.h"
 #include "sphxr/app/display.h"
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"

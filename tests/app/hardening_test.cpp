@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "sphxr/app/cli.h"
+#include "sphxr/app/run_start.h"
 #include "sphxr/app/headless.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/state_file.h"
