@@ -1,6 +1,5 @@
 #include "sphxr/app/cli.h"
 
-#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -403,44 +402,20 @@ std::string UsageText() {
          "                    docs/user/scenes.md holds it)\n";
 }
 
-namespace {
-
-// A refusal from an option's callback: stops CLI11's parse at the option that failed.
-struct Refusal {
-  Status status;
-};
-
-}  // namespace
-
 Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
   *out = Options{};
   std::vector<std::string> seen;  // "GROUP FLAG" of each option given (CheckGivenOnce)
-  CLI::App app;
-  app.set_help_flag();  // --help and -h are ours (the table's)
-  app.allow_extras();   // an unknown argument is refused with our message
-  for (const OptionSpec& spec : kOptions) {
-    const std::string flag = spec.flag;
-    auto run = [&seen, out, &spec, flag](const char* v) {
-      if (Status s = CheckGivenOnce(flag, &spec, &seen); !s) throw Refusal{s};
-      if (Status s = spec.apply(flag, v, out); !s) throw Refusal{s};
-    };
-    if (spec.takesValue) {
-      app.add_option(flag, [run](const CLI::results_t& r) { return run(r.empty() ? "" : r.front().c_str()), true; })
-          ->trigger_on_parse()
-          ->expected(1)
-          ->allow_extra_args(false);
-    } else {
-      app.add_flag_callback(flag, [run]() { run(nullptr); })->trigger_on_parse()->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const OptionSpec* spec = FindOption(arg);
+    if (Status s = CheckGivenOnce(arg, spec, &seen); !s) return s;
+    if (!spec) return Status::Error("unknown argument '" + ShowText(arg) + "' (see --help)");
+    const char* v = nullptr;
+    if (spec->takesValue) {
+      if (Status s = TakeValue(arg, argc, argv, &i, &v); !s) return s;
     }
+    if (Status s = spec->apply(arg, v, out); !s) return s;
   }
-  try {
-    app.parse(argc, argv);
-  } catch (const Refusal& r) {
-    return r.status;
-  } catch (const CLI::ParseError& e) {
-    return Status::Error(e.what());
-  }
-  for (const std::string& extra : app.remaining()) return Status::Error("unknown argument '" + ShowText(extra) + "' (see --help)");
   if (Status s = CheckExclusions(*out); !s) return s;
   if (Status s = CheckOptionsTakeEffect(*out, seen); !s) return s;
 
