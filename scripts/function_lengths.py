@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Lengths of the functions and rooms (a .cpp with its .h) in C++ sources, found by matching braces.
 
-    scripts/function_lengths.py [--over N] [--rooms] [folders...]
+    scripts/function_lengths.py [--over N] [--rooms] [folders or files...]
 
 Prints one line per function of more than N lines (default 80), longest first:
 `lines  file:line  name`. A function is counted from the first line of its signature to its closing
@@ -160,7 +160,8 @@ def main():
     args = parser.parse_args()
     rows, rooms = [], {}
     for folder in args.folders:
-        for root, _, files in os.walk(folder):
+        walk = [(os.path.dirname(folder), [], [os.path.basename(folder)])] if os.path.isfile(folder) else os.walk(folder)
+        for root, _, files in walk:
             for f in sorted(files):
                 if not f.endswith(SUFFIXES):
                     continue
