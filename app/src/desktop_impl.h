@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "gl_window.h"
+#include "interop_surface.h"
 #include "sim_worker.h"
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/pictures.h"
