@@ -68,6 +68,10 @@ class Reader {
   Status Probe(const json& root);
   // "paddles": {"frame_rate": 90, "list": [{name, hand, shapes, trajectory, loop, viscosity, limits, haptics}]}
   Status Paddles(const json& j);
+  Status Paddle(const json& p, const std::string& key, size_t index, interaction::PaddleDesc* d);  // one of the list
+  Status PaddleShapes(const json& p, const std::string& key, interaction::PaddleDesc* d) const;
+  Status PaddleLimits(const json& l, const std::string& key, interaction::PaddleLimits* limits);  // "limits"
+  Status PaddleTrajectory(const json& p, const std::string& key, interaction::PaddleDesc* d);
   Status Positive(const json& obj, const std::string& prefix, const char* name, float* out) const;
   Status Shape(const json& j, const std::string& key, sim::ShapePrimitive* out) const;
 
