@@ -8,8 +8,8 @@
 # default (--threads 0: the team measured step by step, sim/src/cpu/team.h, docs/design/contention.md).
 #   wait=default   the OpenMP runtime's own (libgomp: a spin of 300,000 rounds before sleeping)
 #   wait=passive   OMP_WAIT_POLICY=passive (sleep at once at every barrier), for comparison
-# The targets (issue 47): beside one busy process, the threads=auto step <= 1.3x the 1-thread step alone;
-# alone, the threads=auto step within 5 % of the fixed N-thread step (what sphxr did before).
+# The targets: beside one busy process, the threads=auto step <= 1.3x the 1-thread step alone;
+# alone, the threads=auto step within 5 % of the fixed N-thread step.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 time_s=0.1 rounds=3 csv=bench/results/contention.csv

@@ -38,10 +38,13 @@ done
 # The unit tier when tests/CMakeLists.txt labels it, else everything but the validation, GPU and
 # integration tiers (and render and xr, not built here); either way without the tests that take over
 # 8 s under the sanitizers (a few tests that are most of the tier's time there; each runs in the normal
-# test command).
+# test command), and the conformance suite's cases that take over 0.5 s without them (every row of
+# each: the name matches all of its instances).
 slow=(BodyMotion.FollowsTheSegmentWithTheRigidVelocity ConservationTest.MomentumOfCollidingBlocksInAClosedBox
-      DeterminismTest.DensityBlocksFittedToTheParticlesGiveThePairsBits DeterminismTest.OneAndTwoThreadsGiveIdenticalResults
-      DeterminismTest.OneAndTwoThreadsGiveIdenticalResultsWithReuse Energy.MirroredWallsDoNotConserveIt
+      Wcsph.DensityBlocksFittedToTheParticlesGiveThePairsBits Solvers/Conformance.TheSameBitsAtEveryThreadCount
+      Wcsph.OneAndTwoThreadsGiveIdenticalResultsWithReuse Energy.MirroredWallsDoNotConserveIt
+      Solvers/Conformance.TheWallsHoldTheWaterWithoutTheClamp Solvers/Conformance.APaddlePushesTheWaterAheadAndFeelsItResist
+      Solvers/Conformance.StillWaterRestsUnderHydrostaticPressure
       Energy.ViscosityOnlyTakesEnergyOut Energy.WallDensityWithoutViscosityConservesItToTheIntegratorsError
       ExtremesTest.BlockTouchingTheWalls HeadlessTest.AStirredRunContinuedFromItsStateFileEndsWhereTheWholeRunEnds
       PaddleFluid.FiveMetresPerSecondSwingLeavesNoParticleInside PaddleFluid.HeldStillInWaterFeelsArchimedesBuoyancy

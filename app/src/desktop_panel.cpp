@@ -161,14 +161,14 @@ void DesktopApp::Impl::PanelSolver(const SimSnapshot& snap) {
       }
       if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s\n%s", row.summary, row.paper);
     }
-    // The method's own statistics of the last step (its row's stats, as in the stats CSV).
+    // The method's own statistics of the last step (its row's columns, as in the stats CSV).
     const sim::SolverInfo& method = sim::SolverInfoOf(setup.method);
-    if (!method.stats.empty()) {
+    if (!method.columns.empty()) {
       std::string line = "last step:";
-      for (sim::SolverStat stat : method.stats) {
-        const double value = sim::SolverStatValue(snap.last, stat);
-        const bool error = stat == sim::SolverStat::kDensityError || stat == sim::SolverStat::kDivergenceError;
-        line += Format(" %s %.3g%s", sim::SolverStatName(stat), error ? 100.0 * value : value, error ? " %" : "");
+      for (const sim::SolveColumn& column : method.columns) {
+        const double value = column.Value(snap.last.solve);
+        const bool fraction = column.fraction != nullptr;
+        line += Format(" %s %.3g%s", column.name, fraction ? 100.0 * value : value, fraction ? " %" : "");
       }
       ImGui::TextUnformatted(line.c_str());
     }

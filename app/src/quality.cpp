@@ -40,13 +40,6 @@ float SpacingForRealtime(float spacing, double realtime, double target, float mi
   return static_cast<float>(std::clamp(h, static_cast<double>(minSpacing), static_cast<double>(maxSpacing)));
 }
 
-float PbfSubstepsForSpacing(float sceneSubsteps, float sceneSpacing, float spacing) {
-  if (!(spacing > 0.0f) || !(sceneSpacing > 0.0f)) return sceneSubsteps;
-  // The 1e-3 keeps a ratio that rounding put a hair above a whole number (3 x 0.01 / 0.015) on it.
-  const double s = std::ceil(static_cast<double>(sceneSubsteps) * sceneSpacing / spacing - 1e-3);
-  return static_cast<float>(std::clamp(s, 1.0, 16.0));
-}
-
 Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& config, double target, double budgetSeconds,
                      QualityChoice* out) {
   *out = QualityChoice{};
@@ -77,10 +70,11 @@ Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& conf
     }
   }
   out->method = trial.method;
-  const bool pbf = trial.method == sim::SolverMethod::kPbf;
-  const float s0 = scene.params.pbfSubsteps;
+  // The method's own parameters that follow the spacing (its row; nullptr: none).
+  const auto forSpacing = sim::SolverInfoOf(trial.method).paramsForSpacing;
+  std::string ownParams;
   trial.params.spacing = SpacingForRealtime(h0, r0, aim, minH, maxH);
-  if (pbf) trial.params.pbfSubsteps = PbfSubstepsForSpacing(s0, h0, trial.params.spacing);
+  if (forSpacing) ownParams = forSpacing(scene.params, trial.params.spacing, &trial.params);
   double r1 = r0;
   int n1 = n0;
   if (trial.params.spacing != h0) {
@@ -88,9 +82,9 @@ Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& conf
     // One correction from the second measurement (the h^4 model is rough at small particle counts).
     const float h2 = SpacingForRealtime(trial.params.spacing, r1, aim, minH, maxH);
     if (r1 < target && h2 > trial.params.spacing) trial.params.spacing = h2;
-    if (pbf) trial.params.pbfSubsteps = PbfSubstepsForSpacing(s0, h0, trial.params.spacing);
+    if (forSpacing) ownParams = forSpacing(scene.params, trial.params.spacing, &trial.params);
   }
-  out->pbfSubsteps = pbf ? trial.params.pbfSubsteps : 0.0f;
+  out->params = trial.params;
   out->spacing = trial.params.spacing;
   out->surfaceCellSize = trial.params.spacing;
   out->realtime = r1;
@@ -99,7 +93,7 @@ Status ChooseQuality(const sim::SceneSetup& scene, const sim::SolverConfig& conf
                         "measured %.3g simulated s per wall s at the scene's spacing (%d particles), %.3g at %.4g m",
                         sim::SolverMethodName(out->method), out->spacing, h0, out->fluid, out->surfaceCellSize, r0, n0,
                         r1, trial.params.spacing);
-  if (pbf) out->summary += Format(" (pbf_substeps %g, the scene's %g at %.4g m)", out->pbfSubsteps, s0, h0);
+  if (!ownParams.empty()) out->summary += " (" + ownParams + Format(" at %.4g m)", h0);
   if (r1 < target) {
     out->summary += Format("; real time is out of reach on this machine at %g particles or more: the window shows "
                            "the simulation slower than real time", kMinFluid);

@@ -125,9 +125,8 @@ Status ApplyAutoQuality(const Options& options, bool wanted, const StateFile* st
   }
   QualityChoice choice;
   if (Status s = ChooseQuality(*setup, config, 1.0, 1.0, &choice); !s) return Status::Error(options.scenePath + ": " + s.message());
-  setup->params.spacing = choice.spacing;
+  setup->params = choice.params;  // the chosen spacing and the method's own parameters for it
   setup->method = choice.method;
-  if (choice.pbfSubsteps > 0.0f) setup->params.pbfSubsteps = choice.pbfSubsteps;
   const bool diffuseSet = std::any_of(options.sets.begin(), options.sets.end(),
                                       [](const std::string& kv) { return kv.rfind("diffuse=", 0) == 0; });
   if (TurnOffDiffuseOutOfRealTime(choice.realtime, diffuseSet, &setup->params)) {

@@ -52,11 +52,11 @@ Status StatsSink::Open() {
 
 Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBreakProbe>& probe) {
   m_probe = probe;
-  m_stats = sim::SolverInfoOf(simulation.Solver().Method()).stats;
+  m_stats = sim::SolverInfoOf(simulation.Solver().Method()).columns;
   const interaction::PaddleSystem* paddles = simulation.Paddles();
   std::string header = "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction";
   if (m_probe) header += ",front_Z,height_H";
-  for (sim::SolverStat stat : m_stats) header += std::string(",") + sim::SolverStatName(stat);
+  for (const sim::SolveColumn& column : m_stats) header += std::string(",") + column.name;
   if (paddles) {
     header += ",pushed_out";
     for (int k = 0; k < paddles->Count(); ++k) header += Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
@@ -114,7 +114,7 @@ Status StatsSink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
     const DamBreakMeasure m = MeasureDamBreak(*m_probe, m_host, simulation.Setup().params.spacing);
     row << ',' << m.front << ',' << m.height;
   }
-  for (sim::SolverStat stat : m_stats) row << ',' << sim::SolverStatValue(info, stat);
+  for (const sim::SolveColumn& column : m_stats) row << ',' << column.Value(info.solve);
   if (const interaction::PaddleSystem* paddles = simulation.Paddles()) {
     row << ',' << info.pushedOut;
     for (int k = 0; k < paddles->Count(); ++k) {

@@ -39,7 +39,7 @@ class StatsSink : public SimulationSink {
   std::ofstream m_out;
   int64_t m_whole = -1;  // bytes of the file known to end at a whole row; -1: not a regular file
   std::optional<DamBreakProbe> m_probe;
-  std::span<const sim::SolverStat> m_stats;  // the method's own columns (its solver-table row)
+  std::span<const sim::SolveColumn> m_stats;  // the method's own columns (its solver-table row)
   std::string m_pending;
   std::chrono::steady_clock::time_point m_last = std::chrono::steady_clock::now();
   sim::HostFluid m_host;

@@ -183,7 +183,7 @@ void BindRunTables(py::class_<Run>& run) {
              std::vector<double> time(n), dt(n), speed(n), mean(n), max(n), active(n), iterations(n);
              for (py::ssize_t i = 0; i < n; ++i) {
                time[i] = h[i].time, dt[i] = h[i].dt, speed[i] = h[i].maxSpeed, mean[i] = h[i].meanDensityError;
-               max[i] = h[i].maxDensityError, active[i] = h[i].activeFraction, iterations[i] = h[i].densityIterations;
+               max[i] = h[i].maxDensityError, active[i] = h[i].activeFraction, iterations[i] = h[i].solve.densityIterations;
              }
              py::dict d;
              d["time"] = Array(time, {n});

@@ -36,7 +36,7 @@ class Run::Recorder : public app::SimulationSink {
     r.meanDensityError = info.meanDensityError;
     r.maxDensityError = info.maxDensityError;
     r.activeFraction = info.activeFraction;
-    r.densityIterations = info.densityIterations;
+    r.solve = info.solve;
     steps.push_back(r);
     if (m_damBreak) Measure(simulation);
     return Status::Ok();

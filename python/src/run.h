@@ -40,7 +40,7 @@ struct RunOptions {
 struct StepRecord {
   double time = 0.0;
   float dt = 0.0f, maxSpeed = 0.0f, meanDensityError = 0.0f, maxDensityError = 0.0f, activeFraction = 1.0f;
-  int32_t densityIterations = 0;
+  sim::SolveReport solve;  // the pressure solver's own (sphxr/sim/solve_report.h)
 };
 
 /// The fluid's fields in particle-id order (the solver keeps them in grid order, which changes).

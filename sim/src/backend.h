@@ -22,20 +22,23 @@ struct GridShape {
   int64_t Cells() const { return static_cast<int64_t>(nx) * ny * nz; }
 };
 
-/// Called after each stage of a step (validate mode); a non-ok status stops the step.
-using StageHook = std::function<Status(Stage)>;
+// StageHook (sphxr/sim/solver.h): called after each stage of a step (validate mode); a non-ok status
+// stops the step.
 
 class Backend {
  public:
   virtual ~Backend() = default;
   virtual const char* Name() const = 0;
   /// Uploads particles, sorts the boundary once and computes its volumes (Akinci et al. 2012), and
-  /// makes the `method`'s pressure solver (solvers/factory.h).
-  virtual Status Init(const GridShape& grid, const Physics& physics, SolverMethod method, const HostFluid& fluid,
+  /// makes the scene's pressure solver (solvers/factory.h) with its constants (PressureSolver::Init).
+  virtual Status Init(const GridShape& grid, const SceneSetup& scene, const Physics& physics, const HostFluid& fluid,
                       const HostBoundary& boundary) = 0;
-  /// One step of size dt. Adds each stage's wall time to stageSeconds.
-  virtual Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
-                      const StageHook& hook) = 0;
+  /// The pressure solver's constants again, for a scene changed at run time (Solver::SetReuse).
+  virtual void InitSolver(const SceneSetup& scene, const Physics& physics) = 0;
+  /// One step of size dt: the reduction over the fluid into `out`, the solver's report into `report`.
+  /// Adds each stage's wall time to stageSeconds.
+  virtual Status Step(float dt, const Physics& physics, StepReduction* out, SolveReport* report,
+                      double* stageSeconds, const StageHook& hook) = 0;
   /// Runs only stages 1-3 (cells, sort, grid) and copies the cell ranges out (tests).
   virtual void RebuildGrid(std::vector<uint32_t>* fluidStart, std::vector<uint32_t>* fluidEnd) = 0;
   virtual void Download(HostFluid* out) const = 0;
@@ -84,8 +87,9 @@ class Backend {
   virtual void UsePairDensityBlocks() {}
 };
 
-/// The constants of a step for `scene` (solver.cpp); Solver::Step sets the step's own (its number, the
-/// impulse hold's schedule). Tests that drive a backend directly take theirs from here.
+/// The constants every stage shares, for `scene` (physics.cpp): Solver::Create makes them once, and
+/// Solver::Step sets a step's own (its number, the impulse hold's schedule) on a copy. Tests that drive a
+/// backend directly take theirs from here.
 Physics MakePhysics(const SceneSetup& scene);
 
 std::unique_ptr<Backend> MakeCpuBackend(int threads);

@@ -31,7 +31,7 @@ class CpuBackend final : public BackendImpl<OmpTraits> {
  public:
   explicit CpuBackend(int threads) : m_team(threads > 0 ? threads : omp_get_num_procs(), threads <= 0) {}
 
-  Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
+  Status Step(float dt, const Physics& physics, StepReduction* out, SolveReport* report, double* stageSeconds,
               const StageHook& hook) override {
     const int team = m_team.Threads();
     if (team != m_lastTeam) {
@@ -40,7 +40,7 @@ class CpuBackend final : public BackendImpl<OmpTraits> {
     }
     omp_set_num_threads(team);  // (the calling thread's setting: the step's thread may be a worker's)
     const auto start = std::chrono::steady_clock::now();
-    Status s = BackendImpl<OmpTraits>::Step(dt, physics, out, stageSeconds, hook);
+    Status s = BackendImpl<OmpTraits>::Step(dt, physics, out, report, stageSeconds, hook);
     m_team.Record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     return s;
   }

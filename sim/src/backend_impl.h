@@ -5,7 +5,7 @@
 //
 //   grid (cells, sort, ranges) -> bodies (place) -> solver.Step(context) -> reduction -> post-step stages
 //
-// The solver is one file in solvers/ (the method's row of the solver table); the stages it calls are
+// The solver is one folder in solvers/ (the method's row of the solver table); the stages it calls are
 // StepContext's (solvers/step_context.h). Sorting, fills, gathers and reductions come from thrust
 // (CCCL); nothing of that kind is hand-written. Include this from exactly one translation unit per system.
 #include <thrust/copy.h>
@@ -37,11 +37,12 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
  public:
   const char* Name() const override { return Traits::kName; }
 
-  Status Init(const GridShape& grid, const Physics& physics, SolverMethod method, const HostFluid& fluid,
+  Status Init(const GridShape& grid, const SceneSetup& scene, const Physics& physics, const HostFluid& fluid,
               const HostBoundary& boundary) override {
     return GuardBackend(Traits::kName, "setting up the particles", [&] {
       m_shape = grid;
-      m_solver = MakePressureSolver<Traits>(method);
+      m_solver = MakePressureSolver<Traits>(scene.method);
+      m_solver->Init(scene, physics);
       m_fluid.SizeCells(static_cast<size_t>(grid.Cells()));
       m_fluid.Upload(fluid);
       if (Status s = m_walls.Init(boundary, physics, static_cast<size_t>(grid.Cells()), [this] { return View(); }); !s) {
@@ -52,11 +53,14 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     });
   }
 
-  Status Step(float dt, const Physics& physics, StepReduction* out, double* stageSeconds,
+  void InitSolver(const SceneSetup& scene, const Physics& physics) override { m_solver->Init(scene, physics); }
+
+  Status Step(float dt, const Physics& physics, StepReduction* out, SolveReport* report, double* stageSeconds,
               const StageHook& hook) override {
     m_lastStage = nullptr;
-    return GuardBackend(Traits::kName, "the step", [&] { return StepStages(dt, physics, out, stageSeconds, hook); },
-                        &m_lastStage);
+    return GuardBackend(
+        Traits::kName, "the step", [&] { return StepStages(dt, physics, out, report, stageSeconds, hook); },
+        &m_lastStage);
   }
 
   void RebuildGrid(std::vector<uint32_t>* fluidStart, std::vector<uint32_t>* fluidEnd) override {
@@ -115,7 +119,8 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   }
 
  private:
-  Status StepStages(float dt, const Physics& physics, StepReduction* out, double* stageSeconds, const StageHook& hook) {
+  Status StepStages(float dt, const Physics& physics, StepReduction* out, SolveReport* report, double* stageSeconds,
+                    const StageHook& hook) {
     auto clock = std::chrono::steady_clock::now();
     auto lap = [&](Stage stage) -> Status {
       if (Status s = Traits::Sync(StageName(stage)); !s) return s;
@@ -149,10 +154,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     *out = thrust::transform_reduce(Traits::Policy(), first, first + ctx.n, StepReductionOp{ctx.fluid, physics},
                                     StepReduction{}, StepReductionCombine{});
     out->computed = ctx.computing;
-    out->densityIterations = ctx.report.densityIterations;
-    out->divergenceIterations = ctx.report.divergenceIterations;
-    out->densityError = ctx.report.densityError;
-    out->divergenceError = ctx.report.divergenceError;
+    *report = ctx.report;
     SPHXR_TRY(lap(Stage::kIntegrate));
     // 5. the post-step stages, on the state the step ends in (they read the fluid, never write it)
     return PostSteps(dt, physics, lap);

@@ -17,6 +17,42 @@ void Solver::HoldBody(BodyMotion* b, const Pose& pose, double time) {
   b->velocity = b->angular = Vec3{};
 }
 
+std::vector<BodyState> Solver::StartBodyMotion(float dt) {
+  std::vector<BodyState> states;
+  if (m_bodies.empty()) return states;
+  // Each body moves from its pose now to its interpolated pose at the end of the step; its particles
+  // carry the rigid velocity that takes them there.
+  const double end = m_last.time + dt;
+  size_t firstShape = 0;
+  for (BodyMotion& b : m_bodies) {
+    const Pose to = BodyPoseAt(b, end);
+    BodyState st{};
+    st.position = b.pose.position;
+    st.orientation = b.pose.orientation;
+    st.velocity = (to.position - b.pose.position) * (1.0f / dt);
+    st.angular = RotationVector(Mul(to.orientation, Conjugate(b.pose.orientation))) * (1.0f / dt);
+    st.endPosition = to.position;
+    st.endOrientation = to.orientation;
+    st.boundRadius = b.boundRadius;
+    st.firstShape = static_cast<int>(firstShape);
+    st.shapeCount = static_cast<int>(b.shapes.size());
+    firstShape += b.shapes.size();
+    states.push_back(st);
+  }
+  m_backend->SetBodyStates(states);
+  return states;
+}
+
+void Solver::EndBodyMotion(const std::vector<BodyState>& states) {
+  if (m_bodies.empty()) return;
+  m_backend->BodyLoads(&m_bodyLoads);
+  for (size_t k = 0; k < m_bodies.size(); ++k) {
+    m_bodies[k].pose = Pose{states[k].endPosition, states[k].endOrientation};
+    m_bodies[k].velocity = states[k].velocity;
+    m_bodies[k].angular = states[k].angular;
+  }
+}
+
 void Solver::InitBodies(const Physics& physics) {
   // Boundary particles of every body with Akinci et al.'s (2012, eq. 4) volume V_b = 1 / sum_k W_bk over
   // the body's own particles (a rigid body's sampling never changes, so once), Psi_b = gamma rho0 V_b

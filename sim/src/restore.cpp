@@ -117,6 +117,7 @@ Status Solver::RestoreDiffuse(const HostDiffuse& diffuse) {
 Status Solver::SetReuse(const ReuseParams& reuse) {
   if (Status s = ValidateReuse(reuse); !s) return s;
   m_scene.reuse = reuse;
+  SceneChanged();
   WarnAboutReuse(reuse);
   HostFluid fluid;
   m_backend->Download(&fluid);

@@ -66,7 +66,7 @@ void SampleShell(const Aabb& box, float dx, int layers, bool outward, bool openT
 }
 
 // The number of points SampleShell emits, without visiting them (a scene is counted, and may be
-// refused, before anything is allocated: walking a fine lattice took 25 s for a 1 m tank at 0.5 mm).
+// refused, before anything is allocated: walking a fine lattice takes tens of seconds).
 int64_t ShellCount(const Aabb& box, float dx, int layers, bool outward, bool openTop) {
   const float ext[3] = {box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z};
   int64_t n[3];
@@ -110,7 +110,7 @@ int LogCutBlocks(const SceneSetup& scene) {
                      b, filled[0], filled[1], filled[2], asked[0], asked[1], asked[2], dx);
     }
   }
-  // One line for the scene, however many blocks (97,336 blocks printed a line each).
+  // One line for the scene, however many blocks (a scene may hold tens of thousands).
   if (cut == 1) SPHXR_LOG_INFO("%s", first.c_str());
   if (cut > 1) SPHXR_LOG_INFO("%s; and %d more blocks of the %zu are cut to whole layers", first.c_str(), cut - 1, scene.fluid.size());
   return cut;

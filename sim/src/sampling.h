@@ -39,7 +39,7 @@ float WallDensityCorrection(const CubicSpline& kernel, float dx, int layers);
 /// 4.7 % above it at 2.5 dx, where using the density factor let particles sink into the walls.
 float WallGradientCorrection(const CubicSpline& kernel, float dx, int layers);
 
-/// PBF's constraint-force mixing scale (solvers/pbf.h): sum_j |grad_j C_i|^2 = sum_j (V |grad W_ij|)^2
+/// PBF's constraint-force mixing scale (solvers/pbf/pbf.h): sum_j |grad_j C_i|^2 = sum_j (V |grad W_ij|)^2
 /// for a particle inside the rest lattice, in 1/m^2; the scene's pbf_relaxation is a fraction of it.
 float PbfRestGradientSum(const CubicSpline& kernel, float dx, float volume);
 

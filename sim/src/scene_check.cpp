@@ -81,7 +81,7 @@ Status ValidateBodies(const SceneSetup& scene) {
 // first) of blocks overlapping by more than half a spacing on every axis. Each block, shrunk by a
 // quarter spacing on every side, goes into the cells of a uniform grid of about one cell per block that
 // it touches; only blocks sharing a cell are compared. Interior-disjoint blocks touch a few cells each,
-// so the check is linear in the count (the pairwise loop took 34 s for 97,336 blocks). A grid that would
+// so the check is linear in the count (a pairwise loop is quadratic in it). A grid that would
 // take more than kBudget entries (blocks spanning many cells) is made coarser.
 Status CheckBlocksApart(const SceneSetup& scene) {
   const size_t n = scene.fluid.size();
@@ -157,27 +157,9 @@ Status CheckBlocksApart(const SceneSetup& scene) {
                               bestI, Str(a.min).c_str(), Str(a.max).c_str(), bestJ, Str(b.min).c_str(), Str(b.max).c_str()));
 }
 
-}  // namespace
-
-Status ValidateReuse(const ReuseParams& r) {
-  for (const ReuseParamInfo& p : ReuseParamInfos()) {
-    if (p.count) {
-      const int v = r.*p.count;
-      if (v < p.min || v > p.max) {
-        return Status::Error(Format("reuse.%s = %d is invalid: must be %g to %g %s", p.key, v, p.min, p.max, p.unit));
-      }
-      continue;
-    }
-    const float v = r.*p.real;
-    // Compared as floats, as the solver parameters are (ValidateScene).
-    if (!std::isfinite(v) || v < static_cast<float>(p.min) || v > static_cast<float>(p.max)) {
-      return Status::Error(Format("reuse.%s = %g is invalid: must be a number from %g to %g", p.key, v, p.min, p.max));
-    }
-  }
-  return Status::Ok();
-}
-
-Status ValidateScene(const SceneSetup& scene) {
+/// The solver's parameters (each within its registry range, whole where it must be), reuse's, and the
+/// ones that must be ordered.
+Status ValidateParams(const SceneSetup& scene) {
   for (const ParamInfo& p : SolverParamInfos()) {
     const float v = scene.params.*p.member;
     // Compared as floats: the value is stored as one, so the limit typed exactly (cfl 0.01) must pass.
@@ -218,19 +200,60 @@ Status ValidateScene(const SceneSetup& scene) {
                                   p.diffuseSprayBelow, p.diffuseBubbleAbove + 1.0f));
     }
   }
+  return Status::Ok();
+}
+
+Status ValidateGravity(const SceneSetup& scene) {
   if (!Finite(scene.gravity)) return Status::Error("gravity must be three finite numbers");
-  {
-    const double gx = scene.gravity.x, gy = scene.gravity.y, gz = scene.gravity.z;
-    const double g = std::sqrt(gx * gx + gy * gy + gz * gz);  // in double: a float Length overflows at 2e19
-    if (g > kMaxGravity) {
-      return Status::Error(Format("gravity = %s has magnitude %g m/s^2: at most %g (%.0f g) is supported",
-                                  Str(scene.gravity).c_str(), g, kMaxGravity, kMaxGravity / 9.81));
-    }
+  const double gx = scene.gravity.x, gy = scene.gravity.y, gz = scene.gravity.z;
+  const double g = std::sqrt(gx * gx + gy * gy + gz * gz);  // in double: a float Length overflows at 2e19
+  if (g > kMaxGravity) {
+    return Status::Error(Format("gravity = %s has magnitude %g m/s^2: at most %g (%.0f g) is supported",
+                                Str(scene.gravity).c_str(), g, kMaxGravity, kMaxGravity / 9.81));
   }
+  return Status::Ok();
+}
+
+Status ValidateTank(const SceneSetup& scene) {
   if (scene.boundaryLayers < 1 || scene.boundaryLayers > 4) {
     return Status::Error(Format("tank.boundary_layers = %d is invalid: must be 1 to 4", scene.boundaryLayers));
   }
-  if (Status s = ValidateBox(scene.tank, "tank"); !s) return s;
+  return ValidateBox(scene.tank, "tank");
+}
+
+/// A block's start speed: within what is supported, below the sound speed of an acoustic method, and
+/// not above the speed a method caps every particle to (its row's speedCapParam).
+Status ValidateBlockSpeed(const SceneSetup& scene, size_t i, const SolverInfo& method, float soundSpeed) {
+  const std::string key = Format("fluid[%zu]", i);
+  // (Far past any water: refused here with the key named, before the first step's CFL limit would
+  // collapse with a message about instability.)
+  const Vec3 v = scene.fluid[i].velocity;
+  const double speed = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+  if (speed > kMaxFluidSpeed) {
+    return Status::Error(Format("%s.velocity = %s has speed %g m/s: at most %g m/s is supported", key.c_str(),
+                                Str(v).c_str(), speed, kMaxFluidSpeed));
+  }
+  // A weakly compressible fluid faster than its own sound speed is not water: its step resolves the
+  // pressure waves, and the block outruns them (the speeds and compression explode within steps). The
+  // methods that solve for the density are not bound by it (the row's `acoustic`, solver_table.h).
+  if (method.acoustic && speed > soundSpeed) {
+    return Status::Error(Format("%s.velocity: %g m/s is %.3gx the sound speed %.3g m/s of solver.method %s, whose "
+                                "step cannot resolve it: lower the speed below %.3g m/s (0.1x for 1 %% density "
+                                "error) or raise solver.stiffness",
+                                key.c_str(), speed, speed / soundSpeed, soundSpeed, method.name, soundSpeed));
+  }
+  // A method that caps every speed would start the block slower than the scene says, silently.
+  if (const ParamInfo* cap = method.speedCapParam ? FindSolverParam(method.speedCapParam) : nullptr;
+      cap && speed > scene.params.*cap->member) {
+    return Status::Error(Format("%s.velocity: %g m/s is above the %g m/s that solver.method %s holds every particle "
+                                "to: lower the speed or raise solver.%s",
+                                key.c_str(), speed, scene.params.*cap->member, method.name, cap->key));
+  }
+  return Status::Ok();
+}
+
+/// The fluid blocks: how many, each box, its velocity and its place in the tank; no two overlapping.
+Status ValidateFluidBlocks(const SceneSetup& scene) {
   const float slack = 1e-5f * scene.params.spacing;
   if (scene.fluid.size() > static_cast<size_t>(kMaxFluidBlocks)) {
     return Status::Error(Format("fluid: %zu blocks, at most %d: merge blocks that touch", scene.fluid.size(),
@@ -242,32 +265,7 @@ Status ValidateScene(const SceneSetup& scene) {
     const std::string key = Format("fluid[%zu]", i);
     if (Status s = ValidateBox(scene.fluid[i].box, key); !s) return s;
     if (!Finite(scene.fluid[i].velocity)) return Status::Error(key + ".velocity must be three finite numbers");
-    {
-      // (Far past any water: at 1e30 m/s the first step's CFL limit collapsed with a message about
-      // instability, not about the key.)
-      const Vec3 v = scene.fluid[i].velocity;
-      const double speed = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
-      if (speed > kMaxFluidSpeed) {
-        return Status::Error(Format("%s.velocity = %s has speed %g m/s: at most %g m/s is supported", key.c_str(),
-                                    Str(v).c_str(), speed, kMaxFluidSpeed));
-      }
-      // A weakly compressible fluid faster than its own sound speed is not water: its step resolves the
-      // pressure waves, and the block outran them (1,000 m/s, 67x: 203,387 m/s and 906 % compression in
-      // three steps). DFSPH and PBF solve for the density and are not bound by it (solver_table.h).
-      if (method.acoustic && speed > soundSpeed) {
-        return Status::Error(Format("%s.velocity: %g m/s is %.3gx the sound speed %.3g m/s of solver.method %s, whose "
-                                    "step cannot resolve it: lower the speed below %.3g m/s (0.1x for 1 %% density "
-                                    "error) or raise solver.stiffness",
-                                    key.c_str(), speed, speed / soundSpeed, soundSpeed, method.name, soundSpeed));
-      }
-      // A method that caps every speed would start the block slower than the scene says, silently.
-      if (const ParamInfo* cap = method.speedCapParam ? FindSolverParam(method.speedCapParam) : nullptr;
-          cap && speed > scene.params.*cap->member) {
-        return Status::Error(Format("%s.velocity: %g m/s is above the %g m/s that solver.method %s holds every particle "
-                                    "to: lower the speed or raise solver.%s",
-                                    key.c_str(), speed, scene.params.*cap->member, method.name, cap->key));
-      }
-    }
+    if (Status s = ValidateBlockSpeed(scene, i, method, soundSpeed); !s) return s;
     if (!Contains(scene.tank, scene.fluid[i].box, slack)) {
       return Status::Error(key + ": the block " + Str(scene.fluid[i].box.min) + " to " + Str(scene.fluid[i].box.max) +
                            " is not inside the tank " + Str(scene.tank.min) + " to " + Str(scene.tank.max));
@@ -277,6 +275,11 @@ Status ValidateScene(const SceneSetup& scene) {
   // exactly: such twins have no force between them and never separate) or closer than the spacing.
   // Blocks may touch; less than half a spacing of overlap is rounding.
   if (Status s = CheckBlocksApart(scene); !s) return s;
+  return Status::Ok();
+}
+
+Status ValidateObstacles(const SceneSetup& scene) {
+  const float slack = 1e-5f * scene.params.spacing;
   if (scene.obstacles.size() > static_cast<size_t>(kMaxObstacles)) {
     return Status::Error(Format("obstacles: %zu boxes given, at most %d are supported (each is checked for fluid "
                                 "inside it every step): merge touching boxes",
@@ -290,7 +293,11 @@ Status ValidateScene(const SceneSetup& scene) {
                            Str(scene.tank.max));
     }
   }
-  if (Status s = ValidateBodies(scene); !s) return s;
+  return Status::Ok();
+}
+
+/// Room for the walls' mass at the support factor, and a neighbour grid within the supported size.
+Status ValidateWallsAndGrid(const SceneSetup& scene) {
   const float gamma = WallDensityCorrection(CubicSpline::Make(scene.params.spacing * scene.params.supportFactor),
                                             scene.params.spacing, scene.boundaryLayers);
   if (!(gamma > 0.0f)) {
@@ -307,12 +314,18 @@ Status ValidateScene(const SceneSetup& scene) {
                                   scene.params.spacing, dims[a], "xyz"[a], kMaxGridDim));
     }
   }
+  return Status::Ok();
+}
+
+/// The particles the scene samples and the memory they need, within what is supported and available.
+Status ValidateParticleBudget(const SceneSetup& scene) {
+  const GridShape grid = MakeGridShape(scene);
   // The CPU's SIMD stages gather a particle's Vec4 fields with 32-bit offsets of 4 floats per particle.
   constexpr int64_t kMaxParticles = int64_t{1} << 29;
   if (!scene.obstacles.empty() || !scene.bodies.empty()) {
-    // CountParticles walks the fluid lattice when obstacles or bodies take part of it (1.1e9 sites took
-    // 20 s before a refusal): the lattice without them, a closed form, is checked first. Its memory is
-    // an upper bound, so a scene refused here says "up to".
+    // CountParticles walks the fluid lattice when obstacles or bodies take part of it (slow for a fine
+    // lattice): the lattice without them, a closed form, is checked first. Its memory is an upper
+    // bound, so a scene refused here says "up to".
     SceneSetup open;
     open.params = scene.params;
     open.fluid = scene.fluid;
@@ -350,6 +363,34 @@ Status ValidateScene(const SceneSetup& scene) {
   return Status::Ok();
 }
 
+}  // namespace
+
+Status ValidateReuse(const ReuseParams& r) {
+  for (const ReuseParamInfo& p : ReuseParamInfos()) {
+    if (p.count) {
+      const int v = r.*p.count;
+      if (v < p.min || v > p.max) {
+        return Status::Error(Format("reuse.%s = %d is invalid: must be %g to %g %s", p.key, v, p.min, p.max, p.unit));
+      }
+      continue;
+    }
+    const float v = r.*p.real;
+    // Compared as floats, as the solver parameters are (ValidateScene).
+    if (!std::isfinite(v) || v < static_cast<float>(p.min) || v > static_cast<float>(p.max)) {
+      return Status::Error(Format("reuse.%s = %g is invalid: must be a number from %g to %g", p.key, v, p.min, p.max));
+    }
+  }
+  return Status::Ok();
+}
+
+Status ValidateScene(const SceneSetup& scene) {
+  for (auto check : {ValidateParams, ValidateGravity, ValidateTank, ValidateFluidBlocks, ValidateObstacles,
+                     ValidateBodies, ValidateWallsAndGrid, ValidateParticleBudget}) {
+    if (Status s = check(scene); !s) return s;
+  }
+  return Status::Ok();
+}
+
 // Reuse settings measured unstable are named when they are set (at start-up and by SetReuse).
 void WarnAboutReuse(const ReuseParams& reuse) {
   constexpr int kStableIdle = 3;
@@ -362,11 +403,13 @@ void WarnAboutReuse(const ReuseParams& reuse) {
   }
 }
 
+static void WarnAboutBlocks(const SceneSetup& scene, const SolverInfo& method, float soundSpeed);
+
 // Settings that run but will not give usable water are named at start-up, once.
 void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed) {
   // Fluid is not seeded inside the moving bodies at their start poses: say how much that leaves out (a
-  // paddle larger than the water removed 1,484 of 1,575 particles without a word). `seeded`: the
-  // particles Create made; the count without the bodies is a closed form unless there are obstacles.
+  // paddle larger than the water can leave most of it out). `seeded`: the particles Create made; the
+  // count without the bodies is a closed form unless there are obstacles.
   if (!scene.bodies.empty()) {
     SceneSetup without = scene;
     without.bodies.clear();
@@ -390,23 +433,7 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
                    "errors above 1%% (WCSPH wants 10x); solver.stiffness >= %.3g Pa would give that",
                    soundSpeed, soundSpeed / vRef, vRef, needB);
   }
-  // PBF's steady compression under a column of depth D is about K (1 + eps) g D dt^2 / (N s^2) at
-  // spacing s: each substep's fall g dt^2 is carried up the column by N Jacobi iterations that reach one
-  // support each. K = 0.195 from tank_rest (S^2 N x the mean compression 94-98.5 % over seven settings
-  // at eps = 1; bench/pbf_still_water.py, docs/design/pbf.md).
-  if (scene.method == SolverMethod::kPbf && height > 0.0f) {
-    const SolverParams& p = scene.params;
-    const float dt = p.pbfFrame / p.pbfSubsteps, s = p.spacing;
-    const float compression = 0.195f * (1.0f + p.pbfRelaxation) * g * height * dt * dt / (p.pbfIterations * s * s);
-    if (compression > 0.05f) {
-      const float substeps = std::ceil(p.pbfSubsteps * std::sqrt(compression / 0.02f));
-      const std::string fix = substeps <= 16.0f ? Format("pbf_substeps %g would give about 2 %%", substeps)
-                                                : std::string("more iterations or a coarser spacing would lower it");
-      SPHXR_LOG_WARN("pbf: expect about %.0f%% mean compression at rest under the %.3g m column (%g substeps of %g "
-                     "iterations a %.3g s frame at %.3g m spacing; it falls as 1 / (substeps^2 iterations)): %s",
-                     100.0f * compression, height, p.pbfSubsteps, p.pbfIterations, p.pbfFrame, s, fix.c_str());
-    }
-  }
+  if (method.warnAtStart) method.warnAtStart(scene, height);  // the method's own (its row)
   const bool deltaSph = scene.density == DensityModel::kDeltaSph;
   if (!method.deltaSph && deltaSph) {
     SPHXR_LOG_WARN("solver.density delta_sph is not a model of solver.method %s, which sums the density (the setting "
@@ -424,8 +451,12 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
   } else if (scene.reuse.enabled) {
     SPHXR_LOG_WARN("reuse is a WCSPH scheme and is off under solver.method %s", method.name);
   }
-  // One line for each kind of warning, naming the first block and counting the others (97,336 thin
-  // blocks printed a line each).
+  WarnAboutBlocks(scene, method, soundSpeed);
+}
+
+// One line for each kind of warning about the fluid blocks, naming the first block and counting the
+// others (a scene may hold tens of thousands of blocks).
+static void WarnAboutBlocks(const SceneSetup& scene, const SolverInfo& method, float soundSpeed) {
   size_t thin = 0, fast = 0, firstThin = 0, firstFast = 0;
   float thinnest = 0.0f, fastest = 0.0f;
   for (size_t i = 0; i < scene.fluid.size(); ++i) {
@@ -434,8 +465,7 @@ void WarnAboutSettings(const SceneSetup& scene, int64_t seeded, float soundSpeed
     if (t < 3.0f * scene.params.spacing) {
       if (thin++ == 0) firstThin = i, thinnest = t;
     }
-    // Weak compressibility holds below Mach 0.1 (about 1 % compression); a block started at 1,000 m/s
-    // compressed by 885 % without a word.
+    // Weak compressibility holds below Mach 0.1 (about 1 % compression).
     const float speed = Length(scene.fluid[i].velocity);
     if (method.acoustic && speed > 0.1f * soundSpeed) {
       if (fast++ == 0) firstFast = i, fastest = speed;

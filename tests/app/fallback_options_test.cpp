@@ -1,5 +1,5 @@
 // A headless run that sphxr chose itself (no display) says in one line which window options it cannot
-// honour (an explicit --headless refuses them: hardening_round2_test.cpp).
+// honour (an explicit --headless refuses them: cli_test.cpp).
 #include <gtest/gtest.h>
 
 #include <cstdio>

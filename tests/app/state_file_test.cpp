@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "refusal.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/state_file.h"
 #include "sphxr/interaction/paddle.h"
@@ -21,6 +22,9 @@
 
 namespace sphxr::app {
 namespace {
+
+using test::ExpectBriefRefusal;
+using test::ExpectCleanRefusal;
 
 std::unique_ptr<sim::Solver> SteppedSolver(int steps) {
   auto solver = test::CreateOrFail(test::SmallDamBreak(0.01f));
@@ -209,7 +213,7 @@ TEST(StateFile, RecordsTheSolverMethod) {
   EXPECT_EQ(log.Count("saved under solver.method dfsph", LogLevel::kWarn), 1) << log.All();
 }
 
-// Version 1 (the first session's files) had no step count: it is still read, with the step unknown
+// Version 1 files have no step count: it is still read, with the step unknown
 // (-1: a continued run numbers from 0), and the fluid as saved.
 TEST(StateFile, AVersionOneFileIsReadWithoutItsStepCount) {
   test::TempDir dir("state_v1");
@@ -333,8 +337,8 @@ TEST(StateFile, AnotherSceneOrSpacingIsRefused) {
 }
 
 // The file is renamed into place, which would replace whatever is there: a pipe or device is refused
-// and left alone (--save-state /dev/null, as root, replaced the system's /dev/null), and a symbolic link
-// is followed: the link stays, its target gets the state.
+// and left alone (--save-state /dev/null, as root, must not replace the system's /dev/null), and a
+// symbolic link is followed: the link stays, its target gets the state.
 TEST(StateFile, APipeIsRefusedAndALinkIsFollowed) {
   test::TempDir dir("state_nodes");
   auto solver = SteppedSolver(2);
@@ -357,7 +361,7 @@ TEST(StateFile, APipeIsRefusedAndALinkIsFollowed) {
 }
 
 // Without --save-state the window and the headset save to "<scene name>.state": a scene's name from a
-// shared file must not name a path (it saved "../escape_dir/evil.state").
+// shared file must not name a path ("../escape_dir/evil" would save outside the folder).
 TEST(StateFile, TheDefaultSaveNameStaysInTheWorkingDirectory) {
   EXPECT_EQ(DefaultStatePath("dam_break"), "dam_break.state");
   EXPECT_EQ(DefaultStatePath("deep tank v1.2"), "deep_tank_v1.2.state");
@@ -382,6 +386,117 @@ TEST(StateFile, AFailedWriteLeavesTheEarlierFile) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find(path), std::string::npos) << s.message();
   EXPECT_EQ(Bytes(path), before) << "the earlier state file is unchanged";
+}
+
+// State files are checked as scenes are: finite but absurd values (every particle outside the tank, a
+// body at y = 1e9 m, a particle at 1e9 m/s, two particles with one id) are refused, not restored.
+class StateChecks : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    m_scene = test::SmallDamBreak(0.01f);
+    auto solver = test::CreateOrFail(m_scene);
+    ASSERT_TRUE(solver);
+    ASSERT_TRUE(solver->Step().ok());
+    ASSERT_TRUE(WriteStateFile(m_dir.File("a.state"), *solver, "small").ok());
+    ASSERT_TRUE(ReadStateFile(m_dir.File("a.state"), &m_state).ok());
+  }
+  Status Restore(const StateFile& state) {
+    auto fresh = test::CreateOrFail(m_scene);
+    return fresh ? RestoreState(state, fresh.get()) : Status::Error("no solver");
+  }
+  test::TempDir m_dir{"state_checks"};
+  sim::SceneSetup m_scene;
+  StateFile m_state;
+};
+
+TEST_F(StateChecks, TheSavedStateRestores) { EXPECT_TRUE(Restore(m_state).ok()); }
+
+// A damaged field name is refused in one line, not quoted raw with its newlines (a fuzz target's input).
+TEST_F(StateChecks, ADamagedFieldNameIsRefusedInOneLine) {
+  std::string bytes = test::ReadFile(m_dir.File("a.state"));
+  const size_t at = bytes.find("velocity");
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 3] = '\n';
+  StateFile state;
+  ExpectBriefRefusal(ParseStateFile(std::vector<char>(bytes.begin(), bytes.end()), "a.state", &state), "has no name");
+}
+
+TEST_F(StateChecks, ParticlesOutsideTheTankAreRefused) {
+  StateFile s = m_state;
+  for (sim::Vec4& p : s.fluid.position) p.x += 10.0f;
+  ExpectBriefRefusal(Restore(s), "outside the tank");
+}
+
+TEST_F(StateChecks, ASpeedBeyondTheScenesLimitIsRefused) {
+  StateFile s = m_state;
+  s.fluid.velocity[5].y = 1e9f;
+  ExpectBriefRefusal(Restore(s), "moves at 1e+09 m/s");
+}
+
+TEST_F(StateChecks, DuplicateIdsAreRefused) {
+  StateFile s = m_state;
+  s.fluid.id[3] = s.fluid.id[4];
+  ExpectBriefRefusal(Restore(s), "appears twice");
+}
+
+TEST_F(StateChecks, ABodyFarFromTheTankIsRefused) {
+  // The scene with one paddle, saved, then its pose moved to y = 1e9 m.
+  sim::SceneSetup scene = m_scene;
+  interaction::PaddleDesc d;
+  d.name = "p";
+  d.holder = interaction::Holder::kLeftHand;
+  d.shapes = {sim::ShapePrimitive{sim::ShapePrimitive::Kind::kBox, {0, 0, 0}, {0.01f, 0.03f, 0.01f}, 0.0f}};
+  std::unique_ptr<interaction::PaddleSystem> paddles;
+  ASSERT_TRUE(interaction::PaddleSystem::Create({d}, scene, &paddles).ok());
+  paddles->AddBodies(&scene);
+  auto solver = test::CreateOrFail(scene);
+  ASSERT_TRUE(solver);
+  ASSERT_TRUE(WriteStateFile(m_dir.File("b.state"), *solver, "small").ok());
+  StateFile state;
+  ASSERT_TRUE(ReadStateFile(m_dir.File("b.state"), &state).ok());
+  ASSERT_EQ(state.bodies.size(), 1u);
+  auto fresh = test::CreateOrFail(scene);
+  EXPECT_TRUE(RestoreState(state, fresh.get()).ok());
+  state.bodies[0].pose.position.y = 1e9f;
+  auto again = test::CreateOrFail(scene);
+  ExpectBriefRefusal(RestoreState(state, again.get()), "body 0's pose");
+}
+
+// The saved clock is checked as the scene is.
+class ClockChecks : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    m_scene = test::SmallDamBreak(0.02f);
+    auto solver = test::CreateOrFail(m_scene);
+    ASSERT_TRUE(solver);
+    ASSERT_TRUE(solver->Step().ok());
+    m_path = m_dir.File("clock.state");
+    ASSERT_TRUE(WriteStateFile(m_path, *solver, "small").ok());
+    ASSERT_TRUE(ReadStateFile(m_path, &m_state).ok());
+  }
+  Status Restore(const StateFile& state) {
+    auto fresh = test::CreateOrFail(m_scene);
+    return fresh ? RestoreState(state, fresh.get()) : Status::Error("no solver");
+  }
+  test::TempDir m_dir{"state_clock"};
+  sim::SceneSetup m_scene;
+  std::string m_path;
+  StateFile m_state;
+};
+
+TEST_F(ClockChecks, ASavedMaximumSpeedBeyondTheScenesLimitIsRefusedNamingTheFile) {
+  EXPECT_TRUE(Restore(m_state).ok());
+  StateFile bad = m_state;
+  bad.clock.lastMaxSpeed = 1e30f;
+  ExpectCleanRefusal(Restore(bad), m_path);
+  ExpectCleanRefusal(Restore(bad), "last maximum speed");
+}
+
+TEST_F(ClockChecks, ASavedMaximumAccelerationTheStepCannotResolveIsRefused) {
+  StateFile bad = m_state;
+  bad.clock.lastMaxAccel = 3.4e38f;
+  ExpectCleanRefusal(Restore(bad), m_path);
+  ExpectCleanRefusal(Restore(bad), "last maximum acceleration");
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "sphxr/interaction/paddle.h"
 #include "sphxr/interaction/trajectory.h"
 #include "sphxr/sim/solver.h"
+#include "refusal.h"
 #include "support.h"
 
 namespace sphxr::interaction {
@@ -456,7 +457,7 @@ TEST(PaddleFluid, HeldStillInWaterFeelsArchimedesBuoyancy) {
 
 TEST(PaddleFluid, HeldStillInPbfWaterFeelsArchimedesBuoyancy) {
   // Under PBF the force is the impulse of the constraint corrections the cube's boundary particles
-  // cause, read through the pressure estimate (solvers/pbf_stages.h). The same truth in WCSPH's band.
+  // cause, read through the pressure estimate (solvers/pbf/pbf_stages.h). The same truth in WCSPH's band.
   HeldCubeFeelsArchimedesBuoyancy(sim::SolverMethod::kPbf, 0.30);
 }
 
@@ -500,6 +501,25 @@ TEST(PaddleFluid, ParticlesNearAPaddleStayActiveUnderReuse) {
   EXPECT_GT(checked, 100) << "no particle came near the paddle: the test would prove nothing";
   EXPECT_GT(idleFar, 0) << "reuse never skipped a particle: the settings do not exercise the hook";
   EXPECT_EQ(test::FirstNonFinite(test::DownloadFluid(*rig.solver)), "");
+}
+
+// A paddle far larger than the tank is refused before it is sampled (a capsule of radius 100 m would
+// take 8.9 GB).
+TEST(PaddleSystem, AHugePaddleIsRefusedBeforeItIsSampled) {
+  const sim::SceneSetup scene = test::SmallDamBreak(0.01f);
+  for (const sim::ShapePrimitive& shape :
+       {sim::ShapePrimitive{sim::ShapePrimitive::Kind::kCapsule, {0, 0, 0}, {0, 0, 0}, 100.0f},
+        sim::ShapePrimitive{sim::ShapePrimitive::Kind::kBox, {0, 0, 0}, {6e9f, 0.01f, 0.01f}, 0.0f}}) {
+    interaction::PaddleDesc d;
+    d.name = "big";
+    d.holder = interaction::Holder::kLeftHand;
+    d.shapes = {shape};
+    std::unique_ptr<interaction::PaddleSystem> system;
+    Status s;
+    const double seconds = test::Seconds([&] { s = interaction::PaddleSystem::Create({d}, scene, &system); });
+    test::ExpectBriefRefusal(s, "more than the tank's");
+    EXPECT_LT(seconds, 1.0);
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sphxr/interaction/trajectory.h"
+#include "refusal.h"
 #include "support.h"
 
 namespace sphxr::interaction {
@@ -74,6 +75,18 @@ TEST(Trajectory, BadFilesAreRefusedWithTheLine) {
   const Status s = Trajectory::Load("/nonexistent/path.csv", &t);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("/nonexistent/path.csv"), std::string::npos);
+}
+
+TEST(Trajectory, ValuesBeyondAFloatNameTheFileAndLine) {
+  for (const char* value : {"1e300", "3e38", "-3e38"}) {
+    interaction::Trajectory t;
+    const std::string text = std::string("time,px,py,pz\n0,0.1,0.1,0.1\n1,") + value + ",0.1,0.1\n";
+    test::ExpectBriefRefusal(interaction::Trajectory::Parse(text, "hand.csv", &t), "hand.csv:3: column 2");
+  }
+  interaction::Trajectory t;
+  test::ExpectBriefRefusal(interaction::Trajectory::Parse("0,0,0,0\n1e12,0,0,0\n", "hand.csv", &t), "hand.csv:2: column 1");
+  test::ExpectBriefRefusal(interaction::Trajectory::Parse("0,0,0,0\n1,0,0," + std::string(10000, '9') + "x\n", "hand.csv", &t),
+                     "is not a finite number");
 }
 
 }  // namespace

@@ -478,10 +478,9 @@ TEST(DesktopPaddleTest, MouseDragMovesThePaddleThePaddleMovesTheWaterAndThePanel
   const auto start = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   // Each frame advances the simulation by the same 13 steps (N: one step while paused), about 3.3 ms of
-  // simulated time, as a frame of 30 ms wall time did on this machine when the test was written. Free-
-  // running frames made the stroke's speed in simulated time depend on how fast the solver is: after
-  // the CPU's SIMD stages a frame held 4.5 ms, the 20-frame stroke was slower, and the water ahead of
-  // the blade moved 0-4 mm instead of 4-9 mm. Stepped frames make the test the same on every machine.
+  // simulated time. Free-running frames would make the stroke's speed in simulated time depend on how
+  // fast the solver is (a faster solver, a slower stroke, and less water moved ahead of the blade);
+  // stepped frames make the test the same on every machine.
   constexpr int kStepsPerFrame = 13;
   auto frame = [&] {
     if (!desktop->Frame()) return false;  // hands the newest cursor pose to the simulation

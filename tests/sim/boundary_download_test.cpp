@@ -1,6 +1,6 @@
 // Solver::DownloadBoundary hands out every per-wall-particle field the walls carry, in the solver's sorted
-// order. The walls' inverse reference (tank.wall_pressure = "wall_density") was declared in HostBoundary
-// but left empty until the seventh session's energy audit (bench/rest.cpp --energy) needed it.
+// order, the walls' inverse reference (tank.wall_pressure = "wall_density") included: the energy audit
+// (bench/rest.cpp --energy, sim/measure.h SphEnergy) reads it.
 #include <gtest/gtest.h>
 
 #include <memory>

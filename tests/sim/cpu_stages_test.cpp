@@ -4,7 +4,7 @@
 // over-full sets (more than kLanes particles in a cell, more neighbours than list slots), with and without
 // reuse masking some particles out, and with walls (their kernel sums). Forces: the neighbour-list sum
 // and the wall terms (mirrored and wall density). Wall pressure: the blocks of 16 wall particles.
-// Position-based fluids: the lambda, correction and XSPH passes (cpu/pbf.h).
+// Position-based fluids: the lambda, correction and XSPH passes (solvers/pbf/pbf_simd.h).
 // Reuse's crowding (CellCountStage, CellBoxSumStage, ActivityStage; both backends' stages) against counting by brute force.
 #include <gtest/gtest.h>
 
@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "cpu/stages.h"
+#include "solvers/dfsph/dfsph_simd.h"
+#include "solvers/pbf/pbf_simd.h"
 #include "stages/integrate.h"
 #include "morton.h"
 
@@ -533,8 +535,8 @@ TEST(CpuStages, ForcesOfOverflowingListsMatch) {
   CompareForces(Clustered(), 24, "clustered, lists overflowing");
 }
 
-/// Position-based fluids' three neighbour passes (cpu/pbf.h) against the per-particle stages
-/// (solvers/pbf_stages.h) and against the pass's sums in double over every fluid and wall particle: the
+/// Position-based fluids' three neighbour passes (solvers/pbf/pbf_simd.h) against the per-particle stages
+/// (solvers/pbf/pbf_stages.h) and against the pass's sums in double over every fluid and wall particle: the
 /// density and lambda, the position correction (with the artificial pressure s_corr), XSPH.
 void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::string& what,
                 const std::vector<Vec3>& walls = {}) {
@@ -542,11 +544,12 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   Setup s(points, maxNeighbours, walls);
   Physics& ph = s.ph;
   ph.volume = kSpacing * kSpacing * kSpacing;
-  ph.pbfRelaxation = 1.0f / (kSpacing * kSpacing);  // eps of the order of sum |grad C|^2 (units 1/m^2)
-  ph.pbfCorrK = 0.1f;
-  ph.pbfCorrN = 4;
-  ph.pbfInvCorrW = 1.0f / ph.kernel.W(0.2f * kSupport);
-  ph.pbfXsph = 0.01f;
+  PbfConstants pbf{};
+  pbf.relaxation = 1.0f / (kSpacing * kSpacing);  // eps of the order of sum |grad C|^2 (units 1/m^2)
+  pbf.corrK = 0.1f;
+  pbf.corrN = 4;
+  pbf.invCorrW = 1.0f / ph.kernel.W(0.2f * kSupport);
+  pbf.xsph = 0.01f;
   s.RunBlocked(false, 0);  // the neighbour lists
   const size_t n = s.position.size();
   const ForceStage f = s.Forces();
@@ -557,7 +560,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   const int stride = PairCacheStride(maxNeighbours);
   std::vector<float> pairGrad(n * static_cast<size_t>(stride), std::numeric_limits<float>::quiet_NaN());
   const PbfView view{lambda.data(), lambdaSum.data(), delta.data(), boundaryGrad.data(), pairGrad.data(), own.data(), stride};
-  const PbfLambdaStage lambdaStage{f.grid, f.fluid, f.list, ph, view};
+  const PbfLambdaStage lambdaStage{f.grid, f.fluid, f.list, ph, pbf, view};
   const CubicSpline k = ph.kernel;
   const double invRho0 = ph.invRestDensity;
   // 1. lambda
@@ -601,7 +604,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
       for (int a = 0; a < 3; ++a) g[a] += d[a] * c;
       if (j >= 0) sum2 += c * c * r * r;
     });
-    const double denom = sum2 + g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + ph.pbfRelaxation;
+    const double denom = sum2 + g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + pbf.relaxation;
     const double lam = -std::max(rho * invRho0 - 1.0, 0.0) / denom;
     // float rounding: a sum of `terms` positive terms in any order is within terms * u of the exact one
     // (u = 2^-24; doubled for the kernel's own rounding), and lambda's numerator rho/rho0 - 1 carries that
@@ -616,7 +619,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   // 2. the correction, from the same lambdas: the scalar stage, and the SIMD one from the pair cache and
   // own terms the SIMD lambda pass above left (with these lambdas: run it again on them)
   lambda = lambdaRef;
-  const PbfCorrectStage correct{f.grid, f.fluid, f.list, ph, view};
+  const PbfCorrectStage correct{f.grid, f.fluid, f.list, ph, pbf, view};
   for (size_t i = 0; i < n; ++i) correct(static_cast<int>(i));
   deltaRef = delta;
   for (size_t i = 0; i < n; ++i) PbfLambdaListStage{lambdaStage}(static_cast<int>(i));  // lambda_i again (same values)
@@ -629,7 +632,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
     pairs(i, [&](long j, const double* d, double r, double psi) {
       double c;
       if (j >= 0) {
-        const double corr = -ph.pbfCorrK * std::pow(kernelW(r) * ph.pbfInvCorrW, ph.pbfCorrN);
+        const double corr = -pbf.corrK * std::pow(kernelW(r) * pbf.invCorrW, pbf.corrN);
         c = (li + lambda[static_cast<size_t>(j)] + corr) * ph.volume * grad(r);
       } else {
         c = li * psi * invRho0 * grad(r);
@@ -647,7 +650,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
   }
   EXPECT_GT(moved, n / 20) << "the set must be compressed somewhere, or the correction is not tested";
   // 3. XSPH
-  const PbfXsphStage xsph{f.grid, f.fluid, f.list, ph, view};
+  const PbfXsphStage xsph{f.grid, f.fluid, f.list, ph, pbf, view};
   for (size_t i = 0; i < n; ++i) xsph(static_cast<int>(i));
   deltaRef = delta;
   std::fill(delta.begin(), delta.end(), Vec4{9.0f, 9.0f, 9.0f, 9.0f});
@@ -657,7 +660,7 @@ void ComparePbf(const std::vector<Vec3>& points, int maxNeighbours, const std::s
     pairs(i, [&](long j, const double*, double r, double) {
       if (j < 0) return;
       const Vec4 vj = s.velocity[static_cast<size_t>(j)], vi = s.velocity[i];
-      const double w = ph.pbfXsph * ph.volume * kernelW(r);
+      const double w = pbf.xsph * ph.volume * kernelW(r);
       dv[0] += (double(vj.x) - vi.x) * w, dv[1] += (double(vj.y) - vi.y) * w, dv[2] += (double(vj.z) - vi.z) * w;
       scale += 2.0 * std::abs(w);  // |v| <= sqrt(3) m/s here
     });
@@ -676,7 +679,7 @@ TEST(CpuStages, PbfPassesMatchPerParticleAndBruteForce) {
   ComparePbf(Clustered(), 24, "clustered, lists overflowing");
 }
 
-/// DFSPH's three neighbour passes (cpu/dfsph.h) against the per-particle stages (solvers/dfsph_stages.h)
+/// DFSPH's three neighbour passes (solvers/dfsph/dfsph_simd.h) against the per-particle stages (solvers/dfsph/dfsph_stages.h)
 /// and against their sums in double over every fluid and wall particle: the factor alpha_i with the
 /// walls' gradient gB_i and the neighbour count, Predict's increment delta_i (the density solve's from
 /// the compressed set's rho_i and D rho_i/Dt, the divergence solve's from D rho_i/Dt), and Correct's

@@ -1,6 +1,6 @@
-// A fluid block that does not hold a whole number of layers is filled with whole layers, as before, and
-// the solver says so in one info line with the size filled and the size asked for (issue 37: a 0.55 m
-// column at 2 cm became 0.54 m without a word).
+// A fluid block that does not hold a whole number of layers is filled with whole layers, and the solver
+// says so in one info line with the size filled and the size asked for (a 0.55 m column at 2 cm is
+// 0.54 m of water).
 #include <gtest/gtest.h>
 
 #include <memory>

@@ -99,8 +99,8 @@ ProbeSet CornerSensors(float dx, float surface) {
 // (tests/validation/hydrostatic_test.cpp): the least-squares slope of p against depth through the
 // origin, here held to the issue's 2 % of rho0 g. Each single sensor is not held to 2 % here: the
 // settled state's own pressure field stands +0.1 .. +3 % (and up to +11 % two spacings under the
-// surface) off rho0 g depth around the sensors, which the disabled test below shows and the pressure
-// remedy of issue 37 is to fix; the probes' sums themselves are exact (the brute-force test).
+// surface) off rho0 g depth around the sensors, which the disabled test below shows (the solver's
+// pressure field, not the probes: their sums themselves are exact, the brute-force test).
 TEST(Probes, StillWaterReadsHydrostaticsAndTheSurface) {
   Settled s;
   LoadSettled(&s);
@@ -422,7 +422,7 @@ TEST(Probes, AFloodedCornerSensorIsNeverDry) {
   EXPECT_TRUE(std::isnan(sample.pressure[0])) << "an edge sensor above the water reads " << sample.pressure[0];
 }
 
-// The case of issue 46 in a dam break: the surge runs along the floor into the far wall, and a sensor in
+// A flooded floor corner in a dam break: the surge runs along the floor into the far wall, and a sensor in
 // the floor's corner there (half a spacing from the three faces) must read whenever the sensor above
 // it in the same edge, 12 mm over the floor, reads and the corner holds water: three quarters of the
 // kernel sum a flooded corner has (its rest lattice's, computed here), where its dry threshold is about

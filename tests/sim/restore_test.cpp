@@ -1,72 +1,23 @@
 // Solver::Restore: a restart from a saved state (the state file of app/src/state_file.h). The truth is
 // the solver that was never stopped: a small dam break saved mid-collapse and restored into a fresh
-// solver of the same scene must take the same steps, bit for bit (the CPU backend is deterministic),
-// with reuse's idle counts carried along. Then the refusals.
+// solver of the same scene must take the same steps, bit for bit (the CPU backend is deterministic).
+// That every solver does is the conformance suite's case (tests/sim/solvers/conformance_test.cpp); here
+// reuse's idle counts carried along, and the refusals.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <memory>
 
+#include "sim/same_bits.h"
 #include "sphxr/sim/solver.h"
 #include "support.h"
 
 namespace sphxr::sim {
 namespace {
 
-bool SameBits(const Vec4& a, const Vec4& b) { return std::memcmp(&a, &b, sizeof(Vec4)) == 0; }
-
-/// Steps `solver` `steps` times and returns every step's dt.
-std::vector<float> Run(Solver* solver, int steps) {
-  std::vector<float> dts;
-  for (int k = 0; k < steps; ++k) {
-    EXPECT_TRUE(solver->Step().ok());
-    dts.push_back(solver->LastStep().dt);
-  }
-  return dts;
-}
-
-void ExpectRestoredRunMatches(const SceneSetup& scene) {
-  // The one that runs through: 60 steps, saved after 40 (the column is falling and spreading).
-  auto through = test::CreateOrFail(scene);
-  ASSERT_TRUE(through);
-  Run(through.get(), 40);
-  HostFluid saved;
-  through->Download(&saved);
-  const SolverClock clock = through->Clock();
-  EXPECT_GT(clock.time, 0.0);
-  EXPECT_GT(clock.lastMaxSpeed, 0.1f) << "the column should be moving when it is saved";
-  const std::vector<float> throughDts = Run(through.get(), 20);
-
-  auto restored = test::CreateOrFail(scene);
-  ASSERT_TRUE(restored);
-  ASSERT_TRUE(restored->Restore(saved, clock).ok());
-  EXPECT_EQ(restored->Time(), clock.time);
-  const std::vector<float> restoredDts = Run(restored.get(), 20);
-  EXPECT_EQ(restoredDts, throughDts) << "the time steps after the restart differ";
-  EXPECT_EQ(restored->Time(), through->Time());
-  EXPECT_EQ(restored->GetTotals().steps, 20) << "the step count starts at 0 after a restore";
-
-  HostFluid a, b;
-  through->Download(&a);
-  restored->Download(&b);
-  ASSERT_EQ(a.size(), b.size());
-  int differ = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    const bool same = a.id[i] == b.id[i] && SameBits(a.position[i], b.position[i]) &&
-                      SameBits(a.velocity[i], b.velocity[i]) && a.density[i] == b.density[i] && a.idle[i] == b.idle[i];
-    if (!same && differ++ < 5) {
-      ADD_FAILURE() << "particle " << i << " (id " << a.id[i] << " / " << b.id[i] << ") differs after the restart: x "
-                    << a.position[i].x << " / " << b.position[i].x << ", v " << a.velocity[i].x << " / "
-                    << b.velocity[i].x;
-    }
-  }
-  EXPECT_EQ(differ, 0);
-}
-
-TEST(Restore, ContinuesTheSavedRunBitForBit) { ExpectRestoredRunMatches(test::SmallDamBreak(0.01f)); }
+using same_bits::ExpectRestoredRunMatches;
 
 TEST(Restore, CarriesReuseIdleCounts) {
   SceneSetup scene = test::SmallDamBreak(0.01f);

@@ -2,7 +2,8 @@
 // times of the contention benchmark's table (bench/results/contention.csv: stir on 2 cores, alone 2
 // threads 7.2 ms and 1 thread 12.5 ms; beside a busy process 17.8 and 13.0 ms), with +-10 % noise, it
 // must settle on the faster team, spend few steps trying the other, and follow a neighbour that comes
-// and goes. Whatever the team, the bits are the same (determinism_test); only the speed is at stake.
+// and goes. Whatever the team, the bits are the same (solvers/conformance_test.cpp, every row); only
+// the speed is at stake.
 #include <gtest/gtest.h>
 
 #include <functional>
@@ -55,7 +56,7 @@ TEST(TeamSizer, BesideABusyProcessOneThreadWins) {
   EXPECT_EQ(team.Threads(), 1);
   // the first try comes after kMinInterval steps; then 2 threads only for confirming windows
   EXPECT_LE(r.atCores, TeamSizer::kMinInterval + 2 * TeamSizer::kWindow + 8 * TeamSizer::kWindow);
-  EXPECT_LT(r.seconds, 1.3 * 5000 * 12.5e-3) << "issue 47's bound: 1.3x one thread alone";
+  EXPECT_LT(r.seconds, 1.3 * 5000 * 12.5e-3) << "the bound: 1.3x one thread alone";
 }
 
 TEST(TeamSizer, FollowsANeighbourThatComesAndGoes) {

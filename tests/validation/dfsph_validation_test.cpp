@@ -29,7 +29,7 @@ std::unique_ptr<sim::Solver> RestTankAfterOneSecond(app::SceneFile* scene) {
 }
 
 TEST(DfsphStillWater, WallsHoldItWithoutTheDomainClamp) {
-  // The walls mirror each fluid particle's stiffness (solvers/dfsph.h): the first layer then rests on the
+  // The walls mirror each fluid particle's stiffness (solvers/dfsph/dfsph.h): the first layer then rests on the
   // wall instead of sliding to the domain clamp, which caught 12 % of the particles every step when the
   // walls pushed with the particle's stiffness alone. At most one clamp per 1,000 particle-steps.
   app::SceneFile scene;
@@ -78,7 +78,7 @@ TEST(DfsphStillWater, PressureIsHydrostaticOverTheLowerEightyPercent) {
   // particles (a sheet half a spacing below the floor, sampling.cpp), whose kernel sums are cut by the
   // wall (the boundary model's own error: recorded, not held to the interior's 5 %). The distance is the
   // layer's measured mean height, not the lattice's: DFSPH's first layer sinks into the wall's zone
-  // (issue 47), and the layer above it then reaches within the support too.
+  // (docs/design/dfsph.md), and the layer above it then reaches within the support too.
   const int deepest = layers.rbegin()->first;
   const double sheet = scene.setup.tank.min.y - 0.5 * dx;
   const double support = scene.setup.params.supportFactor * dx;

@@ -1,6 +1,6 @@
-// Position-based fluids (solvers/pbf.h, Macklin & Müller 2013) over a long violent run: ten simulated
+// Position-based fluids (solvers/pbf/pbf.h, Macklin & Müller 2013) over a long violent run: ten simulated
 // seconds of a dam break thrown at the far wall, without a NaN or a lost particle. (Martin & Moyce under
-// PBF: dam_break_test.cpp; still water and the iteration extremes over one second: tests/sim/pbf_test.cpp;
+// PBF: dam_break_test.cpp; still water and the iteration extremes over one second: tests/sim/solvers/pbf_test.cpp;
 // the held paddle and the 5 m/s swing: tests/interaction/paddle_test.cpp.)
 #include <gtest/gtest.h>
 

@@ -53,8 +53,23 @@ struct DensityBlockStage {
       }  // other lanes stay far away, never a hit (their squared distance overflows to +inf)
     }
     const CubicSpline k = stage.ph.kernel;
-    const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
     uint32_t found[kLanes] = {};
+    const Lanes sum = FluidSums(k, cells, computing, particle, px, py, pz, found);
+    const Lanes wall = WallSums(k, box, cells, computing, px, py, pz);
+    for (int l = 0; l < lanes; ++l) {
+      if (computing & (1u << l)) {
+        stage.Complete(static_cast<int>(particle[l]), Vec3{px[l], py[l], pz[l]}, sum[l], wall[l], found[l]);
+      }
+    }
+  }
+
+  /// The lanes' fluid kernel sums, and each computing lane's neighbour list (`found`: its neighbour
+  /// count, which may pass the list's capacity: the force stage then scans the cells).
+  SPHXR_INLINE Lanes FluidSums(const CubicSpline& k, const BlockCells& cells, uint32_t computing,
+                               const uint32_t* particle, Lanes px, Lanes py, Lanes pz, uint32_t* found) const {
+    const GridView& g = stage.grid;
+    const Vec4* position = stage.fluid.position;
+    const uint32_t capacity = static_cast<uint32_t>(stage.list.maxNeighbours);
     Lanes sum;
     if constexpr (kVectorAppends) {
       // The neighbour lists without a branch per hit: every candidate that hits some lane is written to
@@ -98,8 +113,14 @@ struct DensityBlockStage {
         }
       });
     }
-    // The walls: the lanes whose own cell has a wall particle in its 27 cells (WallSum's test); the
-    // others keep 0, as WallSum gives them.
+    return sum;
+  }
+
+  /// The walls' sums of the lanes whose own cell has a wall particle in its 27 cells (WallSum's test);
+  /// the others keep 0, as WallSum gives them.
+  SPHXR_INLINE Lanes WallSums(const CubicSpline& k, const BlockBox& box, const BlockCells& cells, uint32_t computing,
+                              Lanes px, Lanes py, Lanes pz) const {
+    const GridView& g = stage.grid;
     Lanes wall = Splat(0.0f);
     bool anyNear = false, allNear = true;
     for (int z = box.z0; z <= box.z1; ++z)
@@ -121,11 +142,7 @@ struct DensityBlockStage {
       }
       wall = KernelSumLanes(k, cells, g.boundaryStart, g.boundaryEnd, g.boundary, true, wx, wy, wz);
     }
-    for (int l = 0; l < lanes; ++l) {
-      if (computing & (1u << l)) {
-        stage.Complete(static_cast<int>(particle[l]), Vec3{px[l], py[l], pz[l]}, sum[l], wall[l], found[l]);
-      }
-    }
+    return wall;
   }
 };
 

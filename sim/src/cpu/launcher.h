@@ -1,11 +1,14 @@
 #pragma once
 // The CPU backend's launcher (backend_cpu.cpp): the calls of launch/plain.h with the SIMD forms of the
-// density, force and wall-pressure stages (cpu/stages.h) and guided OpenMP chunks. The only place where
+// density, force and wall-pressure stages (cpu/stages.h) and of the solvers' neighbour passes (each in
+// its solver's folder), and guided OpenMP chunks. The only place where
 // the CPU's stages differ from the ones CUDA runs.
 #include <thrust/copy.h>
 #include <thrust/iterator/counting_iterator.h>
 
 #include "cpu/stages.h"
+#include "solvers/dfsph/dfsph_simd.h"  // DFSPH's factor and its solves' two passes
+#include "solvers/pbf/pbf_simd.h"      // position-based fluids' lambda, correction and XSPH passes
 #include "reuse_lists.h"
 #include "store/fluid_store.h"
 
@@ -18,8 +21,8 @@ class CpuLauncher {
 
  public:
   /// The SIMD forms keep each listed pair's kernel gradient lane-blocked (PairCacheStride) for the passes
-  /// after them: PBF's lambda pass for its correction (cpu/pbf.h), DFSPH's factor for its solves
-  /// (cpu/dfsph.h).
+  /// after them: PBF's lambda pass for its correction (solvers/pbf/pbf_simd.h), DFSPH's factor for its solves
+  /// (solvers/dfsph/dfsph_simd.h).
   static constexpr bool kPairCache = true;
   /// The SIMD stages' loop. thrust's OpenMP for_each gives each thread one equal slice; these stages'
   /// items cost what their neighbours and walls cost, and with reuse the compacted list puts the calm
@@ -28,7 +31,7 @@ class CpuLauncher {
   /// threads, then a quarter, ... down to `chunk` items) let the thread that finishes first take over the
   /// rest (4-10 % faster than the equal slices, docs/design/simd_stages.md). An item writes only its own
   /// results, so the schedule changes no number.
-  /// A stage with a SIMD form (SimdForm, cpu/pbf.h) runs that form.
+  /// A stage with a SIMD form (SimdForm, solvers/pbf/pbf_simd.h) runs that form.
   template <class F>
   void ForEach(int n, int chunk, const F& f) {
     if constexpr (requires { typename SimdForm<F>::type; }) {

@@ -1,7 +1,8 @@
 #pragma once
 // The SIMD traversals of a particle's neighbour list and of the wall particles of its cells, kLanes at a
 // time, shared by the passes that work from the density stage's lists (position-based fluids' passes,
-// cpu/pbf.h; DFSPH's factor and solve, cpu/dfsph.h), and the lane-blocked pair cache's loads and stores.
+// solvers/pbf/pbf_simd.h; DFSPH's factor and solve, solvers/dfsph/dfsph_simd.h), and the lane-blocked
+// pair cache's loads and stores.
 #include <cstdint>
 #include <cstring>
 
@@ -41,7 +42,8 @@ SPHXR_INLINE LaneInts ListLanes(const uint32_t* slots, uint32_t base, uint32_t f
 }
 
 /// Particle i's row of a lane-blocked pair cache (PairCacheStride floats a particle): the passes of PBF
-/// and DFSPH that keep each listed pair's V grad W_ij for the passes after them (cpu/pbf.h, cpu/dfsph.h).
+/// and DFSPH that keep each listed pair's V grad W_ij for the passes after them (solvers/pbf/pbf_simd.h,
+/// solvers/dfsph/dfsph_simd.h).
 SPHXR_INLINE float* PairCacheRow(float* cache, int stride, int i) {
   SPHXR_ASSERT(cache);  // the CPU launcher's kPairCache
   return cache + static_cast<size_t>(i) * static_cast<size_t>(stride);

@@ -104,8 +104,8 @@ inline uint32_t Bits(LaneInts c) {
 /// is one register (AVX-512, AVX) the float operators are one instruction each (AVX without AVX2
 /// splits the integer ones, a cost in speed only). In the SSE2 tier's
 /// four registers GCC 12 lowers a comparison or a ?: lane by lane (a scalar compare, a store of each
-/// 32-bit result, then a 128-bit reload that the store buffer cannot forward; measured on an AVX2 machine
-/// with 16 lanes in two halves, that made the density and force stages 2-3x slower), so that tier
+/// 32-bit result, then a 128-bit reload that the store buffer cannot forward; with 16 lanes in two
+/// halves that makes the density and force stages 2-3x slower), so that tier
 /// compares and selects per quarter with the intrinsics. Same NaN semantics as the operators: <, <= are
 /// ordered (false for NaN), != is unordered (true for NaN); the results are bit for bit the operators'.
 #if defined(__SSE2__) && !defined(__AVX__)
@@ -214,7 +214,7 @@ SPHXR_INLINE void GatherXyz(const float* base, LaneInts index, Lanes* x, Lanes* 
 }
 
 /// SimdForm<Stage>::type: the SIMD form CpuLauncher::ForEach runs in place of a scalar stage (where
-/// one is declared, beside the form: cpu/pbf.h).
+/// one is declared, beside the form: solvers/pbf/pbf_simd.h).
 template <class Stage>
 struct SimdForm {};
 

@@ -28,8 +28,9 @@
 // layout), so reuse off and reuse with IDLE = 0 stay bit-identical. tests/sim/cpu_stages_test.cpp compares each with the per-particle stages and with
 // brute force.
 //
-// PBF (cpu/pbf.h) and DFSPH (cpu/dfsph.h): their neighbour passes as the forces', per particle over the
-// list kLanes at a time, each pair's kernel gradient kept lane-blocked for the passes after it.
+// The solvers' own SIMD forms live in their folders (solvers/pbf/pbf_simd.h, solvers/dfsph/dfsph_simd.h):
+// their neighbour passes as the forces', per particle over the list kLanes at a time, each pair's kernel
+// gradient kept lane-blocked for the passes after it; the launcher (cpu/launcher.h) includes them.
 //
 // One header per stage, beside the stage it implements (stages/):
 #include "../stages.h"    // the stages these implement (sim/src/stages.h, not this file)
@@ -38,5 +39,3 @@
 #include "cpu/density.h"  // DensityBlockStage
 #include "cpu/forces.h"   // ForceListStage
 #include "cpu/walls.h"    // WallPressureBlockStage
-#include "cpu/pbf.h"      // position-based fluids' lambda, correction and XSPH passes
-#include "cpu/dfsph.h"    // DFSPH's factor and its solves' two passes

@@ -3,10 +3,10 @@
 //
 // A step of the CPU backend is a few dozen OpenMP regions; each ends at a barrier where every thread
 // waits for the last. Alone on the machine all cores are fastest. Beside another busy process one
-// thread of the team is descheduled in turn, and every barrier waits for it: measured on 2 cores
-// (bench/contention.sh), a 2-thread step of `stir` took 1.4-1.9x the 1-thread step, and 31x on the
-// machine of issue 47. No wait policy is right for both: sleeping at once (OMP_WAIT_POLICY=passive)
-// is the best beside a busy process and 16 % slower alone here, 1.7x there.
+// thread of the team is descheduled in turn, and every barrier waits for it: a 2-thread step can take
+// longer than a 1-thread one, by up to an order of magnitude (bench/contention.sh,
+// docs/design/contention.md). No wait policy is right for both: sleeping at once
+// (OMP_WAIT_POLICY=passive) is the best beside a busy process and slower alone.
 //
 // So the team is measured, not guessed: the step runs at one size of a ladder (all cores, half, ...,
 // 1); after `interval` steps it tries a neighbouring size for kWindow steps and keeps whichever had the

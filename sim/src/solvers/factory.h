@@ -2,9 +2,9 @@
 // The solvers' factory over a backend's Traits: one line per row of the solver table (solver_table.cpp).
 #include <memory>
 
-#include "solvers/dfsph.h"
-#include "solvers/pbf.h"
-#include "solvers/wcsph.h"
+#include "solvers/dfsph/dfsph.h"
+#include "solvers/pbf/pbf.h"
+#include "solvers/wcsph/wcsph.h"
 
 namespace sphxr::sim {
 

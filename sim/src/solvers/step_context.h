@@ -6,28 +6,20 @@
 // A StepContext carries one step: dt, the physics, the grid and fluid views, and the shared stages
 // over the backend's stores, each launched by the backend's launcher (launch/plain.h, or the CPU's SIMD
 // forms in cpu/launcher.h), so a solver reads as a list of named stages and never asks which backend or
-// which stage form it runs on. Each solver is one file in solvers/ and one row of the solver table
-// (solver_table.cpp); the factory over Traits is solvers/factory.h.
+// which stage form it runs on. Each solver is one folder in solvers/ (its step, its stages, its
+// constants, its CPU SIMD form, its rules) and one row of the solver table (solver_table.cpp); the
+// factory over Traits is solvers/factory.h.
 #include <chrono>
 #include <functional>
 
 #include "probe_arrays.h"
 #include "reuse_lists.h"
+#include "sphxr/sim/solve_report.h"
 #include "stages.h"
 #include "store/boundary_store.h"
 #include "store/fluid_store.h"
 
 namespace sphxr::sim {
-
-/// What a solver reports of its step besides the shared reduction: the iterations of its solves and
-/// the errors they reached (fractions). Which of them a method fills, and their names, is its row of
-/// the solver table (SolverInfo::stats).
-struct SolveReport {
-  int32_t densityIterations = 0;
-  int32_t divergenceIterations = 0;
-  float densityError = 0.0f;
-  float divergenceError = 0.0f;
-};
 
 /// The backend's stores one step works on.
 template <class Traits>
@@ -50,11 +42,11 @@ class StepContext {
         m_lap(std::move(lap)) {}
 
   const float dt;
-  const Physics& physics;
+  const Physics& physics;  // what every stage shares (the solver's own constants are its own: Init)
   const GridView grid;
   const FluidView fluid;
   const int n;
-  SolveReport report;
+  SolveReport report;  // the solver's statistics of this step (sphxr/sim/solve_report.h)
   /// The particles that compute density and forces this step (all, or after Activity the compacted list).
   int computing = 0;
   const uint32_t* computeList = nullptr;
@@ -139,6 +131,9 @@ template <class Traits>
 class PressureSolver {
  public:
   virtual ~PressureSolver() = default;
+  /// Computes its own constants from the scene, once (the backend's Init), and again only when the
+  /// scene changes at run time (Solver::SetReuse).
+  virtual void Init(const SceneSetup& scene, const Physics& physics) = 0;
   /// One step of ctx.dt, after the grid and the bodies' placement; leaves every particle integrated
   /// (positions, velocities, accelerations with the clamp flags of stages/integrate.h).
   virtual Status Step(StepContext<Traits>& ctx) = 0;

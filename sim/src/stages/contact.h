@@ -8,8 +8,8 @@
 // quarter spacing from it (0.25 dx, stages/clamp.h). The contact zone is the last `contactWidth`
 // (0.1 dx) before the clamp box, from 0.35 dx of the face inwards, so water at rest, even compressed
 // by 15 % (its first layer 0.85 dx from the wall's sheet instead of 1 dx), never feels it; narrow, so that it changes as little as it can of the flow along a wall (a
-// pressure-free film on a floor rests at its edge, 0.35 dx, where the clamp used to hold it at 0.25 dx;
-// the floor's friction on it depends on that distance). Inside the zone the acceleration points away from the wall and grows as
+// pressure-free film on a floor rests at its edge, 0.35 dx from the face, not at the clamp box's
+// 0.25 dx; the floor's friction on it depends on that distance). Inside the zone the acceleration points away from the wall and grows as
 // K s^2, s = (depth into the zone) / width, and the velocity along the wall's normal is damped
 // critically there: water that meets a wall loses its normal speed, as at the clamp it replaces (an
 // inelastic wall), instead of bouncing back off a spring. An elastic contact (the spring alone) ran the

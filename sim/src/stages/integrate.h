@@ -87,11 +87,6 @@ struct StepReduction {
   int32_t computed = 0;  // particles that computed density and forces this step (set by the backend)
   int32_t pushed = 0;    // fluid particles pushed out of a moving body this step (stages/bodies.h)
   int32_t nonFinite = 0; // fluid particles with a NaN or infinite position, velocity, acceleration or density
-  // DFSPH (set by the backend): iterations of each solve and the mean errors they reached (fractions).
-  int32_t densityIterations = 0;
-  int32_t divergenceIterations = 0;
-  float densityError = 0.0f;
-  float divergenceError = 0.0f;
 };
 
 struct StepReductionOp {

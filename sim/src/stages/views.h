@@ -1,6 +1,6 @@
 #pragma once
-// What every stage reads: plain views of raw pointers (FluidView, GridView, NeighbourList), the step's
-// constants (Physics), passed by value into host+device functors, and the loop over the 27 cells
+// What every stage reads: plain views of raw pointers (FluidView, GridView, NeighbourList), the constants
+// every stage shares (Physics), passed by value into host+device functors, and the loop over the 27 cells
 // around a point. The stages themselves are one header each beside this one (stages.h lists them in
 // the order of a step).
 #include <cstdint>
@@ -183,7 +183,9 @@ struct DiffuseConstants {
   float radius;          // m, r_V: the spawning cylinder's radius (half a spacing)       [IAAT12 sec. 4.1]
 };
 
-/// Constants of one step, passed by value into every stage.
+/// The constants every stage shares, computed once per scene (Solver::Create, and again when a setting
+/// changes at run time); a step sets only its own number (step, reuseSyncStep). A solver's own constants
+/// are its own (solvers/<method>/<method>_constants.h). Passed by value into every stage.
 struct Physics {
   CubicSpline kernel;
   float mass;           // kg per fluid particle
@@ -225,24 +227,6 @@ struct Physics {
   bool contactBelowRestOnly;  // the contact acts only on particles lighter than rho0 (DFSPH; contact.h)
   bool closedTop;
   float volume;                 // m / rho0, each fluid particle's rest volume
-  // dfsph (solvers/dfsph.h)
-  float densityTolerance;       // mean compression (fraction) at which the density solve stops
-  float divergenceTolerance;    // mean compression per step (fraction) at which the divergence solve stops
-  int minIterations;
-  int maxIterations;
-  int minDivergenceIterations;
-  int maxDivergenceIterations;  // 0: no divergence solve
-  // pbf (solvers/pbf.h)
-  int pbfIterations;
-  float pbfRelaxation;          // epsilon, absolute (the relative scene value times the rest lattice's sum)
-  float pbfCorrK;               // m^2: k over the rest lattice's sum |grad C|^2 (s_corr enters beside lambda)
-  int pbfCorrN;
-  float pbfInvCorrW;            // 1 / W(dq)
-  float pbfXsph;
-  float pbfVorticity;           // m/s, vorticity confinement's epsilon (0: off)
-  float pbfMaxSpeed;
-  float pbfContact;             // m: the collision response's distance beyond the clamp box (the
-                                // particle radius, half a spacing from a face, less the clamp's inset)
   // post-step stages (post_step.h)
   DiffuseConstants diffuse;     // spray, foam and bubbles (stages/diffuse.h)
   int64_t step;                 // this step's number since the run began (SolverClock::steps + 1): seeds the

@@ -1,4 +1,4 @@
-// Nothing lost to a kill (issue 39): a headless run with --stats and --checkpoint-every killed with
+// Nothing lost to a kill: a headless run with --stats and --checkpoint-every killed with
 // SIGKILL 10 s in leaves a CSV of whole rows and a state file from which the run continues, its rows
 // appended after the checkpoint's step as the whole run numbers them.
 #include <fcntl.h>

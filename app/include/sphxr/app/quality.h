@@ -2,8 +2,9 @@
 // --quality auto: pick the pressure solver and the particle spacing (and the surface cell size) so that a
 // scene runs in real time on the machine it finds. Measured, not guessed: a few steps of the scene are
 // timed under each method, the faster kept, and the spacing is scaled by the cost model (particles ~
-// h^-3, stable dt ~ h, so simulated seconds per wall second ~ h^4), then checked once more there. Under
-// PBF the substeps follow the spacing (PbfSubstepsForSpacing), which makes its cost ~ h^-4 as well.
+// h^-3, stable dt ~ h, so simulated seconds per wall second ~ h^4), then checked once more there. A
+// method's own parameters follow the spacing as its row of the solver table says (paramsForSpacing: PBF's
+// substeps, which makes its cost ~ h^-4 as well).
 #include <string>
 
 #include "sphxr/common/status.h"
@@ -15,7 +16,7 @@ struct QualityChoice {
   sim::SolverMethod method = sim::SolverMethod::kWcsph;  // the faster at the scene's spacing
   float spacing = 0.0f;          // m
   float surfaceCellSize = 0.0f;  // m, for the surface mesh (HPMC) when it lands: one spacing
-  float pbfSubsteps = 0.0f;      // under PBF: the substeps that keep the scene's step per spacing (0: other methods)
+  sim::SolverParams params;      // the scene's, with the chosen spacing and the method's own parameters for it
   double realtime = 0.0;         // simulated s per wall s measured at the chosen spacing
   int fluid = 0;                 // particles at the chosen spacing
   std::string summary;           // the logged line
@@ -24,12 +25,6 @@ struct QualityChoice {
 /// The spacing that reaches `target` simulated seconds per wall second, from a measured `realtime` at
 /// `spacing` (cost ~ h^-4), clamped to [minSpacing, maxSpacing].
 float SpacingForRealtime(float spacing, double realtime, double target, float minSpacing, float maxSpacing);
-
-/// PBF's substeps a frame at `spacing` for a scene that takes `sceneSubsteps` at `sceneSpacing`: the
-/// fewest that keep the step per spacing (dt / h) at most the scene's, within pbf_substeps' range [1, 16].
-/// PBF's rest compression goes as g D dt^2 / (N h^2) (docs/design/pbf.md), so a coarser spacing keeps the
-/// scene's compression and stability with fewer substeps, and a finer one needs more.
-float PbfSubstepsForSpacing(float sceneSubsteps, float sceneSpacing, float spacing);
 
 /// Under --quality auto, spray, foam and bubbles are a luxury: when the water cannot keep real time at
 /// the chosen spacing (`realtime` < 1 simulated s per wall s) the diffuse stage is turned off (its cost

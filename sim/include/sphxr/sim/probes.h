@@ -1,5 +1,5 @@
 #pragma once
-// Probes: what a user measures in a run without exporting every particle (issue 37). Pressure sensors,
+// Probes: what a user measures in a run without exporting every particle. Pressure sensors,
 // water-level gauges, and the force and torque of the fluid on a moving body. The solver evaluates the
 // sensors and gauges on its backend in every step, one work item per probe over the neighbour grid
 // (sim/src/stages/probes.h), on the state at the start of the step: positions, densities and pressures

@@ -1,7 +1,8 @@
 #pragma once
-// The WCSPH solver (Becker & Teschner 2007) on a Z-ordered uniform grid (Huang et al. 2013, §3.1),
-// with boundary particles after Akinci et al. (2012). One source for the CPU (OpenMP) and CUDA
-// backends: see sim/src/stages.h for the per-particle stages and sim/src/backend_impl.h for the step.
+// The SPH solver (its pressure solver chosen by solver.method: the solver table, solver_table.h) on a
+// Z-ordered uniform grid (Huang et al. 2013, §3.1), with boundary particles after Akinci et al. (2012).
+// One source for the CPU (OpenMP) and CUDA backends: see sim/src/stages.h for the per-particle stages
+// and sim/src/backend_impl.h for the step. What a step reports: step_info.h.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -15,6 +16,7 @@
 #include "sphxr/sim/params.h"
 #include "sphxr/sim/probes.h"
 #include "sphxr/sim/rigid.h"
+#include "sphxr/sim/step_info.h"
 #include "sphxr/sim/surface.h"
 
 namespace sphxr::sim {
@@ -35,55 +37,6 @@ struct SolverConfig {
   int threads = 0;        // CPU backends (cpu, cpu-reference): 0 = all cores
   bool validate = false;  // check every stage for non-finite values (slow)
 };
-
-/// Stages of one step, each timed.
-/// kBodies: the moving boundaries' own work (placing and sorting their particles, the reaction on them,
-/// the push-out); their terms inside the density and force loops count to those stages.
-/// kDivergence, kPressure: DFSPH's two solves (its factor counts to kDensity); WCSPH leaves them 0.
-/// kProbes: the pressure sensors and level gauges (Solver::SetProbes); 0 without probes.
-/// kDiffuse: spray, foam and bubbles after the step (solver.diffuse, sphxr/sim/diffuse.h); 0 when off.
-enum class Stage : int {
-  kCells, kSort, kGrid, kActivity, kDensity, kForces, kIntegrate, kBodies, kDivergence, kPressure, kProbes, kDiffuse,
-  kCount
-};
-const char* StageName(Stage stage);
-
-struct StepInfo {
-  double time = 0.0;             // s, simulated time after the step
-  float dt = 0.0f;               // s, the step taken
-  float maxSpeed = 0.0f;         // m/s
-  float meanDensityError = 0.0f; // mean of max(0, rho/rho0 - 1) over fluid particles
-  float maxDensityError = 0.0f;  // max of |rho/rho0 - 1| over fluid particles
-  int32_t clamped = 0;           // fluid particles pushed back into the domain this step
-  float activeFraction = 1.0f;   // fraction of fluid particles that computed density and forces (reuse)
-  int32_t pushedOut = 0;         // fluid particles pushed out of a moving body this step
-  // DFSPH: iterations of its solves and the mean errors they reached (fractions: the density solve's
-  // mean compression, the divergence solve's mean compression rate times dt). 0 under WCSPH.
-  int32_t densityIterations = 0;
-  int32_t divergenceIterations = 0;
-  float solverDensityError = 0.0f;
-  float solverDivergenceError = 0.0f;
-};
-
-struct Totals {
-  int64_t steps = 0;
-  int64_t clampedEvents = 0;     // sum of StepInfo::clamped
-  std::array<int64_t, kClampSites> clampedAt{};  // the same, per tank face and obstacle (ClampSiteName)
-  int64_t particleSteps = 0;     // sum over steps of the fluid particles stepped (the clamp rate's denominator)
-  int64_t dtClampedSteps = 0;    // steps where a fixed dt was clamped to the CFL limit
-  int64_t pushedOutEvents = 0;   // sum of StepInfo::pushedOut
-  int64_t densityIterations = 0;     // DFSPH: sums of StepInfo's iterations
-  int64_t divergenceIterations = 0;
-  int64_t iterationCapSteps = 0;     // DFSPH: steps whose density solve stopped at max_iterations
-  std::array<double, static_cast<int>(Stage::kCount)> stageSeconds{};
-  double stepSeconds = 0.0;      // wall time in Step()
-};
-
-/// "x- wall", "x+ wall", "floor", "top", "z- wall", "z+ wall", then "obstacles[k]" (params.h kClampSites).
-std::string ClampSiteName(int site);
-/// The clamp rate above which the walls leak (the solver warns once, naming the wall): 1 in 10,000
-/// particle-steps. Below it the clamp is a safety net, not what holds the water.
-inline constexpr double kLeakingClampRate = 1e-4;
 
 /// What Solver::Settle did.
 struct SettleReport {
@@ -116,6 +69,9 @@ using SettleProgress = std::function<bool(double done)>;
 
 class Backend;
 struct Physics;
+struct BodyState;
+struct StepReduction;
+using StageHook = std::function<Status(Stage)>;
 
 class Solver {
  public:
@@ -248,11 +204,14 @@ class Solver {
   Backend* BackendForTests() { return m_backend.get(); }
 
  private:
-  Solver() = default;
+  Solver();
   SceneSetup m_scene;
   SolverConfig m_config;
   Device m_device = Device::kCpu;
   std::unique_ptr<Backend> m_backend;
+  std::unique_ptr<Physics> m_physics;  // what every stage shares, for m_scene (MakePhysics)
+  /// m_scene changed at run time (SetReuse): the shared constants and the pressure solver's own again.
+  void SceneChanged();
   StepInfo m_last;
   Totals m_totals;
   int64_t m_stepBase = 0;  // steps of the run before a restore (SolverClock::steps)
@@ -281,6 +240,19 @@ class Solver {
   void ReadProbes(const ProbeSet& probes, const std::vector<float>& dry, double time, int64_t steps,
                   ProbeSample* out) const;
   void SampleProbesNow();  // the backend's re-grid and evaluation (solver.cpp: it has the step's physics)
+  // ---- the step's parts (solver_step.cpp, bodies.cpp) ---------------------------------------------------
+  /// The next step's size: the method's stable step, or solver.fixed_dt below it; an error when it collapsed.
+  Status NextDt(float* dt);
+  /// Validate mode: every particle finite at the start of the step, and after each stage (the hook).
+  Status ValidateStart(int64_t stepNumber, HostFluid* host) const;
+  StageHook ValidateHook(int64_t stepNumber, HostFluid* host) const;
+  /// Each body's motion over the next `dt` (to the backend), and its end pose and loads after the step.
+  std::vector<BodyState> StartBodyMotion(float dt);
+  void EndBodyMotion(const std::vector<BodyState>& states);
+  /// The step's reduction and the solver's report into m_last and m_totals.
+  void RecordStep(float dt, const StepReduction& red, const SolveReport& report);
+  /// Logs at most once per simulated second when the density solve stopped at its iteration cap.
+  void WarnIfIterationCapped(const SolveReport& report);
   bool m_dtClampLogged = false;
   bool m_leakWarned = false;
   /// Logs once per run when the clamps exceed kLeakingClampRate, naming the wall that clamps most.

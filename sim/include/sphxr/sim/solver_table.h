@@ -1,23 +1,18 @@
 #pragma once
 // The solver table: one row per pressure solver (`solver.method`). What each method is, what it
-// supports, its stable time step, its parameters and its statistics are read from here by the solver
-// itself (which models it turns on), the scene check (which warnings), `--set`, the panel, `--quality
-// auto`, the stats CSV and the generated scene reference; nothing outside a solver's own file and this
-// table asks which method runs. Adding a solver: docs/dev/extending.md.
+// supports, its stable time step, its statistics and its own rules (start-up warnings, parameters for a
+// spacing) are read from here by the solver itself (which models it turns on), the scene check (which
+// warnings), `--set`, the panel, `--quality auto`, the stats CSV and the generated scene reference;
+// nothing outside a solver's own folder (sim/src/solvers/<method>/) and this table asks which method
+// runs. Adding a solver: docs/dev/extending.md.
 #include <cstdint>
 #include <span>
 #include <string>
 
 #include "sphxr/sim/params.h"
+#include "sphxr/sim/solve_report.h"
 
 namespace sphxr::sim {
-
-struct StepInfo;
-
-/// The values a solver may report of its step (StepInfo's solve fields), by stats-CSV column name.
-enum class SolverStat { kDensityIterations, kDivergenceIterations, kDensityError, kDivergenceError };
-const char* SolverStatName(SolverStat stat);  // "density_iterations", ...
-double SolverStatValue(const StepInfo& info, SolverStat stat);
 
 /// What the stable time step of a method reads.
 struct StableDtInput {
@@ -48,14 +43,20 @@ struct SolverInfo {
   bool acoustic;     // its step and its compression follow the sound speed (the scene check's Mach warnings)
   /// Its stable step for the current state, solver.max_dt included (solver.fixed_dt is clamped to it).
   float (*stableDt)(const StableDtInput& in);
-  std::span<const SolverStat> stats;  // what its steps report, in the stats CSV's order
-  /// Its density solve may stop at solver.max_iterations short of its tolerance (then a warning).
-  bool iterationCap;
+  std::span<const SolveColumn> columns;  // its statistics (its SolveReport's fields), in the stats CSV's order
   /// Bytes of its own per fluid particle, given the neighbour-list slots per particle.
   int64_t (*bytesPerFluid)(int64_t neighbourSlots);
   /// The solver parameter (m/s) that its steps hold every particle's speed to, or nullptr: a scene's
   /// block faster than it is refused, as the start state the method would silently slow down.
   const char* speedCapParam;
+  /// Its own start-up warnings about settings that run but will not give usable water (once, at
+  /// Solver::Create; the table's flags above give the shared ones), or nullptr. `waterHeight`: m from
+  /// the tank's floor to the highest block's top.
+  void (*warnAtStart)(const SceneSetup& scene, float waterHeight);
+  /// Its own parameters for a particle spacing (`--quality auto`): given the scene's parameters and a new
+  /// `spacing`, sets in `*out` the ones of this method that follow the spacing and returns what it set,
+  /// for a message ("" when nothing). nullptr: none of its parameters depends on the spacing.
+  std::string (*paramsForSpacing)(const SolverParams& scene, float spacing, SolverParams* out);
 };
 
 std::span<const SolverInfo> SolverTable();

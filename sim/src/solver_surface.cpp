@@ -1,5 +1,5 @@
-// Solver's surface entry points: parameter checks and defaults, then the backend's HPMC stages
-// (surface_impl.h). See docs/dev/surface.md.
+// Solver's surface entry points (ExtractSurface, BuildSurface, WriteSurface): parameter checks and
+// defaults, then the backend's HPMC stages (surface_impl.h). See docs/dev/surface.md.
 #include <cmath>
 
 #include "backend.h"

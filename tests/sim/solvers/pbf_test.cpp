@@ -1,13 +1,13 @@
-// Position-based fluids (sim/src/solvers/pbf.h, Macklin & Müller 2013): one step against the paper's
+// Position-based fluids (sim/src/solvers/pbf/pbf.h, Macklin & Müller 2013): one step against the paper's
 // algorithm written out here by brute force over every particle pair, in double; still water from the
-// lattice; the extremes of the iteration count; the same bits at every thread count. (cpu against
-// cpu-reference and CUDA: tests/backend/agreement_test.cpp.)
+// lattice; the extremes of the iteration count. (The same bits at every thread count, a restore, cpu
+// against cpu-reference: the conformance suite, conformance_test.cpp; against CUDA:
+// tests/backend/agreement_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <cstring>
 #include <unordered_map>
 
 #include "kernel.h"
@@ -459,26 +459,6 @@ TEST_P(PbfSpeedCap, HoldsAfterEveryVelocityChange) {
 INSTANTIATE_TEST_SUITE_P(Extremes, PbfSpeedCap,
                          ::testing::Values(CapCase{1.0f / 90.0f, 10.0f, 0.0f}, CapCase{0.1f, 10.0f, 0.0f},
                                            CapCase{0.1f, 10.0f, 1.0f}, CapCase{0.1f, 0.0f, 1.0f}));
-
-TEST(Pbf, TheSameBitsAtEveryThreadCount) {
-  SceneSetup scene = test::SmallDamBreak(0.01f);
-  scene.method = sim::SolverMethod::kPbf;
-  sim::HostFluid out[2];
-  for (int t = 0; t < 2; ++t) {
-    sim::SolverConfig config = test::TestConfig();
-    config.threads = t + 1;
-    auto solver = test::CreateOrFail(scene, config);
-    ASSERT_TRUE(solver);
-    for (int s = 0; s < 60; ++s) ASSERT_TRUE(solver->Step().ok());
-    solver->Download(&out[t]);
-  }
-  ASSERT_EQ(out[0].size(), out[1].size());
-  for (size_t i = 0; i < out[0].size(); ++i) {
-    ASSERT_EQ(out[0].id[i], out[1].id[i]);
-    ASSERT_EQ(std::memcmp(&out[0].position[i], &out[1].position[i], sizeof(Vec4)), 0) << "particle " << i;
-    ASSERT_EQ(std::memcmp(&out[0].velocity[i], &out[1].velocity[i], sizeof(Vec4)), 0) << "particle " << i;
-  }
-}
 
 }  // namespace
 }  // namespace sphxr

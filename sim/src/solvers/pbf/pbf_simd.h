@@ -1,5 +1,5 @@
 #pragma once
-// The SIMD forms of position-based fluids' three neighbour passes (solvers/pbf_stages.h): the lambda
+// The SIMD forms of position-based fluids' three neighbour passes (solvers/pbf/pbf_stages.h): the lambda
 // pass, the correction pass and XSPH, per particle over its neighbour list kLanes neighbours at a time
 // (as ForceListStage), and the wall particles of its cells kLanes at a time. The physics is the scalar
 // stage's; the sums' order differs (rounding only), a list that overflowed falls back to the scalar
@@ -18,18 +18,18 @@
 
 #include "cpu/lists.h"
 #include "cpu/simd.h"
-#include "solvers/pbf_stages.h"
+#include "solvers/pbf/pbf_stages.h"
 
 namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {
 
 /// PbfCorr (MM13's s_corr) in every lane from the pairs' W_ij.
-SPHXR_INLINE Lanes CorrLanes(const Physics& ph, Lanes w) {
-  if (ph.pbfCorrK <= 0.0f) return Splat(0.0f);
-  const Lanes wq = w * ph.pbfInvCorrW;
+SPHXR_INLINE Lanes CorrLanes(const PbfConstants& pbf, Lanes w) {
+  if (pbf.corrK <= 0.0f) return Splat(0.0f);
+  const Lanes wq = w * pbf.invCorrW;
   Lanes p = wq;
-  for (int e = 1; e < ph.pbfCorrN; ++e) p *= wq;
-  return -ph.pbfCorrK * p;
+  for (int e = 1; e < pbf.corrN; ++e) p *= wq;
+  return -pbf.corrK * p;
 }
 
 struct PbfLambdaListStage {
@@ -41,6 +41,7 @@ struct PbfLambdaListStage {
       return;
     }
     const Physics& ph = stage.ph;
+    const PbfConstants& pbf = stage.pbf;
     const CubicSpline k = ph.kernel;
     const Vec3 xi = Xyz(stage.fluid.position[i]);
     const PbfView& view = stage.view;
@@ -48,7 +49,7 @@ struct PbfLambdaListStage {
     // zeros where no pair is), and the sum of the pairs' s_corr V grad W_ij.
     SPHXR_ASSERT(view.pairGrad && view.ownCorrection);  // the CPU launcher's kPairCache
     float* cache = PairCacheRow(view.pairGrad, view.pairStride, i);
-    const bool corrected = ph.pbfCorrK > 0.0f;
+    const bool corrected = pbf.corrK > 0.0f;
     const Lanes zero = Splat(0.0f);
     Lanes w = zero, s2 = zero, gx = zero, gy = zero, gz = zero, sx = zero, sy = zero, sz = zero;
     ForListLanes(
@@ -62,7 +63,7 @@ struct PbfLambdaListStage {
           s2 += ax * ax + ay * ay + az * az;
           StorePairBatch(cache, batch, ax, ay, az);
           if (corrected) {
-            const Lanes corr = CorrLanes(ph, wj);
+            const Lanes corr = CorrLanes(pbf, wj);
             sx += corr * ax, sy += corr * ay, sz += corr * az;
           }
         },
@@ -124,6 +125,7 @@ struct PbfXsphListStage {
       return;
     }
     const Physics& ph = stage.ph;
+    const PbfConstants& pbf = stage.pbf;
     const CubicSpline k = ph.kernel;
     const FluidView& f = stage.fluid;
     const Vec3 xi = Xyz(f.position[i]);
@@ -138,7 +140,7 @@ struct PbfXsphListStage {
       ux += (vx - vi.x) * wj, uy += (vy - vi.y) * wj, uz += (vz - vi.z) * wj;
     });
     const Vec3 dv{SumLanes(ux), SumLanes(uy), SumLanes(uz)};
-    stage.view.delta[i] = MakeVec4(dv * (ph.pbfXsph * ph.volume));
+    stage.view.delta[i] = MakeVec4(dv * (pbf.xsph * ph.volume));
   }
 };
 

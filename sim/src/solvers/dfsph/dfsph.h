@@ -1,11 +1,12 @@
 #pragma once
 // Divergence-free SPH (Bender & Koschier 2015, 2017 [BK17]): the accurate solver, whose step follows the
 // flow speed instead of the sound speed. Two Jacobi solves per step, on the velocities: the divergence
-// (before the non-pressure forces) and the density (after them). The stages: solvers/dfsph_stages.h.
+// (before the non-pressure forces) and the density (after them). The stages: solvers/dfsph/dfsph_stages.h.
 #include <thrust/fill.h>
 #include <thrust/reduce.h>
 
-#include "solvers/dfsph_stages.h"
+#include "solvers/dfsph/dfsph_constants.h"
+#include "solvers/dfsph/dfsph_stages.h"
 #include "solvers/step_context.h"
 
 namespace sphxr::sim {
@@ -16,6 +17,9 @@ class DfsphSolver final : public PressureSolver<Traits> {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  /// Its constants from the scene (dfsph_constants.h).
+  void Init(const SceneSetup& scene, const Physics& physics) override { m_c = MakeDfsphConstants(scene, physics); }
+
   Status Step(StepContext<Traits>& ctx) override {
     const Physics& ph = ctx.physics;
     ctx.computing = ctx.n;
@@ -27,8 +31,9 @@ class DfsphSolver final : public PressureSolver<Traits> {
     Prepare(ctx);
     SPHXR_TRY(ctx.Lap(Stage::kDensity));
     // 3. divergence-free solve on the velocities at the start of the step        [BK17 §4.2, alg. 2]
-    if (ph.maxDivergenceIterations > 0) {
-      const Result r = Solve(ctx, false, ph.minDivergenceIterations, ph.maxDivergenceIterations, ph.divergenceTolerance);
+    if (m_c.maxDivergenceIterations > 0) {
+      const Result r =
+          Solve(ctx, false, m_c.minDivergenceIterations, m_c.maxDivergenceIterations, m_c.divergenceTolerance);
       ctx.report.divergenceIterations = r.iterations;
       ctx.report.divergenceError = r.error;
     }
@@ -39,9 +44,10 @@ class DfsphSolver final : public PressureSolver<Traits> {
     SPHXR_TRY(ctx.Lap(Stage::kForces));
     // 5. kick v* = v + dt a, then the density-invariance solve on v*              [BK17 §4.1, alg. 3]
     ctx.Map(DfsphKickStage{ctx.fluid, View(), ctx.dt});
-    const Result r = Solve(ctx, true, ph.minIterations, ph.maxIterations, ph.densityTolerance);
+    const Result r = Solve(ctx, true, m_c.minIterations, m_c.maxIterations, m_c.densityTolerance);
     ctx.report.densityIterations = r.iterations;
     ctx.report.densityError = r.error;
+    ctx.report.densityCapped = r.iterations >= m_c.maxIterations && r.error > m_c.densityTolerance;
     SPHXR_TRY(ctx.Lap(Stage::kPressure));
     // 6. the step's pressure (into the bodies' reaction term), acceleration and, without probes, the drift
     const bool probes = ctx.HasProbes();
@@ -125,10 +131,11 @@ class DfsphSolver final : public PressureSolver<Traits> {
                      m_pairStride};
   }
 
-  /// Whether the launcher's SIMD passes keep G_ij lane-blocked (the CPU's, cpu/dfsph.h) in place of the
+  /// Whether the launcher's SIMD passes keep G_ij lane-blocked (the CPU's, solvers/dfsph/dfsph_simd.h) in place of the
   /// scalar stages' Vec3 a slot.
   static constexpr bool kPairCache = kLauncherPairCache<Traits>;
 
+  DfsphConstants m_c{};
   Vector<Vec3> m_grad;       // G_ij a neighbour slot (the scalar stages)
   Vector<float> m_pairGrad;  // the same, lane-blocked (kPairCache)
   int m_pairStride = 0;

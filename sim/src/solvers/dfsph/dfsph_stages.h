@@ -1,7 +1,7 @@
 #pragma once
 // The stages of divergence-free SPH (Bender & Koschier, "Divergence-free smoothed particle
 // hydrodynamics", SCA 2015; "Divergence-free SPH for incompressible and highly viscous fluids", TVCG 2017
-// [BK17]), host+device functors for both backends; their order is DfsphSolver::Step (solvers/dfsph.h).
+// [BK17]), host+device functors for both backends; their order is DfsphSolver::Step (solvers/dfsph/dfsph.h).
 //
 //   factor       G_ij = V grad W_ij for every neighbour slot (cached: positions do not move until the
 //                drift), the boundary terms gB_i = sum_b V_b grad W_ib and sB_i = sum_b V_b v_b . grad W_ib,
@@ -40,8 +40,8 @@ struct DfsphView {
   float* delta;           // this iteration's stiffness increment
   uint64_t* error;        // this iteration's residual of each particle, fixed point (ErrorToFixed)
   Vec4* velocityStart;    // v* (after the non-pressure forces), for the step's acceleration
-  // The CPU's SIMD passes (cpu/dfsph.h) keep G_ij here, lane-blocked (PairCacheStride floats a particle),
-  // in place of `grad`; nullptr on the backends that run the scalar stages.
+  // The CPU's SIMD passes (dfsph_simd.h) keep G_ij here, lane-blocked (PairCacheStride floats a
+  // particle), in place of `grad`; nullptr on the backends that run the scalar stages.
   float* pairGrad = nullptr;
   int pairStride = 0;
 };

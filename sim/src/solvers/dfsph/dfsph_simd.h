@@ -1,8 +1,8 @@
 #pragma once
-// The SIMD forms of DFSPH's three neighbour passes (solvers/dfsph_stages.h): the factor, and the two
+// The SIMD forms of DFSPH's three neighbour passes (solvers/dfsph/dfsph_stages.h): the factor, and the two
 // passes of each Jacobi iteration (Predict: D rho^_i/Dt; Correct: the velocity update), per particle over
 // its neighbour list kLanes neighbours at a time, and the factor's wall particles kLanes at a time (as
-// the PBF passes, cpu/pbf.h). The physics is the scalar stages'; the sums' order differs (rounding
+// the PBF passes, solvers/pbf/pbf_simd.h). The physics is the scalar stages'; the sums' order differs (rounding
 // only), a list that overflowed falls back to the scalar stage (a scan of the cells, no cache), and the
 // paddles' particles (a few near any fluid particle) stay scalar. CpuLauncher::ForEach runs these in place
 // of the scalar stages (SimdForm); the CUDA backend and cpu-reference run the scalar ones.
@@ -16,7 +16,7 @@
 
 #include "cpu/lists.h"
 #include "cpu/simd.h"
-#include "solvers/dfsph_stages.h"
+#include "solvers/dfsph/dfsph_stages.h"
 
 namespace sphxr::sim {
 inline namespace SPHXR_CPU_TIER {

@@ -2,13 +2,13 @@
 // Position-based fluids (Macklin & Müller, "Position Based Fluids", ACM TOG 32(4), SIGGRAPH 2013
 // [MM13]): the real-time solver. A fixed number of Jacobi iterations of the density constraint on
 // predicted positions per step, so a step costs the same at any speed and the water can advance by
-// one displayed frame per step (docs/design/pbf.md). The stages: solvers/pbf_stages.h.
+// one displayed frame per step (docs/design/pbf.md). The stages: solvers/pbf/pbf_stages.h.
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/transform_reduce.h>
 
-#include "solvers/pbf_stages.h"
+#include "solvers/pbf/pbf_stages.h"
 #include "solvers/step_context.h"
 
 namespace sphxr::sim {
@@ -19,9 +19,13 @@ class PbfSolver final : public PressureSolver<Traits> {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  /// Its constants from the scene (pbf_constants.h).
+  void Init(const SceneSetup& scene, const Physics& physics) override { m_c = MakePbfConstants(scene, physics); }
+
   /// 1. predict: v* = v + dt g, x* = x + dt v* (before the grid: it is built at x*)     [MM13 alg. 1]
   void BeforeGrid(const FluidView& fluid, const Physics& ph, float dt) override {
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), fluid.count, PbfPredictStage{fluid, ph, dt});
+    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), fluid.count,
+                       PbfPredictStage{fluid, ph, m_c, dt});
   }
 
   Status Step(StepContext<Traits>& ctx) override {
@@ -35,30 +39,31 @@ class PbfSolver final : public PressureSolver<Traits> {
     const NeighbourList list = ctx.Neighbours();
     const PbfView view = View(ph.maxNeighbours);
     thrust::fill(Traits::Policy(), m_lambdaSum.begin(), m_lambdaSum.end(), 0.0f);
-    for (int k = 0; k < ph.pbfIterations; ++k) {
-      ctx.Launch().ForEach(ctx.n, 64, PbfLambdaStage{ctx.grid, ctx.fluid, list, ph, view});
-      ctx.Launch().ForEach(ctx.n, 64, PbfCorrectStage{ctx.grid, ctx.fluid, list, ph, view});
-      ctx.Map(PbfApplyStage{ctx.fluid, ph, view});
+    for (int k = 0; k < m_c.iterations; ++k) {
+      ctx.Launch().ForEach(ctx.n, 64, PbfLambdaStage{ctx.grid, ctx.fluid, list, ph, m_c, view});
+      ctx.Launch().ForEach(ctx.n, 64, PbfCorrectStage{ctx.grid, ctx.fluid, list, ph, m_c, view});
+      ctx.Map(PbfApplyStage{ctx.fluid, ph, m_c, view});
     }
-    ctx.report.densityIterations = ph.pbfIterations;
+    ctx.report.densityIterations = m_c.iterations;
     const thrust::counting_iterator<int> first(0);
     const double residual = thrust::transform_reduce(Traits::Policy(), first, first + ctx.n,
                                                      PbfResidual{ctx.fluid, ph.invRestDensity}, 0.0, thrust::plus<double>());
     ctx.report.densityError = ctx.n > 0 ? static_cast<float>(residual / ctx.n) : 0.0f;
     SPHXR_TRY(ctx.Lap(Stage::kPressure));
     // 4. velocities from the position change, the clamps, the pressure estimate            [MM13 alg. 1]
-    ctx.Map(PbfFinishStage{ctx.fluid, ph, view, ctx.dt, ctx.BodyPressureTerm()});
+    ctx.Map(PbfFinishStage{ctx.fluid, ph, m_c, view, ctx.dt, ctx.BodyPressureTerm()});
     // 5. XSPH viscosity                                                                   [MM13 eq. 17]
-    if (ph.pbfXsph > 0.0f) {
-      ctx.Launch().ForEach(ctx.n, 64, PbfXsphStage{ctx.grid, ctx.fluid, list, ph, view});
-      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, ph, view});
+    if (m_c.xsph > 0.0f) {
+      ctx.Launch().ForEach(ctx.n, 64, PbfXsphStage{ctx.grid, ctx.fluid, list, ph, m_c, view});
+      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, m_c, view});
     }
     // 5b. vorticity confinement, when the scene asks for it                            [MM13 eq. 15-16]
-    if (ph.pbfVorticity > 0.0f) {
+    if (m_c.vorticity > 0.0f) {
       if (m_vorticity.size() != static_cast<size_t>(ctx.n)) m_vorticity.resize(static_cast<size_t>(ctx.n));
       ctx.Launch().ForEach(ctx.n, 64, PbfVorticityStage{ctx.grid, ctx.fluid, list, ph, Raw(m_vorticity)});
-      ctx.Launch().ForEach(ctx.n, 64, PbfConfinementStage{ctx.grid, ctx.fluid, list, ph, view, Raw(m_vorticity), ctx.dt});
-      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, ph, view});
+      ctx.Launch().ForEach(ctx.n, 64,
+                           PbfConfinementStage{ctx.grid, ctx.fluid, list, ph, m_c, view, Raw(m_vorticity), ctx.dt});
+      ctx.Map(PbfAddVelocityChangeStage{ctx.fluid, m_c, view});
     }
     SPHXR_TRY(ctx.Lap(Stage::kIntegrate));
     // 6. the fluid's force on the paddles: the impulse of the corrections their particles caused
@@ -81,7 +86,7 @@ class PbfSolver final : public PressureSolver<Traits> {
 
  private:
   /// Whether the backend's launcher runs the SIMD passes that keep the lambda pass's pair terms (the
-  /// CPU's, cpu/pbf.h); the others recompute them and need no pair array.
+  /// CPU's, solvers/pbf/pbf_simd.h); the others recompute them and need no pair array.
   static constexpr bool kPairCache = kLauncherPairCache<Traits>;
 
   void Size(int n) {
@@ -104,6 +109,7 @@ class PbfSolver final : public PressureSolver<Traits> {
     return v;
   }
 
+  PbfConstants m_c{};
   Vector<float> m_lambda, m_lambdaSum;
   Vector<Vec4> m_delta, m_boundaryGrad;
   Vector<float> m_pairGrad;        // the CPU's pair cache (PbfView::pairGrad)

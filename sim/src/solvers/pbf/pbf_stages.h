@@ -1,6 +1,6 @@
 #pragma once
 // The stages of position-based fluids (Macklin & Müller, "Position Based Fluids", ACM TOG 32(4), 2013
-// [MM13]), host+device functors for both backends; their order is PbfSolver::Step (solvers/pbf.h).
+// [MM13]), host+device functors for both backends; their order is PbfSolver::Step (solvers/pbf/pbf.h).
 //
 //   predict   v* = v + dt g (capped at pbf_max_speed), x* = x + dt v*; the step's start position x
 //             is kept in acceleration.xyz until the finish (the field list sorts it with the particle)
@@ -23,6 +23,7 @@
 // p_i / rho_i^2 = -Lambda_i / (rho0 dt^2), Lambda_i = the sum of lambda_i over the step's iterations.
 // In still water the corrections hold each layer against gravity, so the estimate is rho0 g depth
 // there; the probes, the haptics and the paddles' reaction read it.
+#include "solvers/pbf/pbf_constants.h"
 #include "stages.h"
 
 namespace sphxr::sim {
@@ -34,7 +35,7 @@ struct PbfView {
   Vec4* delta;         // this iteration's position correction (xsph: the velocity change)
   Vec4* boundaryGrad;  // B_i = sum_b (Psi_b / rho0) grad W_ib over the walls and paddles, from the lambda
                        // pass: the correction's boundary term is lambda_i B_i (positions do not move between)
-  // The CPU's SIMD passes only (cpu/pbf.h; nullptr on the other backends): the lambda pass keeps
+  // The CPU's SIMD passes only (solvers/pbf/pbf_simd.h; nullptr on the other backends): the lambda pass keeps
   // V grad W_ij of each list slot, and lambda_i (sum_j V grad W_ij + B_i) + sum_j s_corr V grad W_ij of each
   // particle, so the correction pass adds sum_j lambda_j V grad W_ij without evaluating the kernel again.
   float* pairGrad;     // pairStride floats a particle: per kLanes slots, the x, y and z of kLanes pairs
@@ -44,13 +45,13 @@ struct PbfView {
 
 
 /// The collision response of MM13's solver loop: x* moved out of the tank's faces and the obstacles to
-/// the particle's radius from them (ph.pbfContact beyond the clamp box, whose inset is a quarter
+/// the particle's radius from them (pbf.contact beyond the clamp box, whose inset is a quarter
 /// spacing). The walls' boundary particles alone are soft in the constraint: a particle pushed towards
 /// a sheet leaves its fluid neighbours behind as it nears the walls' ones, and its density rises by
 /// 2.5 % only at the clamp box (docs/design/pbf.md), too little against the corrections of a column
 /// above it. Returns whether it moved the particle (the step's clamp count does not include it).
-SPHXR_HD SPHXR_INLINE bool PbfCollide(const Physics& ph, Vec4* x) {
-  const float g = ph.pbfContact;
+SPHXR_HD SPHXR_INLINE bool PbfCollide(const Physics& ph, const PbfConstants& pbf, Vec4* x) {
+  const float g = pbf.contact;
   Vec4 unused{};  // the velocity follows from the positions at the step's end
   const Vec3 lo{ph.domainMin.x + g, ph.domainMin.y + g, ph.domainMin.z + g};
   const Vec3 hi{ph.domainMax.x - g, ph.closedTop ? ph.domainMax.y - g : ph.domainMax.y, ph.domainMax.z - g};
@@ -64,10 +65,10 @@ SPHXR_HD SPHXR_INLINE bool PbfCollide(const Physics& ph, Vec4* x) {
 }
 
 /// |v| at most pbf_max_speed, its direction kept: the safety net after every change of the velocity.
-SPHXR_HD SPHXR_INLINE void PbfCapSpeed(const Physics& ph, Vec4* v) {
+SPHXR_HD SPHXR_INLINE void PbfCapSpeed(const PbfConstants& pbf, Vec4* v) {
   const float speed2 = v->x * v->x + v->y * v->y + v->z * v->z;
-  if (speed2 > ph.pbfMaxSpeed * ph.pbfMaxSpeed) {
-    const float s = ph.pbfMaxSpeed / sqrtf(speed2);
+  if (speed2 > pbf.maxSpeed * pbf.maxSpeed) {
+    const float s = pbf.maxSpeed / sqrtf(speed2);
     v->x *= s, v->y *= s, v->z *= s;
   }
 }
@@ -77,6 +78,7 @@ SPHXR_HD SPHXR_INLINE void PbfCapSpeed(const Physics& ph, Vec4* v) {
 struct PbfPredictStage {
   FluidView fluid;
   Physics ph;
+  PbfConstants pbf;
   float dt;
   SPHXR_HD void operator()(int i) const {
     Vec4 x = fluid.position[i];
@@ -84,12 +86,12 @@ struct PbfPredictStage {
     v.x += dt * ph.gravity.x;
     v.y += dt * ph.gravity.y;
     v.z += dt * ph.gravity.z;
-    PbfCapSpeed(ph, &v);
+    PbfCapSpeed(pbf, &v);
     fluid.acceleration[i] = Vec4{x.x, x.y, x.z, 0.0f};
     x.x += dt * v.x;
     x.y += dt * v.y;
     x.z += dt * v.z;
-    PbfCollide(ph, &x);
+    PbfCollide(ph, pbf, &x);
     fluid.position[i] = x;
     fluid.velocity[i] = v;
   }
@@ -142,6 +144,7 @@ struct PbfLambdaStage {
   FluidView fluid;
   NeighbourList list;
   Physics ph;
+  PbfConstants pbf;
   PbfView view;
   SPHXR_HD void operator()(int i) const {
     const CubicSpline k = ph.kernel;
@@ -168,11 +171,11 @@ struct PbfLambdaStage {
     gradI += gradB;
     Finish(i, ph.mass * sumW + sumBoundary, sum2 + Dot(gradI, gradI));
   }
-  /// rho_i, and lambda_i from it and sum_k |grad_k C_i|^2 (also the CPU's SIMD form's end, cpu/pbf.h).
+  /// rho_i, and lambda_i from it and sum_k |grad_k C_i|^2 (also the CPU's SIMD form's end, solvers/pbf/pbf_simd.h).
   SPHXR_HD SPHXR_INLINE float Finish(int i, float rho, float gradSum2) const {
     fluid.density[i] = rho;
     const float c = AtLeast(rho * ph.invRestDensity - 1.0f, 0.0f);
-    const float lambda = -c / (gradSum2 + ph.pbfRelaxation);
+    const float lambda = -c / (gradSum2 + pbf.relaxation);
     view.lambda[i] = lambda;
     view.lambdaSum[i] += lambda;
     return lambda;
@@ -180,12 +183,12 @@ struct PbfLambdaStage {
 };
 
 /// MM13's artificial pressure s_corr = -k (W(r) / W(dq))^n of a pair at distance r with W(r) = w [eq. 13].
-SPHXR_HD SPHXR_INLINE float PbfCorr(const Physics& ph, float w) {
-  if (ph.pbfCorrK <= 0.0f) return 0.0f;
-  const float wq = w * ph.pbfInvCorrW;
+SPHXR_HD SPHXR_INLINE float PbfCorr(const PbfConstants& pbf, float w) {
+  if (pbf.corrK <= 0.0f) return 0.0f;
+  const float wq = w * pbf.invCorrW;
   float p = wq;
-  for (int e = 1; e < ph.pbfCorrN; ++e) p *= wq;
-  return -ph.pbfCorrK * p;
+  for (int e = 1; e < pbf.corrN; ++e) p *= wq;
+  return -pbf.corrK * p;
 }
 
 struct PbfCorrectStage {
@@ -193,6 +196,7 @@ struct PbfCorrectStage {
   FluidView fluid;
   NeighbourList list;
   Physics ph;
+  PbfConstants pbf;
   PbfView view;
   SPHXR_HD void operator()(int i) const {
     const CubicSpline k = ph.kernel;
@@ -201,7 +205,7 @@ struct PbfCorrectStage {
     const float volume = ph.volume;
     Vec3 dx{0.0f, 0.0f, 0.0f};
     ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t j, Vec3 d, float r) {
-      const float corr = PbfCorr(ph, k.W(r));
+      const float corr = PbfCorr(pbf, k.W(r));
       dx += d * ((li + view.lambda[j] + corr) * volume * k.GradFactor(r));
     });
     dx += Xyz(view.boundaryGrad[i]) * li;  // sum_b lambda_i (Psi_b / rho0) grad W_ib
@@ -213,6 +217,7 @@ struct PbfCorrectStage {
 struct PbfApplyStage {
   FluidView fluid;
   Physics ph;
+  PbfConstants pbf;
   PbfView view;
   SPHXR_HD void operator()(int i) const {
     Vec4 x = fluid.position[i];
@@ -220,7 +225,7 @@ struct PbfApplyStage {
     x.x += d.x;
     x.y += d.y;
     x.z += d.z;
-    PbfCollide(ph, &x);
+    PbfCollide(ph, pbf, &x);
     fluid.position[i] = x;
   }
 };
@@ -230,6 +235,7 @@ struct PbfApplyStage {
 struct PbfFinishStage {
   FluidView fluid;
   Physics ph;
+  PbfConstants pbf;
   PbfView view;
   float dt;
   float* bodyPressureTerm;  // nullptr without bodies
@@ -240,7 +246,7 @@ struct PbfFinishStage {
     const float inv = 1.0f / dt;
     Vec4 v{(x.x - start.x) * inv, (x.y - start.y) * inv, (x.z - start.z) * inv, vStar.w};
     // The safety net holds for the velocity the corrections give too, not only the predicted one.
-    PbfCapSpeed(ph, &v);
+    PbfCapSpeed(pbf, &v);
     bool clamped = ph.obstacleCount > 0 && ClampOutOfObstacles(ph, &x, &v);
     clamped = ClampToDomain(ph, &x, &v) || clamped;
     // v* = v^n + dt g: the step's acceleration is (v - v^n) / dt = (v - v*) / dt + g.
@@ -263,6 +269,7 @@ struct PbfXsphStage {
   FluidView fluid;
   NeighbourList list;
   Physics ph;
+  PbfConstants pbf;
   PbfView view;
   SPHXR_HD void operator()(int i) const {
     const CubicSpline k = ph.kernel;
@@ -272,7 +279,7 @@ struct PbfXsphStage {
     ForEachWithin(grid, fluid, list, i, xi, k, [&](uint32_t j, Vec3, float r) {
       dv += (Xyz(fluid.velocity[j]) - vi) * k.W(r);
     });
-    view.delta[i] = MakeVec4(dv * (ph.pbfXsph * ph.volume));
+    view.delta[i] = MakeVec4(dv * (pbf.xsph * ph.volume));
   }
 };
 
@@ -280,7 +287,7 @@ struct PbfXsphStage {
 /// confinement's), which can push a particle past the cap the finish held it to.
 struct PbfAddVelocityChangeStage {
   FluidView fluid;
-  Physics ph;
+  PbfConstants pbf;
   PbfView view;
   SPHXR_HD void operator()(int i) const {
     Vec4 v = fluid.velocity[i];
@@ -288,7 +295,7 @@ struct PbfAddVelocityChangeStage {
     v.x += d.x;
     v.y += d.y;
     v.z += d.z;
-    PbfCapSpeed(ph, &v);
+    PbfCapSpeed(pbf, &v);
     fluid.velocity[i] = v;
   }
 };
@@ -322,6 +329,7 @@ struct PbfConfinementStage {
   FluidView fluid;
   NeighbourList list;
   Physics ph;
+  PbfConstants pbf;
   PbfView view;
   const Vec4* vorticity;
   float dt;
@@ -337,7 +345,7 @@ struct PbfConfinementStage {
     // that is flat within rounding has no direction to confine toward).
     const float length = AtLeast(Length(eta), 1e-3f * wi.w * k.invH);
     Vec3 dv{0.0f, 0.0f, 0.0f};
-    if (length > 0.0f) dv = Cross(eta * (1.0f / length), Xyz(wi)) * (ph.pbfVorticity * dt);
+    if (length > 0.0f) dv = Cross(eta * (1.0f / length), Xyz(wi)) * (pbf.vorticity * dt);
     view.delta[i] = MakeVec4(dv);
   }
 };

@@ -10,6 +10,9 @@ namespace sphxr::sim {
 template <class Traits>
 class WcsphSolver final : public PressureSolver<Traits> {
  public:
+  /// No constants of its own: the Tait equation's are the shared Physics (the density stage's pressure).
+  void Init(const SceneSetup& /*scene*/, const Physics& /*physics*/) override {}
+
   Status Step(StepContext<Traits>& ctx) override {
     const Physics& ph = ctx.physics;
     ctx.computing = ctx.n;

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "solvers/pbf/pbf_rules.h"
 #include "sphxr/app/quality.h"
 #include "support.h"
 
@@ -34,9 +35,9 @@ TEST(QualityTest, ChoiceIsMeasuredLoggedAndWithinTheAllowedRange) {
   chosen.params.spacing = choice.spacing;
   EXPECT_EQ(choice.fluid, sim::CountParticles(chosen).fluid);
   if (choice.method == sim::SolverMethod::kPbf) {
-    EXPECT_EQ(choice.pbfSubsteps, app::PbfSubstepsForSpacing(scene.params.pbfSubsteps, 0.01f, choice.spacing));
+    EXPECT_EQ(choice.params.pbfSubsteps, sim::PbfSubstepsForSpacing(scene.params.pbfSubsteps, 0.01f, choice.spacing));
   } else {
-    EXPECT_EQ(choice.pbfSubsteps, 0.0f);
+    EXPECT_EQ(choice.params.pbfSubsteps, scene.params.pbfSubsteps);
   }
   EXPECT_EQ(log.Count(std::string("quality auto: method ") + sim::SolverMethodName(choice.method) + ", spacing",
                       LogLevel::kInfo), 1)
@@ -45,13 +46,13 @@ TEST(QualityTest, ChoiceIsMeasuredLoggedAndWithinTheAllowedRange) {
 
 TEST(QualityTest, PbfSubstepsKeepTheScenesStepPerSpacing) {
   // The fewest substeps with dt / h at most the scene's (3 at 1 cm).
-  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.01f), 3.0f);
-  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.015f), 2.0f);  // 3 x 2/3 exactly, despite rounding
-  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.0177f), 2.0f);
-  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.03f), 1.0f);
-  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.1f), 1.0f);
-  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.005f), 6.0f);
-  EXPECT_EQ(app::PbfSubstepsForSpacing(3.0f, 0.01f, 0.001f), 16.0f);  // pbf_substeps' largest
+  EXPECT_EQ(sim::PbfSubstepsForSpacing(3.0f, 0.01f, 0.01f), 3.0f);
+  EXPECT_EQ(sim::PbfSubstepsForSpacing(3.0f, 0.01f, 0.015f), 2.0f);  // 3 x 2/3 exactly, despite rounding
+  EXPECT_EQ(sim::PbfSubstepsForSpacing(3.0f, 0.01f, 0.0177f), 2.0f);
+  EXPECT_EQ(sim::PbfSubstepsForSpacing(3.0f, 0.01f, 0.03f), 1.0f);
+  EXPECT_EQ(sim::PbfSubstepsForSpacing(3.0f, 0.01f, 0.1f), 1.0f);
+  EXPECT_EQ(sim::PbfSubstepsForSpacing(3.0f, 0.01f, 0.005f), 6.0f);
+  EXPECT_EQ(sim::PbfSubstepsForSpacing(3.0f, 0.01f, 0.001f), 16.0f);  // pbf_substeps' largest
 }
 
 /// PBF still water (PbfStillWater) at `spacing` and `substeps`, 1 s from the lattice: its mean
@@ -74,7 +75,7 @@ TEST(QualityTest, FewerPbfSubstepsAtACoarserSpacingKeepTheScenesCompression) {
   const float reference = PbfStillWaterCompression(0.01f, 3.0f);
   ASSERT_GT(reference, 0.0f);
   for (const float h : {0.015f, 0.03f}) {
-    const float c = PbfStillWaterCompression(h, app::PbfSubstepsForSpacing(3.0f, 0.01f, h));
+    const float c = PbfStillWaterCompression(h, sim::PbfSubstepsForSpacing(3.0f, 0.01f, h));
     ASSERT_GE(c, 0.0f) << "unstable at " << h << " m";
     EXPECT_LE(c, reference) << "at " << h << " m";
   }
