@@ -37,9 +37,9 @@ done
 
 # The unit tier when tests/CMakeLists.txt labels it, else everything but the validation, GPU and
 # integration tiers (and render and xr, not built here); either way without the tests that take over
-# 8 s under the sanitizers (measured: 25 tests, 1,700 of the 1,880 s that all of sim, app and
-# interaction take; each runs in the normal test command), and the conformance suite's cases that take
-# over 0.5 s without them (every row of each: the name matches all of its instances).
+# 8 s under the sanitizers (a few tests that are most of the tier's time there; each runs in the normal
+# test command), and the conformance suite's cases that take over 0.5 s without them (every row of
+# each: the name matches all of its instances).
 slow=(BodyMotion.FollowsTheSegmentWithTheRigidVelocity ConservationTest.MomentumOfCollidingBlocksInAClosedBox
       Wcsph.DensityBlocksFittedToTheParticlesGiveThePairsBits Solvers/Conformance.TheSameBitsAtEveryThreadCount
       Wcsph.OneAndTwoThreadsGiveIdenticalResultsWithReuse Energy.MirroredWallsDoNotConserveIt

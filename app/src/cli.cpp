@@ -1,17 +1,14 @@
 #include "sphxr/app/cli.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <string_view>
-#include <thread>
+#include <vector>
 
-#include "sphxr/app/probe_csv.h"
-#include "sphxr/app/quality.h"
+#include "sphxr/app/probe_config.h"
 #include "sphxr/app/run_arguments.h"
-#include "sphxr/app/state_file.h"
+#include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
 #include "sphxr/render/renderer.h"
@@ -21,7 +18,7 @@ namespace {
 
 Status ParseDouble(const std::string& flag, const char* text, double lo, double hi, double* out) {
   char* end = nullptr;
-  // Decimal only: strtod also reads hexadecimal ("0x10" was 16 s) and "inf".
+  // Decimal only: strtod also reads hexadecimal ("0x10" would be 16 s) and "inf".
   const std::string_view t(text);
   const std::string shown = ShowText(text);
   if (t.find_first_of("xXpP") != std::string_view::npos) return Status::Error(flag + " " + shown + ": not a decimal number");
@@ -46,8 +43,8 @@ Status ParseInt(const std::string& flag, const char* text, int64_t lo, int64_t h
   return Status::Ok();
 }
 
-// An option that does nothing in the run asked for is refused in one line, naming what it needs (each
-// of these was silently ignored).
+// An option that does nothing in the run asked for is refused in one line, naming what it needs
+// (ignoring it silently would let a user believe it acted).
 Status CheckOptionsTakeEffect(const Options& o, const std::vector<std::string>& seen) {
   auto given = [&](const char* flag) {
     for (const std::string& s : seen) {
@@ -71,6 +68,257 @@ Status CheckOptionsTakeEffect(const Options& o, const std::vector<std::string>& 
     }
     if (given("--render") && o.screenshotPath.empty() && o.framesDir.empty()) {
       return Status::Error("--render: --headless makes no picture without --screenshot FILE.png or --frames DIR");
+    }
+  }
+  return Status::Ok();
+}
+
+// ---- the options ----------------------------------------------------------------------------------
+
+// What an option does with its value (null for a flag without one); `flag` as given, for messages.
+using Apply = Status (*)(const std::string& flag, const char* v, Options* o);
+
+struct OptionSpec {
+  const char* flag;
+  // Options of one group exclude each other ("--headless and --desktop: give one of them"); null: the
+  // option is a group of its own.
+  const char* group;
+  bool takesValue;
+  Apply apply;
+};
+
+Status NonEmpty(const std::string& flag, const char* v, const char* why, std::string* out) {
+  if (*v == '\0') return Status::Error(flag + why);
+  *out = v;
+  return Status::Ok();
+}
+
+Status ParseCount(const std::string& flag, const char* v, int64_t lo, int64_t hi, int* out) {
+  int64_t n = 0;
+  if (Status s = ParseInt(flag, v, lo, hi, &n); !s) return s;
+  *out = static_cast<int>(n);
+  return Status::Ok();
+}
+
+// WIDTHxHEIGHT, each from `lo` to 8192.
+Status ParseSize(const std::string& flag, const char* v, int lo, int* width, int* height) {
+  int w = 0, h = 0;
+  char tail = 0;
+  if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < lo || h < lo || w > 8192 || h > 8192) {
+    return Status::Error(Format("%s %s: must be WIDTHxHEIGHT, each from %d to 8192 (e.g. 1280x720)", flag.c_str(),
+                                ShowText(v).c_str(), lo));
+  }
+  *width = w;
+  *height = h;
+  return Status::Ok();
+}
+
+// One of `names` ("ply", "vtk"), else "FLAG VALUE: must be `choices`".
+Status OneOf(const std::string& flag, const char* v, std::initializer_list<const char*> names, const char* choices,
+             std::string* out) {
+  for (const char* name : names) {
+    if (std::string(v) == name) {
+      *out = v;
+      return Status::Ok();
+    }
+  }
+  return Status::Error(flag + " " + ShowText(v) + ": must be " + choices);
+}
+
+// A flag without a value: sets `member` to `value`.
+template <auto member, auto value>
+Status SetFlag(const std::string&, const char*, Options* o) {
+  o->*member = value;
+  return Status::Ok();
+}
+
+// A value kept as given (a file or folder name).
+template <auto member>
+Status Store(const std::string&, const char* v, Options* o) {
+  o->*member = v;
+  return Status::Ok();
+}
+
+Status ApplySet(const std::string&, const char* v, Options* o) {
+  o->sets.emplace_back(v);
+  return Status::Ok();
+}
+
+Status ApplyReuse(const std::string&, const char* v, Options* o) {
+  const std::string r = v;
+  sim::ReuseParams probe;
+  if (r != "on" && r != "off" && !sim::ApplyReusePreset(r, &probe)) {
+    return Status::Error("--reuse " + ShowText(r) + ": must be on, off or a preset (" + sim::ReusePresetNames() + ")");
+  }
+  o->reuse = r == "off" ? 0 : 1;
+  o->reusePreset = (r == "on" || r == "off") ? "" : r;
+  return Status::Ok();
+}
+
+Status ApplyDevice(const std::string& flag, const char* v, Options* o) {
+  if (!sim::ParseDevice(v, &o->device)) return Status::Error(flag + " " + ShowText(v) + ": must be auto, cpu or cuda (or cpu-reference)");
+  return Status::Ok();
+}
+
+Status ApplySpacing(const std::string& flag, const char* v, Options* o) {
+  double h;
+  const sim::ParamInfo* info = sim::FindSolverParam("spacing");
+  if (Status s = ParseDouble(flag, v, info->min, info->max, &h); !s) return s;
+  o->spacing = static_cast<float>(h);
+  return Status::Ok();
+}
+
+Status ApplyQuality(const std::string&, const char* v, Options* o) {
+  const std::string q = v;
+  if (q != "auto" && q != "scene") return Status::Error("--quality " + ShowText(q) + ": must be auto or scene");
+  o->quality = q == "auto" ? 1 : 0;
+  return Status::Ok();
+}
+
+Status ApplyRenderQuality(const std::string& flag, const char* v, Options* o) {
+  render::RenderQuality q;
+  if (!render::ParseRenderQuality(v, &q)) return Status::Error(flag + " " + ShowText(v) + ": must be high, medium or low");
+  o->renderQuality = v;
+  return Status::Ok();
+}
+
+Status ApplyRender(const std::string&, const char* v, Options* o) {
+  const std::string r = v;
+  if (r != "water" && r != "particles") return Status::Error("--render " + ShowText(r) + ": must be water or particles");
+  o->particleImages = r == "particles";
+  return Status::Ok();
+}
+
+// A number of the run's own table (run_arguments.h): --time, --settle, --steps, --threads.
+template <typename T, T Options::*member>
+Status ApplyRunArgument(const std::string& flag, const char* v, Options* o) {
+  double value = 0.0;
+  if (Status s = ParseRunArgument(flag, v, &value); !s) return s;
+  o->*member = static_cast<T>(value);
+  return Status::Ok();
+}
+
+// Every option of the command line, as UsageText lists them.
+const OptionSpec kOptions[] = {
+    {"--help", nullptr, false, SetFlag<&Options::help, true>},
+    {"-h", nullptr, false, SetFlag<&Options::help, true>},
+    {"--print-scene-reference", nullptr, false,
+     SetFlag<&Options::printSceneReference, true>},
+    {"--headless", "mode", false, SetFlag<&Options::mode, Mode::kHeadless>},
+    {"--desktop", "mode", false, SetFlag<&Options::mode, Mode::kDesktop>},
+    {"--xr", "mode", false, SetFlag<&Options::mode, Mode::kXr>},
+    {"--reuse", nullptr, true, ApplyReuse},
+    {"--validate", nullptr, false, SetFlag<&Options::validate, true>},
+    {"--progress", "progress", false, SetFlag<&Options::progress, 1>},
+    {"--no-progress", "progress", false, SetFlag<&Options::progress, 0>},
+    {"--scene", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) {
+       return NonEmpty(f, v, ": give a file name (without --scene: the default scene)", &o->scenePath);
+     }},
+    {"--time", nullptr, true, ApplyRunArgument<double, &Options::time>},
+    {"--settle", nullptr, true, ApplyRunArgument<double, &Options::settle>},
+    {"--steps", nullptr, true, ApplyRunArgument<int64_t, &Options::steps>},
+    {"--threads", nullptr, true, ApplyRunArgument<int, &Options::threads>},
+    {"--load-state", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return NonEmpty(f, v, ": give a file name", &o->loadState); }},
+    {"--save-state", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return NonEmpty(f, v, ": give a file name", &o->saveState); }},
+    {"--device", nullptr, true, ApplyDevice},
+    {"--spacing", nullptr, true, ApplySpacing},
+    {"--set", nullptr, true, ApplySet},
+    {"--export-every", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseInt(f, v, 1, int64_t{1} << 40, &o->exportEvery); }},
+    {"--out", nullptr, true, Store<&Options::outDir>},
+    {"--export-format", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return OneOf(f, v, {"ply", "vtk"}, "ply or vtk", &o->exportFormat); }},
+    {"--export-surface-every", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseInt(f, v, 1, int64_t{1} << 40, &o->exportSurfaceEvery); }},
+    {"--surface-format", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return OneOf(f, v, {"ply", "obj"}, "ply or obj", &o->surfaceFormat); }},
+    {"--screenshot", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) {
+       return NonEmpty(f, v, ": give a file name (without --screenshot: no picture)", &o->screenshotPath);
+     }},
+    {"--frames", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return NonEmpty(f, v, ": give a folder name", &o->framesDir); }},
+    {"--fps", nullptr, true, [](const std::string& f, const char* v, Options* o) { return ParseDouble(f, v, 0.1, 1000.0, &o->fps); }},
+    {"--image-size", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseSize(f, v, 16, &o->imageWidth, &o->imageHeight); }},
+    {"--window-size", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseSize(f, v, 64, &o->windowWidth, &o->windowHeight); }},
+    {"--frame-limit", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseCount(f, v, 1, 1 << 30, &o->frameLimit); }},
+    {"--quality", nullptr, true, ApplyQuality},
+    {"--render-quality", nullptr, true, ApplyRenderQuality},
+    {"--frame-stats", nullptr, true, Store<&Options::frameStatsPath>},
+    {"--gl-debug", nullptr, false, SetFlag<&Options::glDebug, true>},
+    {"--no-vsync", nullptr, false, SetFlag<&Options::vsync, false>},
+    {"--render", nullptr, true, ApplyRender},
+    {"--checkpoint-every", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseDouble(f, v, 1e-6, 1e6, &o->checkpointEvery); }},
+    {"--checkpoint-keep", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseCount(f, v, 1, 100, &o->checkpointKeep); }},
+    // (As probes.every: an interval below a microsecond exports every step of any run.)
+    {"--export-interval", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return ParseDouble(f, v, kMinProbeInterval, 1e6, &o->exportInterval); }},
+    {"--export-surface-interval", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) {
+       return ParseDouble(f, v, kMinProbeInterval, 1e6, &o->exportSurfaceInterval);
+     }},
+    {"--probes", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return NonEmpty(f, v, ": needs a file name", &o->probesPath); }},
+    {"--stats", nullptr, true,
+     [](const std::string& f, const char* v, Options* o) { return NonEmpty(f, v, ": needs a file name", &o->statsPath); }},
+};
+
+const OptionSpec* FindOption(const std::string& arg) {
+  for (const OptionSpec& spec : kOptions) {
+    if (arg == spec.flag) return &spec;
+  }
+  return nullptr;
+}
+
+// Each option once, except --set; the options of a group (the modes, --progress/--no-progress) count as
+// one. `seen` holds "GROUP FLAG" of the options given so far.
+Status CheckGivenOnce(const std::string& arg, const OptionSpec* spec, std::vector<std::string>* seen) {
+  if (arg == "--set" || arg.rfind("--", 0) != 0) return Status::Ok();
+  const std::string group = spec && spec->group ? spec->group : arg;
+  for (const std::string& earlier : *seen) {
+    if (earlier.substr(0, earlier.find(' ')) != group) continue;
+    const std::string first = earlier.substr(earlier.find(' ') + 1);
+    if (first == arg) return Status::Error(ShowText(arg) + " is given twice: give it once");
+    return Status::Error(first + " and " + arg + ": give one of them");
+  }
+  seen->push_back(group + " " + arg);
+  return Status::Ok();
+}
+
+// The value after argv[*i] (moving *i on to it). An option is never another option's value (`--stats
+// --validate` must not write a file named --validate); a file whose name starts with "--" is given as
+// ./--name.
+Status TakeValue(const std::string& arg, int argc, const char* const* argv, int* i, const char** v) {
+  if (*i + 1 >= argc) return Status::Error(arg + ": missing value (see --help)");
+  const std::string next = argv[*i + 1];
+  if (next.size() > 2 && next.rfind("--", 0) == 0) {
+    return Status::Error(arg + ": missing value before " + ShowText(next) + " (a value that starts with -- is "
+                               "written ./" + ShowText(next) + " for a file)");
+  }
+  *v = argv[++*i];
+  return Status::Ok();
+}
+
+// Options that exclude each other's values.
+Status CheckExclusions(const Options& o) {
+  if (o.time > 0.0 && o.steps > 0) return Status::Error("--time and --steps: give one, not both");
+  if (o.exportEvery > 0 && o.exportInterval > 0.0) {
+    return Status::Error("--export-every and --export-interval: give one, not both");
+  }
+  if (o.exportSurfaceEvery > 0 && o.exportSurfaceInterval > 0.0) {
+    return Status::Error("--export-surface-every and --export-surface-interval: give one, not both");
+  }
+  for (const std::string& set : o.sets) {
+    if (o.spacing > 0.0f && set.rfind("spacing=", 0) == 0) {
+      return Status::Error("--spacing and --set " + ShowText(set, 40) + ": give one of them");
     }
   }
   return Status::Ok();
@@ -156,211 +404,19 @@ std::string UsageText() {
 
 Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
   *out = Options{};
-  // Each option once (a repeated --steps kept the last without a word), except --set; the mode flags
-  // and --progress/--no-progress count as one option each.
-  std::vector<std::string> seen;
+  std::vector<std::string> seen;  // "GROUP FLAG" of each option given (CheckGivenOnce)
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg != "--set" && arg.rfind("--", 0) == 0) {
-      const bool modeFlag = arg == "--headless" || arg == "--desktop" || arg == "--xr";
-      const bool progressFlag = arg == "--progress" || arg == "--no-progress";
-      const std::string group = modeFlag ? "mode" : progressFlag ? "progress" : arg;
-      for (const std::string& earlier : seen) {
-        if (earlier.substr(0, earlier.find(' ')) != group) continue;
-        const std::string first = earlier.substr(earlier.find(' ') + 1);
-        if (first == arg) return Status::Error(ShowText(arg) + " is given twice: give it once");
-        return Status::Error(first + " and " + arg + ": give one of them");
-      }
-      seen.push_back(group + " " + arg);
-    }
-    auto value = [&](const char** v) -> Status {
-      if (i + 1 >= argc) return Status::Error(arg + ": missing value (see --help)");
-      // An option is never another option's value (--stats --validate wrote a file named --validate); a
-      // file whose name starts with "--" is given as ./--name.
-      const std::string next = argv[i + 1];
-      if (next.size() > 2 && next.rfind("--", 0) == 0) {
-        return Status::Error(arg + ": missing value before " + ShowText(next) + " (a value that starts with -- is "
-                                   "written ./" + ShowText(next) + " for a file)");
-      }
-      *v = argv[++i];
-      return Status::Ok();
-    };
+    const OptionSpec* spec = FindOption(arg);
+    if (Status s = CheckGivenOnce(arg, spec, &seen); !s) return s;
+    if (!spec) return Status::Error("unknown argument '" + ShowText(arg) + "' (see --help)");
     const char* v = nullptr;
-    if (arg == "--help" || arg == "-h") {
-      out->help = true;
-    } else if (arg == "--print-scene-reference") {
-      out->printSceneReference = true;
-    } else if (arg == "--headless") {
-      out->mode = Mode::kHeadless;
-    } else if (arg == "--desktop") {
-      out->mode = Mode::kDesktop;
-    } else if (arg == "--xr") {
-      out->mode = Mode::kXr;
-    } else if (arg == "--reuse") {
-      if (Status s = value(&v); !s) return s;
-      const std::string r = v;
-      sim::ReuseParams probe;
-      if (r != "on" && r != "off" && !sim::ApplyReusePreset(r, &probe)) {
-        return Status::Error("--reuse " + ShowText(r) + ": must be on, off or a preset (" + sim::ReusePresetNames() + ")");
-      }
-      out->reuse = r == "off" ? 0 : 1;
-      out->reusePreset = (r == "on" || r == "off") ? "" : r;
-    } else if (arg == "--validate") {
-      out->validate = true;
-    } else if (arg == "--progress") {
-      out->progress = 1;
-    } else if (arg == "--no-progress") {
-      out->progress = 0;
-    } else if (arg == "--scene") {
-      if (Status s = value(&v); !s) return s;
-      if (*v == '\0') return Status::Error("--scene: give a file name (without --scene: the default scene)");
-      out->scenePath = v;
-    } else if (arg == "--time") {
-      if (Status s = value(&v); !s) return s;
-      if (Status s = ParseRunArgument(arg, v, &out->time); !s) return s;
-    } else if (arg == "--settle") {
-      if (Status s = value(&v); !s) return s;
-      if (Status s = ParseRunArgument(arg, v, &out->settle); !s) return s;
-    } else if (arg == "--load-state" || arg == "--save-state") {
-      if (Status s = value(&v); !s) return s;
-      if (*v == '\0') return Status::Error(arg + ": give a file name");
-      (arg == "--load-state" ? out->loadState : out->saveState) = v;
-    } else if (arg == "--steps") {
-      if (Status s = value(&v); !s) return s;
-      double steps = 0.0;
-      if (Status s = ParseRunArgument(arg, v, &steps); !s) return s;
-      out->steps = static_cast<int64_t>(steps);
-    } else if (arg == "--device") {
-      if (Status s = value(&v); !s) return s;
-      if (!sim::ParseDevice(v, &out->device)) return Status::Error(arg + " " + ShowText(v) + ": must be auto, cpu or cuda (or cpu-reference)");
-    } else if (arg == "--threads") {
-      if (Status s = value(&v); !s) return s;
-      double t = 0.0;
-      if (Status s = ParseRunArgument(arg, v, &t); !s) return s;
-      out->threads = static_cast<int>(t);
-    } else if (arg == "--spacing") {
-      if (Status s = value(&v); !s) return s;
-      double h;
-      const sim::ParamInfo* info = sim::FindSolverParam("spacing");
-      if (Status s = ParseDouble(arg, v, info->min, info->max, &h); !s) return s;
-      out->spacing = static_cast<float>(h);
-    } else if (arg == "--set") {
-      if (Status s = value(&v); !s) return s;
-      out->sets.emplace_back(v);
-    } else if (arg == "--export-every") {
-      if (Status s = value(&v); !s) return s;
-      if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->exportEvery); !s) return s;
-    } else if (arg == "--out") {
-      if (Status s = value(&v); !s) return s;
-      out->outDir = v;
-    } else if (arg == "--export-format") {
-      if (Status s = value(&v); !s) return s;
-      out->exportFormat = v;
-      if (out->exportFormat != "ply" && out->exportFormat != "vtk") {
-        return Status::Error(arg + " " + ShowText(v) + ": must be ply or vtk");
-      }
-    } else if (arg == "--export-surface-every") {
-      if (Status s = value(&v); !s) return s;
-      if (Status s = ParseInt(arg, v, 1, int64_t{1} << 40, &out->exportSurfaceEvery); !s) return s;
-    } else if (arg == "--surface-format") {
-      if (Status s = value(&v); !s) return s;
-      out->surfaceFormat = v;
-      if (out->surfaceFormat != "ply" && out->surfaceFormat != "obj") {
-        return Status::Error(arg + " " + ShowText(v) + ": must be ply or obj");
-      }
-    } else if (arg == "--screenshot") {
-      if (Status s = value(&v); !s) return s;
-      if (*v == '\0') return Status::Error("--screenshot: give a file name (without --screenshot: no picture)");
-      out->screenshotPath = v;
-    } else if (arg == "--frames") {
-      if (Status s = value(&v); !s) return s;
-      if (*v == '\0') return Status::Error("--frames: give a folder name");
-      out->framesDir = v;
-    } else if (arg == "--fps") {
-      if (Status s = value(&v); !s) return s;
-      if (Status s = ParseDouble(arg, v, 0.1, 1000.0, &out->fps); !s) return s;
-    } else if (arg == "--image-size") {
-      if (Status s = value(&v); !s) return s;
-      int w = 0, h = 0;
-      char tail = 0;
-      if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192) {
-        return Status::Error(arg + " " + ShowText(v) + ": must be WIDTHxHEIGHT, each from 16 to 8192 (e.g. 1280x720)");
-      }
-      out->imageWidth = w;
-      out->imageHeight = h;
-    } else if (arg == "--window-size") {
-      if (Status s = value(&v); !s) return s;
-      int w = 0, h = 0;
-      char tail = 0;
-      if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 8192 || h > 8192) {
-        return Status::Error(arg + " " + ShowText(v) + ": must be WIDTHxHEIGHT, each from 64 to 8192 (e.g. 1280x720)");
-      }
-      out->windowWidth = w;
-      out->windowHeight = h;
-    } else if (arg == "--frame-limit") {
-      if (Status s = value(&v); !s) return s;
-      int64_t n = 0;
-      if (Status s = ParseInt(arg, v, 1, 1 << 30, &n); !s) return s;
-      out->frameLimit = static_cast<int>(n);
-    } else if (arg == "--quality") {
-      if (Status s = value(&v); !s) return s;
-      const std::string q = v;
-      if (q != "auto" && q != "scene") return Status::Error("--quality " + ShowText(q) + ": must be auto or scene");
-      out->quality = q == "auto" ? 1 : 0;
-    } else if (arg == "--render-quality") {
-      if (Status s = value(&v); !s) return s;
-      render::RenderQuality q;
-      if (!render::ParseRenderQuality(v, &q)) return Status::Error(arg + " " + ShowText(v) + ": must be high, medium or low");
-      out->renderQuality = v;
-    } else if (arg == "--frame-stats") {
-      if (Status s = value(&v); !s) return s;
-      out->frameStatsPath = v;
-    } else if (arg == "--gl-debug") {
-      out->glDebug = true;
-    } else if (arg == "--no-vsync") {
-      out->vsync = false;
-    } else if (arg == "--render") {
-      if (Status s = value(&v); !s) return s;
-      const std::string r = v;
-      if (r != "water" && r != "particles") return Status::Error("--render " + ShowText(r) + ": must be water or particles");
-      out->particleImages = r == "particles";
-    } else if (arg == "--checkpoint-every") {
-      if (Status s = value(&v); !s) return s;
-      if (Status s = ParseDouble(arg, v, 1e-6, 1e6, &out->checkpointEvery); !s) return s;
-    } else if (arg == "--checkpoint-keep") {
-      if (Status s = value(&v); !s) return s;
-      int64_t n = 0;
-      if (Status s = ParseInt(arg, v, 1, 100, &n); !s) return s;
-      out->checkpointKeep = static_cast<int>(n);
-    } else if (arg == "--export-interval" || arg == "--export-surface-interval") {
-      if (Status s = value(&v); !s) return s;
-      double* target = arg == "--export-interval" ? &out->exportInterval : &out->exportSurfaceInterval;
-      // (As probes.every: an interval below a microsecond exports every step of any run.)
-      if (Status s = ParseDouble(arg, v, kMinProbeInterval, 1e6, target); !s) return s;
-    } else if (arg == "--probes") {
-      if (Status s = value(&v); !s) return s;
-      if (v[0] == '\0') return Status::Error("--probes: needs a file name");
-      out->probesPath = v;
-    } else if (arg == "--stats") {
-      if (Status s = value(&v); !s) return s;
-      if (v[0] == '\0') return Status::Error("--stats: needs a file name");
-      out->statsPath = v;
-    } else {
-      return Status::Error("unknown argument '" + ShowText(arg) + "' (see --help)");
+    if (spec->takesValue) {
+      if (Status s = TakeValue(arg, argc, argv, &i, &v); !s) return s;
     }
+    if (Status s = spec->apply(arg, v, out); !s) return s;
   }
-  if (out->time > 0.0 && out->steps > 0) return Status::Error("--time and --steps: give one, not both");
-  if (out->exportEvery > 0 && out->exportInterval > 0.0) {
-    return Status::Error("--export-every and --export-interval: give one, not both");
-  }
-  if (out->exportSurfaceEvery > 0 && out->exportSurfaceInterval > 0.0) {
-    return Status::Error("--export-surface-every and --export-surface-interval: give one, not both");
-  }
-  for (const std::string& set : out->sets) {
-    if (out->spacing > 0.0f && set.rfind("spacing=", 0) == 0) {
-      return Status::Error("--spacing and --set " + ShowText(set, 40) + ": give one of them");
-    }
-  }
+  if (Status s = CheckExclusions(*out); !s) return s;
   if (Status s = CheckOptionsTakeEffect(*out, seen); !s) return s;
 
   // A scene by name: the current directory, the installed scenes, the build's (scene_search.cpp). The
@@ -369,149 +425,6 @@ Status ParseCommandLine(int argc, const char* const* argv, Options* out) {
   const std::string name = out->scenePath.empty() ? "dam_break" : out->scenePath;
   if (!FindScene(name, &out->scenePath)) out->scenePath = name;
   return Status::Ok();
-}
-
-namespace {
-
-// Where a path leads: its symbolic links followed, dangling ones too (weakly_canonical stops at a
-// dangling link, so `link.csv -> z.csv` and `z.csv` looked like two files until z.csv existed).
-std::filesystem::path Resolve(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::path p = fs::absolute(path, ec);
-  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
-    const fs::path target = fs::read_symlink(p, ec);
-    if (ec) break;
-    p = target.is_absolute() ? target : p.parent_path() / target;
-  }
-  return fs::weakly_canonical(p, ec);
-}
-
-// Two paths name the same file: the same inode when both exist (hard links, "./a" and "a"), else the
-// same path once links are followed.
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) return std::filesystem::equivalent(a, b, ec);
-  return Resolve(a) == Resolve(b);
-}
-
-// An output that is one of the run's inputs, or another output, would be destroyed by it (a typo in
-// --stats wiped a state file that took minutes to settle): refused before anything runs. A state saved
-// over the one the run started from is allowed: it was read whole at the start, and is replaced
-// atomically (a checkpoint carried forward).
-Status CheckOutputsAreNotInputs(const Options& options, const SceneFile& scene) {
-  std::vector<std::pair<std::string, std::string>> inputs = {{"the scene", options.scenePath}};
-  if (!options.loadState.empty()) inputs.push_back({"--load-state", options.loadState});
-  for (const std::string& t : scene.inputs) inputs.push_back({"the trajectory", t});
-  const std::pair<const char*, std::string> outputs[] = {
-      {"--stats", options.statsPath}, {"--save-state", options.saveState}, {"--screenshot", options.screenshotPath},
-      {"--probes", options.probesPath}};
-  for (size_t k = 0; k < std::size(outputs); ++k) {
-    const auto& [flag, path] = outputs[k];
-    if (path.empty()) continue;
-    for (const auto& [what, input] : inputs) {
-      if (std::string(flag) == "--save-state" && what == "--load-state") continue;
-      if (SameFile(path, input)) {
-        return Status::Error(Format("%s %s is %s (%s): it would be overwritten; give another file", flag,
-                                    ShowText(path).c_str(), what.c_str(), ShowText(input).c_str()));
-      }
-    }
-    for (size_t j = 0; j < k; ++j) {
-      if (!outputs[j].second.empty() && SameFile(path, outputs[j].second)) {
-        return Status::Error(Format("%s %s is also %s's file: one would overwrite the other; give another file", flag,
-                                    ShowText(path).c_str(), outputs[j].first));
-      }
-    }
-  }
-  return Status::Ok();
-}
-
-}  // namespace
-
-Status LoadSceneWithOptions(const Options& options, SceneFile* scene) {
-  if (Status s = LoadScene(options.scenePath, scene); !s) {
-    std::string path;
-    if (Status where = FindScene(options.scenePath, &path); !where) return where;  // a name found nowhere
-    return s;
-  }
-  if (Status s = CheckOutputsAreNotInputs(options, *scene); !s) return s;
-  // A preset from the command line replaces the scene's reuse parameters; --set reuse.* then overrides.
-  if (!options.reusePreset.empty()) sim::ApplyReusePreset(options.reusePreset, &scene->setup.reuse);
-  for (const std::string& set : options.sets) {
-    if (Status s = SetSolverParam(&scene->setup, set); !s) return s;
-  }
-  if (options.spacing > 0.0f) scene->setup.params.spacing = options.spacing;
-  if (options.reuse >= 0) scene->setup.reuse.enabled = options.reuse == 1;
-  return Status::Ok();
-}
-
-std::string HeadlessOnlyOptions(const Options& options) {
-  std::string out;
-  auto add = [&](bool given, const char* flag) {
-    if (given) out += (out.empty() ? "" : ", ") + std::string(flag);
-  };
-  add(!options.statsPath.empty(), "--stats");
-  add(options.exportEvery > 0, "--export-every");
-  add(options.exportSurfaceEvery > 0, "--export-surface-every");
-  add(options.exportInterval > 0.0, "--export-interval");
-  add(options.exportSurfaceInterval > 0.0, "--export-surface-interval");
-  add(!options.probesPath.empty(), "--probes");
-  add(options.time > 0.0, "--time");
-  add(options.steps > 0, "--steps");
-  add(options.settle >= 0.0, "--settle");
-  add(options.checkpointEvery > 0.0, "--checkpoint-every");
-  return out;
-}
-
-float ExplicitSpacing(const Options& options) {
-  if (options.spacing > 0.0f) return options.spacing;
-  // --set spacing=...: parsed as LoadSceneWithOptions parses it (the last one wins).
-  float spacing = 0.0f;
-  for (const std::string& set : options.sets) {
-    sim::SceneSetup probe;
-    probe.params.spacing = 0.0f;
-    if (set.rfind("spacing=", 0) == 0 && SetSolverParam(&probe, set)) spacing = probe.params.spacing;
-  }
-  return spacing;
-}
-
-Status ApplyAutoQuality(const Options& options, bool wanted, const StateFile* start, const sim::SolverConfig& config,
-                        sim::SceneSetup* setup) {
-  if (!wanted || options.spacing > 0.0f) return Status::Ok();
-  if (start) {
-    SPHXR_LOG_INFO("--quality auto: not with --load-state, whose spacing (%g m) is the file's", start->spacing);
-    return Status::Ok();
-  }
-  QualityChoice choice;
-  if (Status s = ChooseQuality(*setup, config, 1.0, 1.0, &choice); !s) return Status::Error(options.scenePath + ": " + s.message());
-  setup->params = choice.params;  // the chosen spacing and the method's own parameters for it
-  setup->method = choice.method;
-  const bool diffuseSet = std::any_of(options.sets.begin(), options.sets.end(),
-                                      [](const std::string& kv) { return kv.rfind("diffuse=", 0) == 0; });
-  if (TurnOffDiffuseOutOfRealTime(choice.realtime, diffuseSet, &setup->params)) {
-    SPHXR_LOG_INFO("--quality auto: spray, foam and bubbles off (the water runs at %.2f of real time here without "
-                   "them); --set diffuse=1 keeps them",
-                   choice.realtime);
-  }
-  return Status::Ok();
-}
-
-Status PrepareStart(const Options& options, RunStart* out) {
-  if (Status s = LoadSceneWithOptions(options, &out->scene); !s) return s;
-  out->setup = out->scene.setup;
-  return ReadStartState(options.loadState, ExplicitSpacing(options), out->scene.name, &out->setup, &out->state);
-}
-
-sim::SolverConfig InteractiveSolverConfig(const Options& options, bool log) {
-  sim::SolverConfig config;
-  config.device = options.device;
-  config.threads = options.threads;
-  if (options.threads == 0) {
-    // One core is left to the frame loop (and llvmpipe's rasteriser, on machines without a GPU).
-    config.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
-    if (log) SPHXR_LOG_INFO("simulation on %d CPU threads, one core left for drawing (--threads to change)", config.threads);
-  }
-  return config;
 }
 
 }  // namespace sphxr::app

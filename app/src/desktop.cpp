@@ -21,6 +21,8 @@
 
 #include "desktop_impl.h"
 #include "gl_window.h"
+#include "sphxr/app/run_start.h"
+#include "sphxr/app/display.h"
 #include "sphxr/app/param_registry.h"
 #include "sim_worker.h"
 #include "sphxr/app/pictures.h"
@@ -33,12 +35,6 @@ namespace sphxr::app {
 
 DesktopApp::DesktopApp() : m_impl(std::make_unique<Impl>()) {}
 DesktopApp::~DesktopApp() = default;
-
-bool DisplayAvailable() {
-  const char* x = std::getenv("DISPLAY");
-  const char* w = std::getenv("WAYLAND_DISPLAY");
-  return (x && *x) || (w && *w);
-}
 
 Status DesktopApp::Create(const Options& options, std::unique_ptr<DesktopApp>* out) {
   out->reset();

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "gl_window.h"
+#include "interop_surface.h"
 #include "sim_worker.h"
 #include "sphxr/app/desktop.h"
 #include "sphxr/app/pictures.h"
@@ -225,6 +226,13 @@ struct DesktopApp::Impl {
   }
 
   void Panel(const SimSnapshot& snap);
+  // The panel's sections (desktop_panel.cpp).
+  void PanelStatus(const SimSnapshot& snap);
+  void PanelTiming(const SimSnapshot& snap);
+  void PanelProbesAndPaddles(const SimSnapshot& snap);
+  void PanelSolver(const SimSnapshot& snap);
+  void PanelReuse(const SimSnapshot& snap);
+  void PanelRender();
 
   /// The s key and the panel's button: the running state into --save-state's file, else
   /// "<scene name>.state" in the working directory (docs/user/scenes.md "State files").

@@ -10,12 +10,62 @@
 #include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
+namespace {
+
+// Parameters: the one registry (app/src/param_registry.h) that scene files and --set read too. True
+// when an edit of `p` in `setup` is finished (the scene is then rebuilt).
+bool EditParam(const ParamDesc& p, sim::SceneSetup& setup) {
+  bool edited = false;
+  if (p.integer) {
+    int v = static_cast<int>(p.Get(setup));
+    ImGui::DragInt(p.name.c_str(), &v, 0.2f, static_cast<int>(p.min), static_cast<int>(p.max), "%d",
+                   ImGuiSliderFlags_AlwaysClamp);
+    if (ImGui::IsItemDeactivatedAfterEdit() || (ImGui::IsItemEdited() && !ImGui::IsItemActive())) edited = true;
+    if (ImGui::IsItemEdited()) p.Set(&setup, v);
+  } else {
+    float v = static_cast<float>(p.Get(setup));
+    const float lo = static_cast<float>(p.min), hi = static_cast<float>(p.max);
+    if (p.name == "spacing") {
+      // A spacing that would make millions of particles is refused by the solver with a message.
+      ImGui::SliderFloat("spacing (m)", &v, std::max(lo, 5e-4f), std::min(hi, 0.05f), "%.4f",
+                         ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+    } else {
+      ImGui::DragFloat(p.name.c_str(), &v, 0.005f * std::max(std::abs(v), 0.1f), lo, hi, "%.4g",
+                       ImGuiSliderFlags_AlwaysClamp);
+    }
+    if (ImGui::IsItemEdited()) p.Set(&setup, v);
+    edited = ImGui::IsItemDeactivatedAfterEdit();
+  }
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("%s\nrange %g to %g %s, default %g", p.help.c_str(), p.min, p.max, p.unit.c_str(), p.defaultValue);
+  }
+  return edited;
+}
+
+}  // namespace
 
 void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSizeConstraints(ImVec2(260, 80), ImVec2(700, std::max(100.0f, ImGui::GetIO().DisplaySize.y - 20)));
   ImGui::Begin("sphxr");
+  PanelStatus(snap);
+  PanelTiming(snap);
+  PanelProbesAndPaddles(snap);
+  PanelSolver(snap);
+  PanelReuse(snap);
+  PanelRender();
+  ImGui::TextDisabled("left drag: paddle  right drag: orbit  middle drag: pan  wheel: zoom  f: frame");
+  if (hand.active) {
+    ImGui::Text("hand target [%.3f %.3f %.3f] m, speed %.2f m/s", hand.position[0], hand.position[1], hand.position[2],
+                std::sqrt(hand.velocity[0] * hand.velocity[0] + hand.velocity[1] * hand.velocity[1] +
+                          hand.velocity[2] * hand.velocity[2]));
+  }
+  ImGui::End();
+}
+
+// The scene, the run's buttons, the messages and the rates.
+void DesktopApp::Impl::PanelStatus(const SimSnapshot& snap) {
   // Scene
   if (!sceneFiles.empty()) {
     const std::string current = sceneIndex >= 0 ? std::filesystem::path(sceneFiles[sceneIndex]).stem().string() : "(other)";
@@ -52,8 +102,10 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
                        snap.simSecondsPerWallSecond);
   }
   ImGui::Text("display %.1f fps, render %.2f ms", ImGui::GetIO().Framerate, renderMs);
+}
 
-  // Timing graph per stage
+// Timing graph per stage
+void DesktopApp::Impl::PanelTiming(const SimSnapshot& snap) {
   if (ImGui::CollapsingHeader("timing (ms per step / frame)", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (int s = 0; s <= static_cast<int>(sim::Stage::kCount) + 1; ++s) {
       const std::deque<float>& h = stageHistory[s];
@@ -72,7 +124,9 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
       ImGui::TextDisabled("surface: not extracted in particle mode");
     }
   }
+}
 
+void DesktopApp::Impl::PanelProbesAndPaddles(const SimSnapshot& snap) {
   // The scene's probes over the last seconds (its "probes" section).
   if (!snap.probes.empty() && ImGui::CollapsingHeader("probes (last 5 s)", ImGuiTreeNodeFlags_DefaultOpen)) {
     DrawProbePlots(snap.probes, 180.0f);
@@ -91,34 +145,10 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
     ImGui::SameLine();
     ImGui::Text("haptic (%s)", hand.index == 0 ? "left" : "right");
   }
-  // Parameters: the one registry (app/src/param_registry.h) that scene files and --set read too.
-  auto editor = [&](const ParamDesc& p) {
-    bool edited = false;
-    if (p.integer) {
-      int v = static_cast<int>(p.Get(setup));
-      ImGui::DragInt(p.name.c_str(), &v, 0.2f, static_cast<int>(p.min), static_cast<int>(p.max), "%d",
-                     ImGuiSliderFlags_AlwaysClamp);
-      if (ImGui::IsItemDeactivatedAfterEdit() || (ImGui::IsItemEdited() && !ImGui::IsItemActive())) edited = true;
-      if (ImGui::IsItemEdited()) p.Set(&setup, v);
-    } else {
-      float v = static_cast<float>(p.Get(setup));
-      const float lo = static_cast<float>(p.min), hi = static_cast<float>(p.max);
-      if (p.name == "spacing") {
-        // A spacing that would make millions of particles is refused by the solver with a message.
-        ImGui::SliderFloat("spacing (m)", &v, std::max(lo, 5e-4f), std::min(hi, 0.05f), "%.4f",
-                           ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
-      } else {
-        ImGui::DragFloat(p.name.c_str(), &v, 0.005f * std::max(std::abs(v), 0.1f), lo, hi, "%.4g",
-                         ImGuiSliderFlags_AlwaysClamp);
-      }
-      if (ImGui::IsItemEdited()) p.Set(&setup, v);
-      edited = ImGui::IsItemDeactivatedAfterEdit();
-    }
-    if (ImGui::IsItemHovered()) {
-      ImGui::SetTooltip("%s\nrange %g to %g %s, default %g", p.help.c_str(), p.min, p.max, p.unit.c_str(), p.defaultValue);
-    }
-    return edited;
-  };
+}
+
+void DesktopApp::Impl::PanelSolver(const SimSnapshot& snap) {
+  auto editor = [&](const ParamDesc& p) { return EditParam(p, setup); };
   if (ImGui::CollapsingHeader("solver (edits rebuild the scene)")) {
     // The pressure solver by name, as the scene's solver.method: one button per row of the solver table.
     bool first = true;
@@ -146,6 +176,10 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
       if (p.group == "solver" && editor(p)) Rebuild();
     }
   }
+}
+
+void DesktopApp::Impl::PanelReuse(const SimSnapshot& snap) {
+  auto editor = [&](const ParamDesc& p) { return EditParam(p, setup); };
   if (ImGui::CollapsingHeader("activity-based reuse", ImGuiTreeNodeFlags_DefaultOpen)) {
     sim::ReuseParams& r = setup.reuse;
     if (ImGui::Checkbox("reuse on", &r.enabled)) Rebuild();
@@ -160,7 +194,9 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
       if (p.group == "reuse" && editor(p) && r.enabled) Rebuild();
     }
   }
-  // Rendering
+}
+
+void DesktopApp::Impl::PanelRender() {
   if (ImGui::CollapsingHeader("render", ImGuiTreeNodeFlags_DefaultOpen)) {
     int m = static_cast<int>(mode);
     ImGui::RadioButton("water", &m, 0);
@@ -187,13 +223,6 @@ void DesktopApp::Impl::Panel(const SimSnapshot& snap) {
                         surfaceCell * setup.params.spacing);
     }
   }
-  ImGui::TextDisabled("left drag: paddle  right drag: orbit  middle drag: pan  wheel: zoom  f: frame");
-  if (hand.active) {
-    ImGui::Text("hand target [%.3f %.3f %.3f] m, speed %.2f m/s", hand.position[0], hand.position[1], hand.position[2],
-                std::sqrt(hand.velocity[0] * hand.velocity[0] + hand.velocity[1] * hand.velocity[1] +
-                          hand.velocity[2] * hand.velocity[2]));
-  }
-  ImGui::End();
 }
 
 }  // namespace sphxr::app

@@ -8,9 +8,19 @@
 #include <cstdio>
 #include <memory>
 
-#include "headless_sinks.h"
+#include "checkpoint_sink.h"
+#include "dam_break_measure.h"
+#include "export_sink.h"
+#include "output_files.h"
+#include "pictures_sink.h"
+#include "progress.h"
+#include "progress_sink.h"
+#include "save_state_sink.h"
+#include "stats_sink.h"
+#include "summary_sink.h"
 #include "interrupt_scope.h"
 #include "sphxr/app/probe_csv.h"
+#include "sphxr/app/run_start.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/simulation.h"
 #include "sphxr/app/state_file.h"
@@ -28,12 +38,11 @@ struct Target {
   int64_t steps = 0;
 };
 
-/// The summary printed at the end (stdout).
-void PrintSummary(const Options& options, const SceneFile& scene, const Simulation& simulation, const Target& target,
-                  const std::string& movie, bool picture, const RunSummary& s) {
+/// The summary's lines of the run itself: the scene, the particles, the device, the steps and the time,
+/// the stages' cost, the density error and the speed.
+void PrintRunLines(const Options& options, const SceneFile& scene, const Simulation& simulation, const RunSummary& s) {
   const RunSummary* summary = &s;
   const sim::Totals& totals = simulation.Solver().GetTotals();
-  const interaction::PaddleSystem* paddles = simulation.Paddles();
   std::printf("sphxr summary: %s\n", scene.name.empty() ? ShowText(options.scenePath, std::string::npos).c_str() : ShowText(scene.name).c_str());
   std::printf("  particles       %d fluid, %d boundary\n", summary->fluid, summary->boundary);
   const sim::Device device = simulation.Solver().ActiveDevice();
@@ -67,6 +76,12 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
               "end (spray and surface particles are light)\n",
               100.0 * summary->meanDensityError, 100.0 * summary->peakMeanDensityError, 100.0 * summary->maxDensityError);
   std::printf("  max speed       %.3f m/s over the run\n", summary->maxSpeed);
+}
+
+/// The summary's lines of the models and what happened to the water: diffuse particles, reuse, the
+/// settle, an interruption, clamped particles, the dam-break measures.
+void PrintModelLines(const SceneFile& scene, const Target& target, const RunSummary& s) {
+  const RunSummary* summary = &s;
   if (summary->diffuse[0] >= 0) {
     std::printf("  diffuse         %d spray, %d foam, %d bubbles at the end (solver.diffuse_capacity %g)\n",
                 summary->diffuse[0], summary->diffuse[1], summary->diffuse[2], scene.setup.params.diffuseCapacity);
@@ -97,19 +112,26 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
     std::printf("  dam break       surge front Z = %.3f, column height H = %.3f (Martin & Moyce units)\n",
                 summary->surgeFront, summary->columnHeight);
   }
-  if (paddles) {
-    for (int k = 0; k < paddles->Count(); ++k) {
-      const interaction::PaddleDesc& d = paddles->Desc(k);
-      const interaction::PaddleState& p = paddles->State(k);
-      std::printf("  paddle          %s (%s): %d boundary particles, %s, filtered force [%.3g %.3g %.3g] N at the end, "
-                  "%lld teleport(s)\n",
-                  d.name.c_str(), interaction::HolderName(d.holder), paddles->ParticleCount(k),
-                  interaction::PaddleModeName(p.mode), p.force.x, p.force.y, p.force.z, static_cast<long long>(p.teleports));
-    }
-    std::printf("  paddles         mean filtered |force| %.3f N, peak haptic amplitude %.2f, fluid pushed out of a paddle "
-                "%lld times\n",
-                summary->paddleMeanForce, summary->paddlePeakHaptic, static_cast<long long>(summary->pushedOut));
+}
+
+/// The summary's lines of the paddles (one each, then their means).
+void PrintPaddleLines(const interaction::PaddleSystem& paddles, const RunSummary& summary) {
+  for (int k = 0; k < paddles.Count(); ++k) {
+    const interaction::PaddleDesc& d = paddles.Desc(k);
+    const interaction::PaddleState& p = paddles.State(k);
+    std::printf("  paddle          %s (%s): %d boundary particles, %s, filtered force [%.3g %.3g %.3g] N at the end, "
+                "%lld teleport(s)\n",
+                d.name.c_str(), interaction::HolderName(d.holder), paddles.ParticleCount(k),
+                interaction::PaddleModeName(p.mode), p.force.x, p.force.y, p.force.z, static_cast<long long>(p.teleports));
   }
+  std::printf("  paddles         mean filtered |force| %.3f N, peak haptic amplitude %.2f, fluid pushed out of a paddle "
+              "%lld times\n",
+              summary.paddleMeanForce, summary.paddlePeakHaptic, static_cast<long long>(summary.pushedOut));
+}
+
+/// The summary's lines of the files written.
+void PrintOutputLines(const Options& options, const std::string& movie, bool picture, const RunSummary& s) {
+  const RunSummary* summary = &s;
   if (summary->surfaceExports > 0) {
     std::printf("  surface         %lld meshes to %s, %.2f ms per extraction; the last %lld triangles\n",
                 static_cast<long long>(summary->surfaceExports), ShowText(options.outDir, std::string::npos).c_str(), summary->surfaceMs,
@@ -134,6 +156,15 @@ void PrintSummary(const Options& options, const SceneFile& scene, const Simulati
     std::printf("  state           saved to %s at t = %.6g s (sphxr --load-state %s continues from there)\n",
                 summary->stateSaved.c_str(), summary->simulatedTime, summary->stateSaved.c_str());
   }
+}
+
+/// The summary printed at the end (stdout).
+void PrintSummary(const Options& options, const SceneFile& scene, const Simulation& simulation, const Target& target,
+                  const std::string& movie, bool picture, const RunSummary& summary) {
+  PrintRunLines(options, scene, simulation, summary);
+  PrintModelLines(scene, target, summary);
+  if (const interaction::PaddleSystem* paddles = simulation.Paddles()) PrintPaddleLines(*paddles, summary);
+  PrintOutputLines(options, movie, picture, summary);
 }
 
 /// The outputs' files, checked (and the CSV opened, the directories made, the GL context of the pictures
@@ -267,57 +298,125 @@ void Summarise(const SceneFile& scene, const sim::Solver& solver, const SummaryS
   }
 }
 
-}  // namespace
-
-Status RunHeadless(const Options& options, RunSummary* summary) {
-  *summary = RunSummary{};
-  SceneFile scene;
+/// The scene with the command line's changes, the state file it starts from (read before anything is
+/// allocated; it fixes the spacing, ReadStartState refuses a --spacing that differs, and replaces the
+/// settle), the solver's configuration and what the run is to reach.
+Status LoadRun(const Options& options, SceneFile* scene, std::shared_ptr<const StateFile>* state,
+               SimulationConfig* config, Target* target) {
   {
     MemoryUse use("reading the scene (its file is at most 16 MiB)");
-    if (Status s = LoadSceneWithOptions(options, &scene); !s) return s;
+    if (Status s = LoadSceneWithOptions(options, scene); !s) return s;
   }
-  // A state file is read before anything is allocated; it fixes the spacing (ReadStartState refuses a
-  // --spacing that differs) and replaces the settle.
   if (options.checkpointEvery > 0.0 && options.saveState.empty()) {
     return Status::Error("--checkpoint-every: needs --save-state FILE (the checkpoints are that file)");
   }
   if (!options.loadState.empty() && options.settle > 0.0) {
     return Status::Error("--settle and --load-state: the state file is the start; settle in the run that saves it");
   }
-  std::shared_ptr<const StateFile> state;
-  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), scene.name, &scene.setup, &state); !s) return s;
-  SimulationConfig config;
-  config.solver.device = options.device;
-  config.solver.threads = options.threads;
-  config.solver.validate = options.validate;
-  config.errorPrefix = options.scenePath + ": ";
-  if (Status s = ApplyAutoQuality(options, options.quality == 1, state.get(), config.solver, &scene.setup); !s) return s;
+  if (Status s = ReadStartState(options.loadState, ExplicitSpacing(options), scene->name, &scene->setup, state); !s) return s;
+  config->solver.device = options.device;
+  config->solver.threads = options.threads;
+  config->solver.validate = options.validate;
+  config->errorPrefix = options.scenePath + ": ";
+  if (Status s = ApplyAutoQuality(options, options.quality == 1, state->get(), config->solver, &scene->setup); !s) return s;
 
-  Target target{options.time, options.steps};
-  if (target.time <= 0.0 && target.steps <= 0) target = {scene.runTime, scene.runSteps};
-  if (target.time <= 0.0 && target.steps <= 0) {
+  *target = Target{options.time, options.steps};
+  if (target->time <= 0.0 && target->steps <= 0) *target = {scene->runTime, scene->runSteps};
+  if (target->time <= 0.0 && target->steps <= 0) {
     return Status::Error(options.scenePath + ": the scene has no run.time or run.steps; give --time or --steps");
   }
-  if (state && target.steps <= 0 && state->clock.time >= target.time - 1e-9) {
+  if (*state && target->steps <= 0 && (*state)->clock.time >= target->time - 1e-9) {
     return Status::Error(Format("--load-state %s: the state is at t = %.6g s, at or past the end time %g s (--time is "
                                 "the end time on the state's clock)",
-                                options.loadState.c_str(), state->clock.time, target.time));
+                                options.loadState.c_str(), (*state)->clock.time, target->time));
   }
+  return Status::Ok();
+}
 
-  // The outputs' files are checked before the solver allocates anything, so a bad path costs nothing.
+/// The run's sinks, in the order they act after each step: the summary's measures, the CSV row, the
+/// probes, a checkpoint (after the rows it keeps), the exports, the state at the end, pictures, progress.
+/// Those with files (the CSVs, the pictures' GL context) are made before the solver allocates anything.
+struct RunSinks {
   std::unique_ptr<StatsSink> stats;
   std::unique_ptr<ProbeSink> probes;
-  if (!options.probesPath.empty()) {
-    if (!scene.probes) {
-      return Status::Error("--probes " + options.probesPath + ": " + options.scenePath +
-                           " has no \"probes\" section (docs/user/scenes.md#probes)");
-    }
-    if (Status s = ProbeSink::Create(options.probesPath, *scene.probes, state ? state->clock.time : 0.0, &probes); !s) {
-      return s;
-    }
-  }
   std::unique_ptr<PicturesSink> pictures;
-  if (Status s = PrepareOutputs(options, scene, summary, &stats, &pictures); !s) return s;
+  std::unique_ptr<SummarySink> measures;
+  std::unique_ptr<CheckpointSink> checkpoints;
+  std::unique_ptr<ExportSink> exports;
+  std::unique_ptr<SaveStateSink> save;
+  std::unique_ptr<Progress> progress;
+  std::unique_ptr<ProgressSink> progressSink;
+
+  Status Open(const Options& options, const SceneFile& scene, const StateFile* state, RunSummary* summary) {
+    if (!options.probesPath.empty()) {
+      if (!scene.probes) {
+        return Status::Error("--probes " + options.probesPath + ": " + options.scenePath +
+                             " has no \"probes\" section (docs/user/scenes.md#probes)");
+      }
+      if (Status s = ProbeSink::Create(options.probesPath, *scene.probes, state ? state->clock.time : 0.0, &probes); !s) {
+        return s;
+      }
+    }
+    return PrepareOutputs(options, scene, summary, &stats, &pictures);
+  }
+
+  void Attach(const Options& options, const SceneFile& scene, double settle, const Target& target, bool showProgress,
+              bool progressLines, RunSummary* summary, Simulation& simulation) {
+    measures = std::make_unique<SummarySink>(summary);
+    simulation.AddSink(measures.get());
+    if (stats) simulation.AddSink(stats.get());
+    if (probes) simulation.AddSink(probes.get());
+    if (options.checkpointEvery > 0.0) {
+      checkpoints = std::make_unique<CheckpointSink>(options, scene.name, stats.get(), summary);
+      simulation.AddSink(checkpoints.get());
+    }
+    exports = std::make_unique<ExportSink>(options, scene.surface, summary);
+    simulation.AddSink(exports.get());
+    if (!options.saveState.empty()) {
+      save = std::make_unique<SaveStateSink>(options, scene.name, settle, summary);
+      simulation.AddSink(save.get());
+    }
+    if (pictures) simulation.AddSink(pictures.get());
+    progress = std::make_unique<Progress>(showProgress, "", progressLines);
+    progressSink = std::make_unique<ProgressSink>(progress.get(), target.steps, target.time, summary->startTime);
+    simulation.AddSink(progressSink.get());
+  }
+};
+
+/// The steps to the target, or to a signal (then the run stops after the step in progress), and the
+/// sinks' Finish: the rows of a run stopped by a signal too.
+Status StepToTarget(Simulation& simulation, const Target& target, RunSinks& sinks, RunSummary* summary) {
+  sim::Solver& solver = simulation.Solver();
+  if (Status s = simulation.Start(); !s) return s;
+  while (target.steps > 0 ? solver.GetTotals().steps < target.steps : solver.Time() < target.time - 1e-9) {
+    if (g_interrupt) break;
+    if (Status s = simulation.Step(); !s) return s;
+  }
+  summary->wallSeconds = sinks.progressSink->WallSeconds();
+  summary->interrupted = g_interrupt;  // also a signal during the last step
+  if (summary->interrupted) {
+    sinks.progress->Finish();
+    SPHXR_LOG_WARN("%s at step %lld (t = %.4f s): stopping; the summary and the files cover the run so far",
+                   summary->interrupted == SIGINT    ? "interrupted (SIGINT)"
+                   : summary->interrupted == SIGHUP ? "hung up (SIGHUP: the terminal closed)"
+                                                    : "terminated (SIGTERM)",
+                   static_cast<long long>(simulation.WholeStep()), solver.Time());
+  }
+  // A failed save is reported after the summary (which covers the run), not instead of it.
+  return simulation.Finish(summary->interrupted != 0);
+}
+
+}  // namespace
+
+Status RunHeadless(const Options& options, RunSummary* summary) {
+  *summary = RunSummary{};
+  SceneFile scene;
+  std::shared_ptr<const StateFile> state;
+  SimulationConfig config;
+  Target target;
+  if (Status s = LoadRun(options, &scene, &state, &config, &target); !s) return s;
+  RunSinks sinks;
+  if (Status s = sinks.Open(options, scene, state.get(), summary); !s) return s;
 
   SimScene simScene = SimSceneFromFile(scene);
   simScene.start = state;
@@ -326,12 +425,11 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
     MemoryUse use("the particles and the grid (use a larger --spacing or a smaller scene)");
     if (Status s = Simulation::Create(simScene, config, &simulation); !s) return s;
   }
-  sim::Solver& solver = simulation->Solver();
   LogStart(options, scene, state.get(), *simulation, summary);
   state.reset();  // the solver and the paddles have it now
   simScene.start.reset();
-  if (stats) {
-    if (Status s = stats->WriteHeader(*simulation, scene.damBreak); !s) return s;
+  if (sinks.stats) {
+    if (Status s = sinks.stats->WriteHeader(*simulation, scene.damBreak); !s) return s;
   }
 
   const bool showProgress = options.progress == 1 || (options.progress == -1 && isatty(STDERR_FILENO));
@@ -342,54 +440,14 @@ Status RunHeadless(const Options& options, RunSummary* summary) {
   if (!options.loadState.empty() && scene.runSettle > 0.0) {
     SPHXR_LOG_INFO("run.settle (%g s) skipped: the state file is the start", scene.runSettle);
   }
-  if (Status s = SettleFirst(settle, showProgress, progressLines, solver, summary); !s) return s;
+  if (Status s = SettleFirst(settle, showProgress, progressLines, simulation->Solver(), summary); !s) return s;
+  sinks.Attach(options, scene, settle, target, showProgress, progressLines, summary, *simulation);
+  if (Status s = StepToTarget(*simulation, target, sinks, summary); !s) return s;
 
-  // The outputs, in the order they act after each step: the CSV row, a checkpoint (after the rows it
-  // keeps), the exports, the state at the end, pictures, progress.
-  SummarySink measures(summary);
-  simulation->AddSink(&measures);
-  if (stats) simulation->AddSink(stats.get());
-  if (probes) simulation->AddSink(probes.get());
-  std::unique_ptr<CheckpointSink> checkpoints;
-  if (options.checkpointEvery > 0.0) {
-    checkpoints = std::make_unique<CheckpointSink>(options, scene.name, stats.get(), summary);
-    simulation->AddSink(checkpoints.get());
-  }
-  ExportSink exports(options, scene.surface, summary);
-  simulation->AddSink(&exports);
-  std::unique_ptr<SaveStateSink> save;
-  if (!options.saveState.empty()) {
-    save = std::make_unique<SaveStateSink>(options, scene.name, settle, summary);
-    simulation->AddSink(save.get());
-  }
-  if (pictures) simulation->AddSink(pictures.get());
-  Progress progress(showProgress, "", progressLines);
-  ProgressSink progressSink(&progress, target.steps, target.time, summary->startTime);
-  simulation->AddSink(&progressSink);
-
-  if (Status s = simulation->Start(); !s) return s;
-  while (target.steps > 0 ? solver.GetTotals().steps < target.steps : solver.Time() < target.time - 1e-9) {
-    if (g_interrupt) break;
-    if (Status s = simulation->Step(); !s) return s;
-  }
-  summary->wallSeconds = progressSink.WallSeconds();
-  summary->interrupted = g_interrupt;  // also a signal during the last step
-  if (summary->interrupted) {
-    progress.Finish();
-    SPHXR_LOG_WARN("%s at step %lld (t = %.4f s): stopping; the summary and the files cover the run so far",
-                   summary->interrupted == SIGINT    ? "interrupted (SIGINT)"
-                   : summary->interrupted == SIGHUP ? "hung up (SIGHUP: the terminal closed)"
-                                                    : "terminated (SIGTERM)",
-                   static_cast<long long>(simulation->WholeStep()), solver.Time());
-  }
-  // The rows of a run stopped by a signal too; a failed save is reported after the summary (which covers
-  // the run), not instead of it.
-  if (Status s = simulation->Finish(summary->interrupted != 0); !s) return s;
-
-  Summarise(scene, solver, measures, exports, summary);
-  PrintSummary(options, scene, *simulation, target, pictures ? pictures->Movie() : std::string(),
-               pictures && !options.screenshotPath.empty(), *summary);
-  return save ? save->Saved() : Status::Ok();
+  Summarise(scene, simulation->Solver(), *sinks.measures, *sinks.exports, summary);
+  PrintSummary(options, scene, *simulation, target, sinks.pictures ? sinks.pictures->Movie() : std::string(),
+               sinks.pictures && !options.screenshotPath.empty(), *summary);
+  return sinks.save ? sinks.save->Saved() : Status::Ok();
 }
 
 }  // namespace sphxr::app

@@ -19,8 +19,9 @@ inline const char* InterruptName(int signal) {
 }
 
 /// SIGINT, SIGTERM and SIGHUP (a closed terminal, a dropped ssh session: long runs are started that
-/// way) set g_interrupt while a run steps, however many arrive: a second Ctrl-C 5 ms after the first
-/// ended the run by the default action, without its summary, cutting a row and leaving FILE.state.tmp.
+/// way) set g_interrupt while a run steps, however many arrive: a second Ctrl-C soon after the first
+/// must not end the run by the default action, without its summary, cutting a row and leaving
+/// FILE.state.tmp.
 /// (SIGQUIT, Ctrl-\, still ends it at once.) The previous handlers come back afterwards.
 class InterruptScope {
  public:

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "sphxr/app/probe_csv.h"
+#include "sphxr/app/probe_config.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
 #include "sphxr/sim/solver_table.h"
@@ -76,11 +76,13 @@ const ParamDesc* FindParam(const std::string& key) {
 
 Status SetParam(const ParamDesc& p, double value, const std::string& where, sim::SceneSetup* s) {
   if (!std::isfinite(value)) return Status::Error(where + ": must be finite");
-  if (p.integer && value != std::floor(value)) return Status::Error(where + ": must be an integer (" + p.unit + ")");
   if (value < p.min || value > p.max) {
     return Status::Error(Format("%s: %s is out of range: must be from %s to %s%s%s (%s)", where.c_str(),
                                 ShowNumber(value).c_str(), ShowNumber(p.min).c_str(), ShowNumber(p.max).c_str(),
                                 p.unit.empty() ? "" : " ", p.unit.c_str(), p.help.c_str()));
+  }
+  if (p.integer && value != std::floor(value)) {
+    return Status::Error(where + ": must be an integer" + (p.unit.empty() ? "" : " (" + p.unit + ")"));
   }
   p.Set(s, value);
   return Status::Ok();

@@ -9,6 +9,7 @@
 #include "sphxr/common/log.h"
 #include "sphxr/common/text_file.h"
 #include "sphxr/sim/solver.h"
+#include "sphxr/sim/solver_table.h"
 #include "scene_probes.h"
 
 namespace sphxr::app {
@@ -73,7 +74,7 @@ Status Reader::Solver(const json& root) {
   for (auto it = solver.begin(); it != solver.end(); ++it) {
     if (it.key() == "method") {  // the pressure solver, by name (docs/user/scenes.md)
       const std::string v = it.value().is_string() ? it.value().get<std::string>() : "";
-      if (!sim::ParseSolverMethod(v, &s.method)) return Error("solver.method", "must be \"wcsph\" or \"dfsph\"");
+      if (!sim::ParseSolverMethod(v, &s.method)) return Error("solver.method", "must be one of " + sim::SolverNames());
       continue;
     }
     if (it.key() == "density") {  // how WCSPH finds the density, by name (docs/dev/physics.md)
@@ -81,21 +82,14 @@ Status Reader::Solver(const json& root) {
       if (!sim::ParseDensityModel(v, &s.density)) return Error("solver.density", "must be \"summation\" or \"delta_sph\"");
       continue;
     }
-    const sim::ParamInfo* info = sim::FindSolverParam(it.key());
-    if (!info) {
+    const ParamDesc* desc = FindParam("solver." + it.key());
+    if (!desc) {
       Unknown("solver." + Shown(it.key()));
       continue;
     }
     double v;
     if (Status st = Number(it.value(), "solver." + it.key(), &v); !st) return st;
-    if (v < info->min || v > info->max) {
-      return Error("solver." + it.key(),
-                   Format("%s is out of range: must be from %s to %s%s%s (%s)", ShowNumber(v).c_str(),
-                          ShowNumber(info->min).c_str(), ShowNumber(info->max).c_str(), info->unit[0] ? " " : "",
-                          info->unit, info->help));
-    }
-    if (info->integer && v != std::floor(v)) return Error("solver." + it.key(), "must be a whole number");
-    s.params.*(info->member) = static_cast<float>(v);
+    if (Status st = SetParam(*desc, v, m_out->path + ": " + desc->key, &s); !st) return st;
   }
   return Status::Ok();
 }
@@ -281,10 +275,10 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
   if (eq == std::string::npos) return Status::Error("--set " + ShowText(assignment) + ": expected key=value");
   const std::string key = assignment.substr(0, eq);
   const std::string value = assignment.substr(eq + 1);
-  // What a message quotes: the key and the value escaped and cut (a value of 5,000 nines was echoed whole).
+  // What a message quotes: the key and the value escaped and cut to 40 characters each.
   const std::string shown = "--set " + ShowText(key, 40) + "=" + ShowText(value, 40);
   if (key == "method" || key == "solver.method") {
-    if (!sim::ParseSolverMethod(value, &setup->method)) return Status::Error(shown + ": must be wcsph, dfsph or pbf");
+    if (!sim::ParseSolverMethod(value, &setup->method)) return Status::Error(shown + ": must be one of " + sim::SolverNames());
     return Status::Ok();
   }
   if (key == "density" || key == "solver.density") {
@@ -292,14 +286,7 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
     return Status::Ok();
   }
   const ParamDesc* desc = FindParam(key);
-  if (desc && desc->group == "reuse") {  // reuse.* keys of the registry
-    char* end = nullptr;
-    const double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || *end != '\0') return Status::Error(shown + ": not a finite number");
-    return SetParam(*desc, v, "--set " + key, setup);
-  }
-  const sim::ParamInfo* info = sim::FindSolverParam(key);
-  if (!info) {
+  if (!desc) {
     std::vector<std::string> solver, reuse;
     for (const ParamDesc& p : ParamRegistry()) (p.group == "solver" ? solver : reuse).push_back(p.group == "solver" ? p.name : p.key);
     return Status::Error("--set " + ShowText(key, 40) + ": unknown parameter (known: " + ShowList(solver, 6) + "; " +
@@ -308,14 +295,8 @@ Status SetSolverParam(sim::SceneSetup* setup, const std::string& assignment) {
   char* end = nullptr;
   const double v = std::strtod(value.c_str(), &end);
   if (value.empty() || *end != '\0' || !std::isfinite(v)) return Status::Error(shown + ": not a finite number");
-  if (v < info->min || v > info->max) {
-    return Status::Error(Format("%s: out of range, must be from %s to %s%s%s", shown.c_str(),
-                                ShowNumber(info->min).c_str(), ShowNumber(info->max).c_str(), *info->unit ? " " : "",
-                                info->unit));
-  }
-  if (info->integer && v != std::floor(v)) return Status::Error(shown + ": must be a whole number");
-  setup->params.*(info->member) = static_cast<float>(v);
-  return Status::Ok();
+  // A known key is shown as it is; the registry's check names it, the value and the range.
+  return SetParam(*desc, v, "--set " + key, setup);
 }
 
 }  // namespace sphxr::app

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "sphxr/app/probe_csv.h"
+#include "sphxr/app/probe_config.h"
 #include "sphxr/common/status.h"
 #include "sphxr/interaction/paddle.h"
 #include "sphxr/sim/params.h"

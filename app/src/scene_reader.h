@@ -28,7 +28,7 @@ std::string Shown(const std::string& key);
 bool Printable(const std::string& text);
 
 // What nlohmann's parser does not say: nesting deeper than kMaxDepth, and a key given twice in one
-// object (the parser keeps the last, so a second "solver" silently replaced the first). A scan of the
+// object (the parser keeps the last, so a second "solver" would silently replace the first). A scan of the
 // raw text, so that the message can give the line of each; run on text the parser accepted.
 class StructureScan {
  public:
@@ -68,6 +68,10 @@ class Reader {
   Status Probe(const json& root);
   // "paddles": {"frame_rate": 90, "list": [{name, hand, shapes, trajectory, loop, viscosity, limits, haptics}]}
   Status Paddles(const json& j);
+  Status Paddle(const json& p, const std::string& key, size_t index, interaction::PaddleDesc* d);  // one of the list
+  Status PaddleShapes(const json& p, const std::string& key, interaction::PaddleDesc* d) const;
+  Status PaddleLimits(const json& l, const std::string& key, interaction::PaddleLimits* limits);  // "limits"
+  Status PaddleTrajectory(const json& p, const std::string& key, interaction::PaddleDesc* d);
   Status Positive(const json& obj, const std::string& prefix, const char* name, float* out) const;
   Status Shape(const json& j, const std::string& key, sim::ShapePrimitive* out) const;
 

@@ -171,78 +171,112 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
   m_latest = std::move(snap);
 }
 
+/// The worker thread's clocks: real-time pacing (simulated time may not run ahead of wall time; anchored
+/// again after a pause or a reset), the half-second windows of the rates, and the totals at the last
+/// snapshot (the snapshot's per-step times are over the steps since).
+struct SimWorker::Pacing {
+  Clock::time_point anchorWall{}, lastPublish{}, rateWindow{};
+  double anchorSim = 0.0, rateSim0 = 0.0;
+  int64_t rateSteps0 = 0;
+  sim::Totals published;
+  bool dirty = false;  // steps taken since the last snapshot
+
+  /// Everything anchored at the solver's clock now (the start, a new solver).
+  void Restart(const sim::Solver& solver) {
+    anchorWall = Clock::now();
+    anchorSim = solver.Time();
+    published = solver.GetTotals();
+    rateSteps0 = published.steps;
+    rateSim0 = solver.Time();  // a state file's start is not 0
+    rateWindow = Clock::now();
+  }
+};
+
+void SimWorker::PublishNow(Pacing* p, Clock::time_point now) {
+  const sim::Totals& t = m_sim->Solver().GetTotals();
+  const double n = std::max<double>(1.0, static_cast<double>(t.steps - p->published.steps));
+  double stageMs[static_cast<int>(sim::Stage::kCount)];
+  for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) {
+    stageMs[s] = 1e3 * (t.stageSeconds[s] - p->published.stageSeconds[s]) / n;
+  }
+  Publish(stageMs, 1e3 * (t.stepSeconds - p->published.stepSeconds) / n);
+  p->published = t;
+  p->lastPublish = now;
+  p->dirty = false;
+}
+
+void SimWorker::SaveIfAsked() {
+  std::unique_ptr<std::pair<std::string, std::string>> save;
+  {
+    std::lock_guard lock(m_mutex);
+    save = std::move(m_pendingSave);
+  }
+  if (!save) return;
+  const std::string message = SaveStateLogged(save->first, save->second);
+  std::lock_guard lock(m_mutex);
+  m_saveMessage = message;
+}
+
+void SimWorker::ApplyPendingReset(Pacing* pacing) {
+  std::unique_ptr<SimScene> reset;
+  {
+    std::lock_guard lock(m_mutex);
+    reset = std::move(m_pendingReset);
+  }
+  if (!reset) return;
+  std::unique_ptr<Simulation> fresh;
+  const Status s = Build(*reset, false, &fresh);
+  if (!s) {
+    SPHXR_LOG_WARN("scene rebuild refused: %s", s.message().c_str());
+    std::lock_guard lock(m_mutex);
+    m_error = s.message();
+    return;
+  }
+  std::unique_lock solverLock = LockSolver();
+  m_sim = std::move(fresh);
+  m_probes = ProbeHistory(reset->probes, kProbePlotSeconds);
+  m_builtBuild = 0;  // the new solver has built no surface yet
+  solverLock.unlock();
+  {
+    std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
+    m_scene = *reset;
+    m_surface = m_scene.surface;
+    m_error.clear();
+  }
+  pacing->Restart(m_sim->Solver());
+  double zero[static_cast<int>(sim::Stage::kCount)] = {};
+  Publish(zero, 0.0);
+}
+
+void SimWorker::StepWithNewestHands() {
+  std::unique_lock solverLock = LockSolver();
+  std::vector<interaction::HandInput> hands;  // the newest: the paddles' targets at their next frame
+  {
+    std::lock_guard lock(m_mutex);
+    hands = m_hands;
+  }
+  const Status stepped = m_sim->Step(hands);
+  if (stepped) m_probes.Add(m_sim->Solver().LastProbes());
+  if (Status s = stepped; !s) {
+    std::lock_guard lock(m_mutex);
+    m_error = std::isfinite(m_sim->Solver().LastStep().maxSpeed)
+                  ? s.message()
+                  : "the simulation became non-finite: press reset, and lower the time step or raise the stiffness";
+    m_paused = true;
+  }
+}
+
 void SimWorker::Run() {
   // The CPU backend's team size is an OpenMP setting of the thread that made the solver (Start ran on
-  // the caller's thread): without this the worker's steps ran with the default team, whose spinning
-  // threads fought the renderer's for the cores (a 3.5 ms step took 650 ms under Xvfb + llvmpipe).
+  // the caller's thread): without this the worker's steps run with the default team, whose spinning
+  // threads fight the renderer's (a software GL's above all) for the cores.
   omp_set_num_threads(m_config.threads > 0 ? m_config.threads : omp_get_num_procs());
-  // Real-time pacing: simulated time may not run ahead of wall time (anchored again after a pause).
-  Clock::time_point anchorWall = Clock::now();
-  double anchorSim = m_sim->Solver().Time();
-  Clock::time_point lastPublish = Clock::now(), rateWindow = Clock::now();
-  int64_t rateSteps0 = m_sim->Solver().GetTotals().steps;
-  double rateSim0 = m_sim->Solver().Time();
-  sim::Totals published = m_sim->Solver().GetTotals();
-  bool dirty = false;
-  auto publishNow = [&](Clock::time_point now) {
-    const sim::Totals& t = m_sim->Solver().GetTotals();
-    const double n = std::max<double>(1.0, static_cast<double>(t.steps - published.steps));
-    double stageMs[static_cast<int>(sim::Stage::kCount)];
-    for (int s = 0; s < static_cast<int>(sim::Stage::kCount); ++s) {
-      stageMs[s] = 1e3 * (t.stageSeconds[s] - published.stageSeconds[s]) / n;
-    }
-    Publish(stageMs, 1e3 * (t.stepSeconds - published.stepSeconds) / n);
-    published = t;
-    lastPublish = now;
-    dirty = false;
-  };
-  auto saveIfAsked = [this]() {
-    std::unique_ptr<std::pair<std::string, std::string>> save;
-    {
-      std::lock_guard lock(m_mutex);
-      save = std::move(m_pendingSave);
-    }
-    if (!save) return;
-    const std::string message = SaveStateLogged(save->first, save->second);
-    std::lock_guard lock(m_mutex);
-    m_saveMessage = message;
-  };
+  Pacing pacing;
+  pacing.Restart(m_sim->Solver());
+  pacing.lastPublish = Clock::now();
   while (!m_stop) {
-    std::unique_ptr<SimScene> reset;
-    {
-      std::lock_guard lock(m_mutex);
-      reset = std::move(m_pendingReset);
-    }
-    if (reset) {
-      std::unique_ptr<Simulation> fresh;
-      const Status s = Build(*reset, false, &fresh);
-      if (!s) {
-        SPHXR_LOG_WARN("scene rebuild refused: %s", s.message().c_str());
-        std::lock_guard lock(m_mutex);
-        m_error = s.message();
-      } else {
-        std::unique_lock solverLock = LockSolver();
-        m_sim = std::move(fresh);
-        m_probes = ProbeHistory(reset->probes, kProbePlotSeconds);
-        m_builtBuild = 0;  // the new solver has built no surface yet
-        solverLock.unlock();
-        {
-          std::lock_guard lock(m_mutex);  // Reset(setup) reads m_scene on the caller's thread
-          m_scene = *reset;
-          m_surface = m_scene.surface;
-          m_error.clear();
-        }
-        anchorWall = Clock::now();
-        anchorSim = m_sim->Solver().Time();
-        published = m_sim->Solver().GetTotals();
-        rateSteps0 = published.steps;
-        rateSim0 = m_sim->Solver().Time();  // a state file's start is not 0
-        rateWindow = Clock::now();
-        double zero[static_cast<int>(sim::Stage::kCount)] = {};
-        Publish(zero, 0.0);
-      }
-    }
-    saveIfAsked();  // between two steps, after a reset asked for before it
+    ApplyPendingReset(&pacing);
+    SaveIfAsked();  // between two steps, after a reset asked for before it
     const bool stepRequested = m_stepRequests.load() > 0;
     bool surfaceChanged;
     {
@@ -250,45 +284,31 @@ void SimWorker::Run() {
       surfaceChanged = m_surfaceChanged;
     }
     if (m_paused && !stepRequested) {
-      if (dirty || surfaceChanged) publishNow(Clock::now());  // the last steps before the pause are shown
+      if (pacing.dirty || surfaceChanged) PublishNow(&pacing, Clock::now());  // the last steps before the pause are shown
       std::unique_lock lock(m_mutex);
       m_wake.wait_for(lock, std::chrono::milliseconds(20));
-      anchorWall = Clock::now();
-      anchorSim = m_sim->Solver().Time();
+      pacing.anchorWall = Clock::now();
+      pacing.anchorSim = m_sim->Solver().Time();
       continue;
     }
-    if (!stepRequested && m_sim->Solver().Time() - anchorSim > Seconds(Clock::now() - anchorWall)) {
+    if (!stepRequested && m_sim->Solver().Time() - pacing.anchorSim > Seconds(Clock::now() - pacing.anchorWall)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));  // ahead of real time
     } else {
       if (stepRequested) --m_stepRequests;
-      std::unique_lock solverLock = LockSolver();
-      std::vector<interaction::HandInput> hands;  // the newest: the paddles' targets at their next frame
-      {
-        std::lock_guard lock(m_mutex);
-        hands = m_hands;
-      }
-      const Status stepped = m_sim->Step(hands);
-      if (stepped) m_probes.Add(m_sim->Solver().LastProbes());
-      if (Status s = stepped; !s) {
-        std::lock_guard lock(m_mutex);
-        m_error = std::isfinite(m_sim->Solver().LastStep().maxSpeed)
-                      ? s.message()
-                      : "the simulation became non-finite: press reset, and lower the time step or raise the stiffness";
-        m_paused = true;
-      }
-      dirty = true;
+      StepWithNewestHands();
+      pacing.dirty = true;
     }
     const Clock::time_point now = Clock::now();
-    if (Seconds(now - rateWindow) >= 0.5) {  // rates over half-second windows
-      m_rateSteps = (m_sim->Solver().GetTotals().steps - rateSteps0) / Seconds(now - rateWindow);
-      m_rateSim = (m_sim->Solver().Time() - rateSim0) / Seconds(now - rateWindow);
-      rateWindow = now;
-      rateSteps0 = m_sim->Solver().GetTotals().steps;
-      rateSim0 = m_sim->Solver().Time();
+    if (Seconds(now - pacing.rateWindow) >= 0.5) {  // rates over half-second windows
+      m_rateSteps = (m_sim->Solver().GetTotals().steps - pacing.rateSteps0) / Seconds(now - pacing.rateWindow);
+      m_rateSim = (m_sim->Solver().Time() - pacing.rateSim0) / Seconds(now - pacing.rateWindow);
+      pacing.rateWindow = now;
+      pacing.rateSteps0 = m_sim->Solver().GetTotals().steps;
+      pacing.rateSim0 = m_sim->Solver().Time();
     }
-    if (dirty && (Seconds(now - lastPublish) >= 1.0 / 60.0 || m_paused)) publishNow(now);
+    if (pacing.dirty && (Seconds(now - pacing.lastPublish) >= 1.0 / 60.0 || m_paused)) PublishNow(&pacing, now);
   }
-  saveIfAsked();  // a save asked for just before the end is not lost
+  SaveIfAsked();  // a save asked for just before the end is not lost
 }
 
 std::unique_lock<std::mutex> SimWorker::LockSolver() {
@@ -403,26 +423,6 @@ void SimWorker::ForceSurfacePathForTests(SurfacePath path) {
   std::lock_guard lock(m_mutex);
   m_surfaceChanged = true;
   m_wake.notify_all();
-}
-
-const render::InteropMesh* InteropSurface::Update(SimWorker& worker, const SimSnapshot& snap) {
-  if (!snap.surfaceOnDevice) return nullptr;
-  if (snap.surfaceBuild > m_written) {
-    uint64_t build = 0;
-    if (Status s = worker.WriteSurfaceInto(&m_mesh, &build); !s) {
-      worker.FallBackToHostCopy(s.message());
-      m_written = 0;
-      return nullptr;
-    }
-    if (build == 0) return nullptr;  // the solver was replaced and has built nothing yet
-    m_written = build;               // the newest build: at least the snapshot's
-  }
-  return m_mesh && m_mesh->VertexCount() > 0 ? m_mesh.get() : nullptr;
-}
-
-void InteropSurface::Reset() {
-  m_mesh.reset();
-  m_written = 0;
 }
 
 }  // namespace sphxr::app

@@ -94,8 +94,15 @@ class SimWorker {
   void ForceSurfacePathForTests(SurfacePath path);
 
  private:
+  struct Pacing;  // the worker thread's clocks (sim_worker.cpp)
   std::unique_lock<std::mutex> LockSolver();
+  /// The worker thread: a pending reset, a pending save, then a step when it is due (or asked for),
+  /// and a snapshot at most 60 times a second.
   void Run();
+  void ApplyPendingReset(Pacing* pacing);
+  void SaveIfAsked();
+  void StepWithNewestHands();
+  void PublishNow(Pacing* pacing, std::chrono::steady_clock::time_point now);
   void Publish(double stageMs[], double stepMs);
   /// Builds the Simulation for `scene` with the worker's solver configuration. `strict` (the first
   /// build): a state file that does not fit is an error; on a reset it is a logged fallback to the
@@ -130,21 +137,6 @@ class SimWorker {
   uint64_t m_builds = 0;        // surfaces built so far (all solvers); guarded by m_solverMutex
   uint64_t m_builtBuild = 0;    // the current solver's last build on the interop path (0: none)
   int64_t m_builtVertices = 0;  // its vertex count
-};
-
-/// The GL thread's half of the GPU surface path (desktop window, headset): the InteropMesh the worker's
-/// solver writes into. Destroy it with the GL context current.
-class InteropSurface {
- public:
-  /// For a snapshot whose surface stayed on the device (SimSnapshot::surfaceOnDevice): brings the mesh
-  /// up to the snapshot's build (one write per build) and returns it for FrameScene::deviceSurface; else
-  /// null (draw the snapshot's host mesh). A failure switches the worker to host copies (logged once).
-  const render::InteropMesh* Update(SimWorker& worker, const SimSnapshot& snap);
-  void Reset();
-
- private:
-  std::unique_ptr<render::InteropMesh> m_mesh;
-  uint64_t m_written = 0;  // the newest build in m_mesh
 };
 
 }  // namespace sphxr::app

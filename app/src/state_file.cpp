@@ -13,40 +13,22 @@
 #include <fstream>
 #include <vector>
 
+#include "state_check.h"
+#include "state_format.h"
 #include "sphxr/common/log.h"
 #include "sphxr/common/shown_text.h"
 #include "sphxr/sim/params.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'P', 'H', 'X', 'R', 'S', 'T', '1'};
-constexpr uint32_t kByteOrder = 0x01020304u;
-// 2: the step count after the clock; 3: the solver method after the scene name; 4: the diffuse particles
-// after the fields
-constexpr uint32_t kVersion = 4;
-constexpr uint32_t kOldestVersion = 1;
-static_assert(sizeof(sim::Vec3) == 12 && sizeof(sim::Quat) == 16 && sizeof(sim::Pose) == 28,
-              "state files write these structs as their bytes: they must have no padding");
-
-class Writer {
- public:
-  explicit Writer(std::ofstream* out) : m_out(out) {}
-  void Bytes(const void* p, size_t n) {
-    if (n > 0) m_out->write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
-  }
-  template <class T>
-  void Put(const T& v) {
-    Bytes(&v, sizeof(T));
-  }
-  void String(const std::string& s) {
-    Put(static_cast<uint32_t>(s.size()));
-    Bytes(s.data(), s.size());
-  }
-
- private:
-  std::ofstream* m_out;
-};
+using state_format::kByteOrder;
+using state_format::kMagic;
+using state_format::kOldestVersion;
+using state_format::kVersion;
+using state_format::Reader;
+using state_format::Writer;
 
 // A paddle's restart state is used as it is (nothing downstream checks it, unlike a body's motion, which
 // Solver::SetBodyMotion does): a NaN here would become the paddle's target pose, or the controller's
@@ -58,204 +40,99 @@ bool Sound(const interaction::PaddleRestart& p) {
          std::isfinite(p.lastFrame);
 }
 
-class Reader {
- public:
-  explicit Reader(std::vector<char> data) : m_data(std::move(data)) {}
-  bool Bytes(void* p, size_t n) {
-    if (n == 0) return true;  // (no memcpy with an empty field's null pointer)
-    if (n > m_data.size() - m_at) return false;
-    std::memcpy(p, m_data.data() + m_at, n);
-    m_at += n;
-    return true;
-  }
-  template <class T>
-  bool Get(T* v) {
-    return Bytes(v, sizeof(T));
-  }
-  bool String(std::string* s, uint32_t limit) {
-    uint32_t n = 0;
-    if (!Get(&n) || n > limit || n > m_data.size() - m_at) return false;
-    s->assign(m_data.data() + m_at, n);
-    m_at += n;
-    return true;
-  }
-  size_t At() const { return m_at; }
-  size_t Left() const { return m_data.size() - m_at; }
+}  // namespace
 
- private:
-  std::vector<char> m_data;
-  size_t m_at = 0;
-};
+namespace {
 
-// A state file is checked as a scene is (sim's ValidateScene): finite is not enough. Every particle
-// outside the tank was clamped back in (a density error of 127,229 %), a body at y = 1e9 m moved at
-// 3.5e9 m/s in its first step, and particles with one id are not one particle's history.
-constexpr double kMaxFluidSpeed = 1000.0;  // m/s: a scene's fluid block may start at most this fast
-
-// The smallest step a state may ask for: the smallest solver.max_dt a scene may set.
-constexpr double kMinResolvedStep = 1e-7;  // s
-
-Status CheckAgainstScene(const StateFile& state, const sim::SceneSetup& scene) {
-  // The clock's last maxima set the first step (its CFL and force conditions): a saved maximum speed of
-  // 1e30 m/s or |a| of 3.4e38 m/s^2 was restored, and the run then stopped with "the time step
-  // collapsed to 4e-33 s", naming neither the file nor the value.
-  const double speed = state.clock.lastMaxSpeed, accel = state.clock.lastMaxAccel;
-  if (!(speed <= kMaxFluidSpeed)) {
-    return Status::Error(Format("the clock's last maximum speed %g m/s is beyond the %g m/s a fluid may have: damaged",
-                                speed, kMaxFluidSpeed));
+// The file is written beside its place and renamed over it, which would replace whatever is there: a
+// device or a pipe (--save-state /dev/null, as root, would replace the system's /dev/null) is refused,
+// and a symbolic link is followed, so the link stays and its target gets the state.
+Status PlaceOfStateFile(const std::string& path, std::string* target) {
+  std::error_code linkError;
+  *target = path;
+  if (std::filesystem::is_symlink(path, linkError)) {
+    const std::filesystem::path resolved = std::filesystem::canonical(path, linkError);
+    if (!linkError) *target = resolved.string();
   }
-  // WCSPH's force condition, dt = 0.25 sqrt(h / a), with the state's smoothing length h.
-  const double h = 0.5 * scene.params.spacing * scene.params.supportFactor;
-  const double maxAccel = h * std::pow(0.25 / kMinResolvedStep, 2.0);
-  if (!(accel <= maxAccel)) {
-    return Status::Error(Format("the clock's last maximum acceleration %g m/s^2 asks for a step below %g s (at most "
-                                "%.3g m/s^2 at spacing %g m): damaged",
-                                accel, kMinResolvedStep, maxAccel, scene.params.spacing));
-  }
-  const sim::HostFluid& f = state.fluid;
-  const float slack = scene.params.spacing;  // the domain clamp keeps particles inside the walls
-  const sim::Aabb& t = scene.tank;
-  for (size_t i = 0; i < f.size(); ++i) {
-    const sim::Vec4 p = f.position[i];
-    const float top = t.max.y + slack;  // (an open tank's domain ends at its rim too)
-    if (!(p.x >= t.min.x - slack && p.x <= t.max.x + slack && p.y >= t.min.y - slack && p.y <= top &&
-          p.z >= t.min.z - slack && p.z <= t.max.z + slack)) {
-      return Status::Error(Format("particle %zu (id %u) at [%g %g %g] is outside the tank [%g %g %g] to [%g %g %g]: "
-                                  "saved from another scene, or damaged",
-                                  i, f.id[i], p.x, p.y, p.z, t.min.x, t.min.y, t.min.z, t.max.x, t.max.y, t.max.z));
-    }
-    const sim::Vec4 v = f.velocity[i];
-    const double speed = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
-    if (!(speed <= kMaxFluidSpeed)) {
-      return Status::Error(Format("particle %zu (id %u) moves at %g m/s; at most %g m/s is supported: damaged", i,
-                                  f.id[i], speed, kMaxFluidSpeed));
-    }
-  }
-  std::vector<uint32_t> ids(f.id);
-  std::sort(ids.begin(), ids.end());
-  if (const auto twin = std::adjacent_find(ids.begin(), ids.end()); twin != ids.end()) {
-    return Status::Error(Format("particle id %u appears twice: damaged", *twin));
-  }
-  // Bodies (paddles) may be withdrawn above the water, not far away: within the tank's diagonal of it.
-  const double reach = Length(t.max - t.min);
-  auto near = [&](const sim::Vec3& x) {
-    const double dx = std::max({double(t.min.x) - x.x, 0.0, double(x.x) - t.max.x});
-    const double dy = std::max({double(t.min.y) - x.y, 0.0, double(x.y) - t.max.y});
-    const double dz = std::max({double(t.min.z) - x.z, 0.0, double(x.z) - t.max.z});
-    return std::sqrt(dx * dx + dy * dy + dz * dz) <= reach;
-  };
-  for (size_t k = 0; k < state.bodies.size(); ++k) {
-    const sim::BodyMotionState& m = state.bodies[k];
-    for (const sim::Pose* pose : {&m.pose, &m.from, &m.to}) {
-      if (!Finite(pose->position) || !near(pose->position)) {
-        return Status::Error(Format("body %zu's pose [%g %g %g] is more than the tank's diagonal (%g m) from the tank: "
-                                    "damaged",
-                                    k, pose->position.x, pose->position.y, pose->position.z, reach));
-      }
-    }
-    const double speed = Finite(m.velocity) ? double(Length(m.velocity)) : HUGE_VAL;
-    if (!(speed <= kMaxFluidSpeed)) {
-      return Status::Error(Format("body %zu moves at %g m/s; at most %g m/s is supported: damaged", k, speed, kMaxFluidSpeed));
-    }
-  }
-  for (size_t k = 0; k < state.paddles.size(); ++k) {
-    if (!near(state.paddles[k].state.commanded.position)) {
-      return Status::Error(Format("paddle %zu's commanded pose is more than the tank's diagonal from the tank: damaged", k));
-    }
+  std::error_code ignored;
+  const auto st = std::filesystem::status(*target, ignored);
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
+    return Status::Error(path + ": not a regular file (a directory, device or pipe): a state file needs a file of its own");
   }
   return Status::Ok();
 }
 
-}  // namespace
+// The header, the clock, the counts, the scene's name and the method (the file's first part).
+void WriteHead(Writer& w, const sim::Solver& solver, const std::string& sceneName, int64_t stepsBefore) {
+  const sim::SolverClock clock = solver.Clock();
+  w.Bytes(kMagic, sizeof(kMagic));
+  w.Put(kByteOrder);
+  w.Put(kVersion);
+  w.Put(clock.time);
+  w.Put(clock.lastMaxSpeed);
+  w.Put(clock.lastMaxAccel);
+  w.Put(static_cast<int64_t>(stepsBefore < 0 ? -1 : stepsBefore + solver.GetTotals().steps));  // -1: unknown
+  w.Put(solver.Scene().params.spacing);
+  w.Put(static_cast<int32_t>(solver.FluidCount()));
+  w.Put(static_cast<int32_t>(solver.BoundaryCount()));
+  w.String(sceneName);
+  w.String(sim::SolverMethodName(solver.Method()));
+}
 
-Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
-                      const interaction::PaddleSystem* paddles, double paddleClock, int64_t stepsBefore) {
-  // The file is written beside its place and renamed over it, which would replace whatever is there: a
-  // device or a pipe (--save-state /dev/null, as root, replaced the system's /dev/null) is refused, and
-  // a symbolic link is followed, so the link stays and its target gets the state.
-  std::error_code linkError;
-  std::string target = path;
-  if (std::filesystem::is_symlink(path, linkError)) {
-    const std::filesystem::path resolved = std::filesystem::canonical(path, linkError);
-    if (!linkError) target = resolved.string();
+// The bodies' motion and the paddles' restart states, then the paddle clock.
+void WriteBodies(Writer& w, const sim::Solver& solver, const interaction::PaddleSystem* paddles, double paddleClock) {
+  w.Put(static_cast<uint32_t>(solver.BodyCount()));
+  for (int k = 0; k < solver.BodyCount(); ++k) {
+    const sim::BodyMotionState m = solver.BodyMotionOf(k);
+    for (const sim::Pose& p : {m.pose, m.from, m.to}) w.Put(p);
+    w.Put(m.fromTime);
+    w.Put(m.toTime);
+    w.Put(m.velocity);
+    w.Put(m.angular);
   }
-  {
-    std::error_code ignored;
-    const auto st = std::filesystem::status(target, ignored);
-    if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
-      return Status::Error(path + ": not a regular file (a directory, device or pipe): a state file needs a file of its own");
-    }
+  const int paddleCount = paddles ? paddles->Count() : 0;
+  w.Put(static_cast<uint32_t>(paddleCount));
+  for (int k = 0; k < paddleCount; ++k) {
+    const interaction::PaddleRestart r = paddles->Restart(k);
+    w.Put(static_cast<int32_t>(r.state.mode));
+    w.Put(r.state.commanded.position);
+    w.Put(r.state.commanded.orientation);
+    w.Put(r.state.force);
+    w.Put(r.state.torque);
+    w.Put(r.state.rawForce);
+    w.Put(r.state.haptic);
+    w.Put(r.state.teleports);
+    w.Put(static_cast<uint8_t>(r.lost ? 1 : 0));
+    w.Put(r.lostSince);
+    w.Put(r.lastFrame);
   }
+  w.Put(paddleCount > 0 ? paddleClock : 0.0);  // only meaningful with paddles
+}
+
+// Every field of the one field list, by name and element size, then the diffuse particles.
+void WriteParticles(Writer& w, const sim::Solver& solver) {
   sim::HostFluid fluid;
   solver.Download(&fluid);
-  const sim::SolverClock clock = solver.Clock();
-  const std::string tmp = target + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Status::Error(path + ": cannot open " + tmp + " for writing: " + std::strerror(errno));
-    Writer w(&out);
-    w.Bytes(kMagic, sizeof(kMagic));
-    w.Put(kByteOrder);
-    w.Put(kVersion);
-    w.Put(clock.time);
-    w.Put(clock.lastMaxSpeed);
-    w.Put(clock.lastMaxAccel);
-    w.Put(static_cast<int64_t>(stepsBefore < 0 ? -1 : stepsBefore + solver.GetTotals().steps));  // -1: unknown
-    w.Put(solver.Scene().params.spacing);
-    w.Put(static_cast<int32_t>(solver.FluidCount()));
-    w.Put(static_cast<int32_t>(solver.BoundaryCount()));
-    w.String(sceneName);
-    w.String(sim::SolverMethodName(solver.Method()));
-    w.Put(static_cast<uint32_t>(solver.BodyCount()));
-    for (int k = 0; k < solver.BodyCount(); ++k) {
-      const sim::BodyMotionState m = solver.BodyMotionOf(k);
-      for (const sim::Pose& p : {m.pose, m.from, m.to}) w.Put(p);
-      w.Put(m.fromTime);
-      w.Put(m.toTime);
-      w.Put(m.velocity);
-      w.Put(m.angular);
-    }
-    const int paddleCount = paddles ? paddles->Count() : 0;
-    w.Put(static_cast<uint32_t>(paddleCount));
-    for (int k = 0; k < paddleCount; ++k) {
-      const interaction::PaddleRestart r = paddles->Restart(k);
-      w.Put(static_cast<int32_t>(r.state.mode));
-      w.Put(r.state.commanded.position);
-      w.Put(r.state.commanded.orientation);
-      w.Put(r.state.force);
-      w.Put(r.state.torque);
-      w.Put(r.state.rawForce);
-      w.Put(r.state.haptic);
-      w.Put(r.state.teleports);
-      w.Put(static_cast<uint8_t>(r.lost ? 1 : 0));
-      w.Put(r.lostSince);
-      w.Put(r.lastFrame);
-    }
-    w.Put(paddleCount > 0 ? paddleClock : 0.0);  // only meaningful with paddles
-    uint32_t fields = 0;
+  uint32_t fields = 0;
 #define SPHXR_COUNT_FIELD(type, name) ++fields;
-    SPHXR_FLUID_FIELDS(SPHXR_COUNT_FIELD)
+  SPHXR_FLUID_FIELDS(SPHXR_COUNT_FIELD)
 #undef SPHXR_COUNT_FIELD
-    w.Put(fields);
+  w.Put(fields);
 #define SPHXR_WRITE_FIELD(type, name)                                   \
   w.String(#name);                                                      \
   w.Put(static_cast<uint32_t>(sizeof(type)));                           \
   w.Bytes(fluid.name.data(), fluid.name.size() * sizeof(type));
-    SPHXR_FLUID_FIELDS(SPHXR_WRITE_FIELD)
+  SPHXR_FLUID_FIELDS(SPHXR_WRITE_FIELD)
 #undef SPHXR_WRITE_FIELD
-    sim::HostDiffuse diffuse;
-    solver.DownloadDiffuse(&diffuse);
-    w.Put(static_cast<uint32_t>(diffuse.count));
-    w.Bytes(diffuse.position.data(), diffuse.position.size() * sizeof(sim::Vec4));
-    w.Bytes(diffuse.velocity.data(), diffuse.velocity.size() * sizeof(sim::Vec4));
-    out.close();  // errors reported only at close (quota, network filesystems) count too
-    if (out.fail()) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      return Status::Error(path + ": write failed (disk full?); an earlier file there is unchanged");
-    }
-  }
-  // On the disk before it replaces an earlier file, so a crash after the rename cannot leave it empty.
+  sim::HostDiffuse diffuse;
+  solver.DownloadDiffuse(&diffuse);
+  w.Put(static_cast<uint32_t>(diffuse.count));
+  w.Bytes(diffuse.position.data(), diffuse.position.size() * sizeof(sim::Vec4));
+  w.Bytes(diffuse.velocity.data(), diffuse.velocity.size() * sizeof(sim::Vec4));
+}
+
+// `tmp` on the disk, then renamed over `target`: a crash after the rename cannot leave it empty.
+Status SyncAndReplace(const std::string& path, const std::string& tmp, const std::string& target) {
   const int fd = ::open(tmp.c_str(), O_RDONLY);
   const bool synced = fd >= 0 && ::fsync(fd) == 0;
   if (fd >= 0) ::close(fd);
@@ -271,6 +148,30 @@ Status WriteStateFile(const std::string& path, const sim::Solver& solver, const 
     return Status::Error(path + ": cannot move " + tmp + " into place: " + ec.message());
   }
   return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteStateFile(const std::string& path, const sim::Solver& solver, const std::string& sceneName,
+                      const interaction::PaddleSystem* paddles, double paddleClock, int64_t stepsBefore) {
+  std::string target;
+  if (Status s = PlaceOfStateFile(path, &target); !s) return s;
+  const std::string tmp = target + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return Status::Error(path + ": cannot open " + tmp + " for writing: " + std::strerror(errno));
+    Writer w(&out);
+    WriteHead(w, solver, sceneName, stepsBefore);
+    WriteBodies(w, solver, paddles, paddleClock);
+    WriteParticles(w, solver);
+    out.close();  // errors reported only at close (quota, network filesystems) count too
+    if (out.fail()) {
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
+      return Status::Error(path + ": write failed (disk full?); an earlier file there is unchanged");
+    }
+  }
+  return SyncAndReplace(path, tmp, target);
 }
 
 Status ReadStateFile(const std::string& path, StateFile* out) {
@@ -300,28 +201,28 @@ Status ReadStateFile(const std::string& path, StateFile* out) {
   return ParseStateFile(std::move(data), path, out);
 }
 
-Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile* out) {
-  *out = StateFile{};
-  out->path = path;
-  if (data.size() < sizeof(kMagic) || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
-    return Status::Error(path + ": not an sphxr state file (written by sphxr --save-state)");
-  }
-  Reader r(std::move(data));
-  auto truncated = [&]() { return Status::Error(Format("%s: truncated at byte %zu: not a whole state file", path.c_str(), r.At())); };
+namespace {
+
+Status Truncated(const std::string& path, const Reader& r) {
+  return Status::Error(Format("%s: truncated at byte %zu: not a whole state file", path.c_str(), r.At()));
+}
+
+// The head: byte order, version, clock, step count, spacing, counts, the scene's name and the method.
+Status ParseHead(Reader& r, const std::string& path, uint32_t* version, StateFile* out) {
   char magic[sizeof(kMagic)];
-  r.Bytes(magic, sizeof(magic));  // checked above
-  uint32_t order = 0, version = 0;
-  if (!r.Get(&order) || !r.Get(&version)) return truncated();
+  r.Bytes(magic, sizeof(magic));  // checked by the caller
+  uint32_t order = 0;
+  if (!r.Get(&order) || !r.Get(version)) return Truncated(path, r);
   if (order != kByteOrder) return Status::Error(path + ": written on a machine of the other byte order");
-  if (version < kOldestVersion || version > kVersion) {
-    return Status::Error(Format("%s: state file version %u; this build reads versions %u to %u", path.c_str(), version,
+  if (*version < kOldestVersion || *version > kVersion) {
+    return Status::Error(Format("%s: state file version %u; this build reads versions %u to %u", path.c_str(), *version,
                                 kOldestVersion, kVersion));
   }
   int32_t fluid = 0, boundary = 0;
-  if (!r.Get(&out->clock.time) || !r.Get(&out->clock.lastMaxSpeed) || !r.Get(&out->clock.lastMaxAccel)) return truncated();
+  if (!r.Get(&out->clock.time) || !r.Get(&out->clock.lastMaxSpeed) || !r.Get(&out->clock.lastMaxAccel)) return Truncated(path, r);
   out->step = -1;  // version 1 has no step count
-  if (version >= 2) {
-    if (!r.Get(&out->step)) return truncated();
+  if (*version >= 2) {
+    if (!r.Get(&out->step)) return Truncated(path, r);
     // (Below -1, or past 1e15 steps, a thousand years of steps at 30 us: damage, e.g. a flipped high bit.)
     if (out->step < -1 || out->step > 1000000000000000LL) {
       return Status::Error(Format("%s: step count %lld: the file is damaged", path.c_str(), static_cast<long long>(out->step)));
@@ -329,14 +230,17 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
   }
   // The impulse hold's schedule continues in step with the saved run (unknown: from 0, a one-off shift).
   out->clock.steps = out->step < 0 ? 0 : out->step;
-  if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return truncated();
+  if (!r.Get(&out->spacing) || !r.Get(&fluid) || !r.Get(&boundary) || !r.String(&out->scene, 4096)) return Truncated(path, r);
   if (fluid < 0 || boundary < 0) return Status::Error(path + ": negative particle counts: the file is damaged");
+  out->fluidCount = fluid;
+  out->boundaryCount = boundary;
   out->method = sim::SolverMethod::kWcsph;  // versions 1 and 2: the only method there was
-  if (version >= 3) {
+  if (*version >= 3) {
     std::string method;
-    if (!r.String(&method, 64)) return truncated();
+    if (!r.String(&method, 64)) return Truncated(path, r);
     if (!sim::ParseSolverMethod(method, &out->method)) {
-      return Status::Error(path + ": its solver method is not wcsph or dfsph: the file is damaged or from a newer build");
+      return Status::Error(path + ": its solver method is not one of " + sim::SolverNames() +
+                           ": the file is damaged or from a newer build");
     }
   }
   // The scene's name is shown in messages and the log: control characters (a damaged file, or a name
@@ -349,8 +253,13 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
     return Status::Error(Format("%s: spacing %g m is outside %g to %g m: the file is damaged", path.c_str(), out->spacing,
                                 spacing->min, spacing->max));
   }
+  return Status::Ok();
+}
+
+// The bodies' motion, the paddles' restart states and the paddle clock.
+Status ParseBodies(Reader& r, const std::string& path, StateFile* out) {
   uint32_t bodies = 0;
-  if (!r.Get(&bodies)) return truncated();
+  if (!r.Get(&bodies)) return Truncated(path, r);
   if (bodies > 1024) return Status::Error(Format("%s: %u bodies: the file is damaged", path.c_str(), bodies));
   // A body's motion is checked where it is used (Solver::SetBodyMotion, SetBodyTarget refuse non-finite
   // values), as the fluid's is (Solver::Restore).
@@ -358,12 +267,12 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
     sim::BodyMotionState m;
     if (!r.Get(&m.pose) || !r.Get(&m.from) || !r.Get(&m.to) || !r.Get(&m.fromTime) || !r.Get(&m.toTime) ||
         !r.Get(&m.velocity) || !r.Get(&m.angular)) {
-      return truncated();
+      return Truncated(path, r);
     }
     out->bodies.push_back(m);
   }
   uint32_t paddleCount = 0;
-  if (!r.Get(&paddleCount)) return truncated();
+  if (!r.Get(&paddleCount)) return Truncated(path, r);
   if (paddleCount > bodies) return Status::Error(Format("%s: %u paddles for %u bodies: the file is damaged", path.c_str(), paddleCount, bodies));
   for (uint32_t k = 0; k < paddleCount; ++k) {
     interaction::PaddleRestart p;
@@ -372,7 +281,7 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
     if (!r.Get(&mode) || !r.Get(&p.state.commanded.position) || !r.Get(&p.state.commanded.orientation) ||
         !r.Get(&p.state.force) || !r.Get(&p.state.torque) || !r.Get(&p.state.rawForce) || !r.Get(&p.state.haptic) ||
         !r.Get(&p.state.teleports) || !r.Get(&lost) || !r.Get(&p.lostSince) || !r.Get(&p.lastFrame)) {
-      return truncated();
+      return Truncated(path, r);
     }
     if (mode < 0 || mode > static_cast<int32_t>(interaction::PaddleMode::kWithdrawing)) {
       return Status::Error(Format("%s: paddle %u has mode %d: the file is damaged", path.c_str(), k, mode));
@@ -385,25 +294,29 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
     }
     out->paddles.push_back(p);
   }
-  if (!r.Get(&out->paddleClock)) return truncated();
+  if (!r.Get(&out->paddleClock)) return Truncated(path, r);
   if (!std::isfinite(out->paddleClock)) return Status::Error(path + ": non-finite paddle clock: the file is damaged");
-  out->fluidCount = fluid;
-  out->boundaryCount = boundary;
+  return Status::Ok();
+}
+
+// The fields, each by name and element size: every field of this build, once, and no other.
+Status ParseFields(Reader& r, const std::string& path, StateFile* out) {
+  const int32_t fluid = out->fluidCount;
   uint32_t fields = 0;
-  if (!r.Get(&fields)) return truncated();
+  if (!r.Get(&fields)) return Truncated(path, r);
   // The fields' bytes must be there before anything is allocated (a damaged count must not ask for
   // gigabytes).
   uint64_t perParticle = 0;
 #define SPHXR_FIELD_BYTES(type, name) perParticle += sizeof(type);
   SPHXR_FLUID_FIELDS(SPHXR_FIELD_BYTES)
 #undef SPHXR_FIELD_BYTES
-  if (static_cast<uint64_t>(fluid) * perParticle > r.Left()) return truncated();
+  if (static_cast<uint64_t>(fluid) * perParticle > r.Left()) return Truncated(path, r);
   out->fluid.resize(static_cast<size_t>(fluid));
   std::vector<std::string> seen;
   for (uint32_t f = 0; f < fields; ++f) {
     std::string name;
     uint32_t element = 0;
-    if (!r.String(&name, 256) || !r.Get(&element)) return truncated();
+    if (!r.String(&name, 256) || !r.Get(&element)) return Truncated(path, r);
     // (Named in messages: a damaged name must not put control characters or a newline on the terminal.)
     const bool identifier = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
       return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
@@ -421,7 +334,7 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
       return Status::Error(Format("%s: field '%s' has %u-byte elements; this build's have %zu", path.c_str(),   \
                                   name.c_str(), element, sizeof(type)));                                        \
     }                                                                                                           \
-    if (!r.Bytes(out->fluid.fieldName.data(), static_cast<size_t>(fluid) * sizeof(type))) return truncated();   \
+    if (!r.Bytes(out->fluid.fieldName.data(), static_cast<size_t>(fluid) * sizeof(type))) return Truncated(path, r);   \
   }
     SPHXR_FLUID_FIELDS(SPHXR_READ_FIELD)
 #undef SPHXR_READ_FIELD
@@ -433,15 +346,36 @@ Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile
   }
   SPHXR_FLUID_FIELDS(SPHXR_CHECK_SEEN)
 #undef SPHXR_CHECK_SEEN
+  return Status::Ok();
+}
+
+Status ParseDiffuse(Reader& r, const std::string& path, StateFile* out) {
+  uint32_t diffuse = 0;
+  if (!r.Get(&diffuse)) return Truncated(path, r);
+  if (static_cast<uint64_t>(diffuse) * 2 * sizeof(sim::Vec4) > r.Left()) return Truncated(path, r);
+  out->diffuse.resize(static_cast<int>(diffuse));
+  if (!r.Bytes(out->diffuse.position.data(), diffuse * sizeof(sim::Vec4)) ||
+      !r.Bytes(out->diffuse.velocity.data(), diffuse * sizeof(sim::Vec4))) {
+    return Truncated(path, r);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ParseStateFile(std::vector<char> data, const std::string& path, StateFile* out) {
+  *out = StateFile{};
+  out->path = path;
+  if (data.size() < sizeof(kMagic) || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
+    return Status::Error(path + ": not an sphxr state file (written by sphxr --save-state)");
+  }
+  Reader r(std::move(data));
+  uint32_t version = 0;
+  if (Status s = ParseHead(r, path, &version, out); !s) return s;
+  if (Status s = ParseBodies(r, path, out); !s) return s;
+  if (Status s = ParseFields(r, path, out); !s) return s;
   if (version >= 4) {  // (older files have none: the run starts without)
-    uint32_t diffuse = 0;
-    if (!r.Get(&diffuse)) return truncated();
-    if (static_cast<uint64_t>(diffuse) * 2 * sizeof(sim::Vec4) > r.Left()) return truncated();
-    out->diffuse.resize(static_cast<int>(diffuse));
-    if (!r.Bytes(out->diffuse.position.data(), diffuse * sizeof(sim::Vec4)) ||
-        !r.Bytes(out->diffuse.velocity.data(), diffuse * sizeof(sim::Vec4))) {
-      return truncated();
-    }
+    if (Status s = ParseDiffuse(r, path, out); !s) return s;
   }
   if (r.Left() != 0) return Status::Error(Format("%s: %zu bytes after the last field: the file is damaged", path.c_str(), r.Left()));
   return Status::Ok();

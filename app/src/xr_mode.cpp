@@ -24,8 +24,11 @@
 
 #include "gl_window.h"
 #include "interrupt_scope.h"
+#include "interop_surface.h"
 #include "sim_worker.h"
-#include "sphxr/app/desktop.h"
+#include "xr_hands.h"
+#include "sphxr/app/run_start.h"
+#include "sphxr/app/display.h"
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
@@ -43,58 +46,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 glm::mat4 ToGlm(const xr::Mat4& m) { return glm::make_mat4(m.m.data()); }
-
-/// A paddle hangs from the hand along its body -y (paddle.h: blade below the grip); a controller's
-/// grip points along its -z. Body -> grip: +90 degrees about x (body -y becomes grip -z).
-constexpr Quat kGripFromPaddle{0.70710678f, 0.70710678f, 0.0f, 0.0f};
-
-/// Where a hand's paddle may go: over the tank (5 cm beyond its sides) from its floor to 0.5 m above its
-/// top. A hand elsewhere (resting at the user's side, reaching past the tank) does not drag its paddle
-/// through the walls and floor: it counts as untracked, so the paddle holds, then withdraws above the
-/// water (paddle.h), and re-enters when the hand comes back.
-bool InReach(const sim::Vec3& p, const sim::Aabb& tank) {
-  constexpr float kSide = 0.05f, kAbove = 0.5f;
-  return p.x >= tank.min.x - kSide && p.x <= tank.max.x + kSide && p.z >= tank.min.z - kSide &&
-         p.z <= tank.max.z + kSide && p.y >= tank.min.y && p.y <= tank.max.y + kAbove;
-}
-
-interaction::HandInput ToHandInput(const xr::HandState& h, const sim::Vec3& offset, const sim::Aabb& tank,
-                                   double timeSeconds) {
-  interaction::HandInput in;
-  in.pose.position = {h.grip.position.x - offset.x, h.grip.position.y - offset.y, h.grip.position.z - offset.z};
-  in.tracked = h.poseValid && h.tracked && InReach(in.pose.position, tank);
-  in.pose.orientation = Mul(h.grip.orientation, kGripFromPaddle);
-  in.hasVelocity = h.velocityValid;
-  in.linearVelocity = {h.linearVelocity.x, h.linearVelocity.y, h.linearVelocity.z};
-  in.angularVelocity = {h.angularVelocity.x, h.angularVelocity.y, h.angularVelocity.z};
-  in.trigger = h.trigger;
-  in.grip = h.squeeze;
-  in.time = timeSeconds;
-  return in;
-}
-
-/// The controllers where the hands are, and each hand's paddle in its hand: where the solver has it
-/// while it is in the water, at the hand while the hand is away from the tank (its body then waits
-/// above the water, out of the way, paddle.h).
-void DrawHandsAndPaddles(const xr::FrameInfo& info, const std::vector<interaction::HandInput>& hands,
-                         const sim::Vec3& offset, const SimSnapshot& snap, render::FrameScene* frame) {
-  frame->solids.clear();
-  for (PaddlePose paddle : snap.paddles) {
-    if (paddle.hand >= 0 && paddle.hand < static_cast<int>(hands.size())) {
-      const xr::HandState& h = info.hands[size_t(paddle.hand)];
-      const bool held = h.poseValid && h.tracked;
-      if (held && !hands[size_t(paddle.hand)].tracked) paddle.pose = hands[size_t(paddle.hand)].pose;
-    }
-    AppendPaddleSolids(paddle, &frame->solids);
-  }
-  for (const xr::HandState& h : info.hands) {
-    if (!(h.poseValid && h.tracked)) continue;
-    interaction::Pose grip;
-    grip.position = {h.grip.position.x - offset.x, h.grip.position.y - offset.y, h.grip.position.z - offset.z};
-    grip.orientation = h.grip.orientation;
-    AppendControllerSolids(grip, &frame->solids);
-  }
-}
 
 double MeanSpeed(const sim::HostFluid& fluid) {
   double sum = 0.0;
@@ -270,25 +221,12 @@ Status StartSimulation(XrApp& app) {
   return Status::Ok();
 }
 
-}  // namespace
-
-sim::Vec3 XrSceneOffset(const sim::Aabb& tank, const XrPlacement& placement) {
-  return {placement.centerX - 0.5f * (tank.min.x + tank.max.x), placement.centerY - 0.5f * (tank.min.y + tank.max.y),
-          placement.centerZ - 0.5f * (tank.min.z + tank.max.z)};
-}
-
-bool XrRuntimeAvailable(std::string* why) {
-  const Status s = xr::ProbeRuntime();
-  if (!s && why) *why = s.message();
-  return static_cast<bool>(s);
-}
-
-Status RunXr(const Options& options, XrOutcome* outcome) {
-  *outcome = XrOutcome{};
-  XrApp app;
+// Before the headset: the scene and the state file (a bad one is one line before the session starts),
+// the display, the runtime, the window and the session (an error there is the headset's: fall back),
+// then the simulation.
+Status PrepareXr(const Options& options, XrApp& app, XrOutcome* outcome) {
   app.options = options;
   {
-    // A bad state file is one line before the headset session starts.
     RunStart start;
     if (Status s = PrepareStart(options, &start); !s) return s;
     app.scene = std::move(start.scene);
@@ -313,19 +251,27 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   if (const std::string ignored = HeadlessOnlyOptions(options); !ignored.empty()) {
     SPHXR_LOG_WARN("%s: honoured by --headless runs only; the headset session ignores them", ignored.c_str());
   }
-  if (Status s = StartSimulation(app); !s) return s;
+  return StartSimulation(app);
+}
 
-  const glm::mat4 sceneToPlay = glm::translate(glm::mat4(1.0f), glm::vec3(app.offset.x, app.offset.y, app.offset.z));
-  std::vector<double> intervals, busy;
+/// The headset's frame loop: each pass polls the window and the session and, while the session runs,
+/// makes one frame (the update with the newest snapshot, then each eye). It keeps the frame measures
+/// and the last mirror image for the end of the run.
+struct FrameLoop {
+  XrApp& app;
+  XrOutcome* outcome;
+  glm::mat4 sceneToPlay;
+  std::vector<double> intervals, busy;  // ms between frames; ms of a frame outside xrWaitFrame
   std::shared_ptr<const SimSnapshot> previousSnap;
   render::Image lastMirror;  // --screenshot: the window's last mirror image
   Clock::time_point previousFrame{};
   int64_t previousPeriodNs = 0;
-  const auto started = Clock::now();
-  InterruptScope interrupts;
   Clock::time_point interruptedAt{};
-  while (true) {
+
+  /// One pass: false once the session has ended (or is left, as a lost one is).
+  bool Pass() {
     glfwPollEvents();
+    const Options& options = app.options;
     if (glfwWindowShouldClose(app.window) || (options.frameLimit > 0 && outcome->frames >= options.frameLimit)) {
       app.RequestExit();
     }
@@ -337,7 +283,7 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     }
     // A session that does not end within two seconds of the signal (not running, a runtime that never
     // answers the request) is left as a lost one is.
-    if (outcome->interrupted && Clock::now() - interruptedAt > std::chrono::seconds(2)) break;
+    if (outcome->interrupted && Clock::now() - interruptedAt > std::chrono::seconds(2)) return false;
     const xr::EventResult ev = app.session->PollEvents();
     for (xr::SessionState state : ev.transitions) {
       if (!outcome->states.empty()) outcome->states += ' ';
@@ -346,12 +292,17 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     if (ev.exit) {
       outcome->lost = ev.lost;
       outcome->message = ev.message;
-      break;
+      return false;
     }
     if (!ev.running) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      continue;
+      return true;
     }
+    return Frame();
+  }
+
+  /// One frame of the session; false when it failed.
+  bool Frame() {
     // The newest snapshot: drawn again when the simulation has not published since the last frame.
     const std::shared_ptr<const SimSnapshot> snap = app.worker->Latest();
     if (snap != previousSnap) {  // how much the water moves (the tests compare a stirred tank with a still one)
@@ -360,134 +311,158 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
     }
     render::FrameScene frame;
     bool mirrored = false;
-    const Status f = app.session->Frame(
-        [&](const xr::FrameInfo& info) {
-          ++outcome->frames;
-          const Clock::time_point now = Clock::now();
-          if (previousFrame != Clock::time_point{}) {
-            const double ms = std::chrono::duration<double, std::milli>(now - previousFrame).count();
-            intervals.push_back(ms);
-            if (previousPeriodNs > 0 && ms > 1.5e-6 * static_cast<double>(previousPeriodNs)) ++outcome->lateFrames;
-          }
-          if (!intervals.empty()) FrameEnded(app, outcome->frames - 1, intervals.back(), 1e-6 * static_cast<double>(info.displayPeriodNs));
-          previousFrame = now;
-          previousPeriodNs = info.displayPeriodNs;
-
-          const double displayTime = 1e-9 * static_cast<double>(info.predictedDisplayTimeNs);
-          std::vector<interaction::HandInput> hands;
-          for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, app.setup.tank, displayTime));
-          app.worker->SetHands(hands);
-          if (const uint64_t saves = app.worker->SavesDone(); saves != app.savesFelt) {
-            app.savesFelt = saves;
-            app.buzzUntil = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(XrApp::kSaveBuzzSeconds));
-          }
-          for (int h = 0; h < xr::kHandCount; ++h) {
-            float amplitude = snap->haptic[h];
-            if (amplitude < 0.01f) amplitude = 0.0f;
-            if (h == static_cast<int>(xr::Hand::kRight) && now < app.buzzUntil) amplitude = std::max(amplitude, XrApp::kSaveBuzz);
-            if (amplitude == 0.0f && app.lastHaptic[h] == 0.0f) continue;  // stop once, not every frame
-            app.lastHaptic[h] = amplitude;
-            if (Status hs = app.session->ApplyHaptics(static_cast<xr::Hand>(h), amplitude); !hs) {
-              LogOnce("xr-haptics", LogLevel::kWarn, "%s", hs.message().c_str());
-            }
-          }
-          if (info.resetRequested) {
-            SPHXR_LOG_INFO("reset button: the scene starts again");
-            app.worker->Reset(app.simScene);
-          }
-          if (info.saveRequested) {  // the worker saves between two steps: the frame does not wait for it
-            SPHXR_LOG_INFO("save button: saving the water");
-            app.worker->RequestSave(app.options.saveState, app.scene.name);
-          }
-          // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
-          frame = MakeFrameScene(*snap, app.mode, app.color, app.interop.Update(*app.worker, *snap));
-          DrawHandsAndPaddles(info, hands, app.offset, *snap, &frame);
-          frame.frameKey = info.frameIndex + 1;  // both eyes share one upload and one shadow pass
-        },
-        [&](const xr::FrameInfo&, const xr::EyeView& eye) {
-          // The renderer writes display-ready colour (the desktop window shows its bytes as they are):
-          // no second sRGB encoding, so the headset looks like the desktop window.
-          glDisable(GL_FRAMEBUFFER_SRGB);
-          render::View view;
-          view.view = ToGlm(eye.view) * sceneToPlay;
-          view.projection = ToGlm(eye.projection);
-          view.framebuffer = eye.framebuffer;
-          view.x = eye.x;
-          view.y = eye.y;
-          view.width = eye.width;
-          view.height = eye.height;
-          app.renderer->Draw(frame, std::span(&view, 1));
-          if (eye.eye == 0) {
-            app.Mirror(eye);
-            if (!options.screenshotPath.empty()) {  // the mirror as blitted, before the panel
-              int w = 0, h = 0;
-              glfwGetFramebufferSize(app.window, &w, &h);
-              if (w > 0 && h > 0) lastMirror = render::ReadPixels(0, 0, 0, w, h);
-              glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer);
-            }
-            mirrored = true;
-            ++outcome->rendered;
-          }
-        });
+    const Status f = app.session->Frame([&](const xr::FrameInfo& info) { Update(info, *snap, &frame); },
+                                        [&](const xr::FrameInfo&, const xr::EyeView& eye) {
+                                          if (Eye(frame, eye)) mirrored = true;
+                                        });
     if (!f) {
       // A failing frame call is a lost session in all but name: end it the same way.
       SPHXR_LOG_WARN("%s", f.message().c_str());
       outcome->lost = true;
       outcome->message = f.message();
-      break;
+      return false;
     }
     const xr::FrameTimings& t = app.session->lastFrameTimings();
     busy.push_back(t.syncMs + t.updateMs + t.renderMs + t.endMs);
-    if (mirrored) {
-      int w = 0, h = 0;
-      glfwGetFramebufferSize(app.window, &w, &h);
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      glViewport(0, 0, w, h);
-      ImGui_ImplOpenGL3_NewFrame();
-      ImGui_ImplGlfw_NewFrame();
-      ImGui::NewFrame();
-      app.Panel(*snap, *outcome);
-      ImGui::Render();
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-      glfwSwapBuffers(app.window);
-    }
+    if (mirrored) PanelOnMirror(*snap);
+    return true;
   }
-  const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
-  // A lost session must not lose the water stirred in it: saved (to --save-state's file, else
-  // "<scene>-lost.state", else that name in the temporary folder), and the window that takes over starts
-  // from it (main.cpp). A session ended by a signal is saved the same way.
-  if (outcome->interrupted) {
-    outcome->message = std::string("ended by ") + InterruptName(outcome->interrupted);
-  }
-  if (outcome->lost || outcome->interrupted) {
-    std::vector<std::string> paths = {!options.saveState.empty() ? options.saveState : LostStatePath(app.scene.name)};
-    if (options.saveState.empty()) {
-      const char* tmp = std::getenv("TMPDIR");
-      paths.push_back((std::filesystem::path(tmp && *tmp ? tmp : "/tmp") / LostStatePath(app.scene.name)).string());
+
+  /// The frame's update: its timing, the hands to the simulation, the haptics, the buttons, the scene.
+  void Update(const xr::FrameInfo& info, const SimSnapshot& snap, render::FrameScene* frame) {
+    ++outcome->frames;
+    const Clock::time_point now = Clock::now();
+    if (previousFrame != Clock::time_point{}) {
+      const double ms = std::chrono::duration<double, std::milli>(now - previousFrame).count();
+      intervals.push_back(ms);
+      if (previousPeriodNs > 0 && ms > 1.5e-6 * static_cast<double>(previousPeriodNs)) ++outcome->lateFrames;
     }
-    for (const std::string& path : paths) {
-      const uint64_t before = app.worker->SavesDone();
-      app.worker->SaveStateLogged(path, app.scene.name);
-      if (app.worker->SavesDone() > before) {
-        outcome->savedState = path;
-        break;
+    if (!intervals.empty()) FrameEnded(app, outcome->frames - 1, intervals.back(), 1e-6 * static_cast<double>(info.displayPeriodNs));
+    previousFrame = now;
+    previousPeriodNs = info.displayPeriodNs;
+
+    const double displayTime = 1e-9 * static_cast<double>(info.predictedDisplayTimeNs);
+    std::vector<interaction::HandInput> hands;
+    for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, app.setup.tank, displayTime));
+    app.worker->SetHands(hands);
+    Haptics(snap, now);
+    if (info.resetRequested) {
+      SPHXR_LOG_INFO("reset button: the scene starts again");
+      app.worker->Reset(app.simScene);
+    }
+    if (info.saveRequested) {  // the worker saves between two steps: the frame does not wait for it
+      SPHXR_LOG_INFO("save button: saving the water");
+      app.worker->RequestSave(app.options.saveState, app.scene.name);
+    }
+    // GPU path: the snapshot's mesh is written into the GL buffers here (once per build), before the eyes.
+    *frame = MakeFrameScene(snap, app.mode, app.color, app.interop.Update(*app.worker, snap));
+    DrawHandsAndPaddles(info, hands, app.offset, snap, frame);
+    frame->frameKey = info.frameIndex + 1;  // both eyes share one upload and one shadow pass
+  }
+
+  /// Each hand's paddle felt in its controller, and a finished save felt in the right one.
+  void Haptics(const SimSnapshot& snap, Clock::time_point now) {
+    if (const uint64_t saves = app.worker->SavesDone(); saves != app.savesFelt) {
+      app.savesFelt = saves;
+      app.buzzUntil = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(XrApp::kSaveBuzzSeconds));
+    }
+    for (int h = 0; h < xr::kHandCount; ++h) {
+      float amplitude = snap.haptic[h];
+      if (amplitude < 0.01f) amplitude = 0.0f;
+      if (h == static_cast<int>(xr::Hand::kRight) && now < app.buzzUntil) amplitude = std::max(amplitude, XrApp::kSaveBuzz);
+      if (amplitude == 0.0f && app.lastHaptic[h] == 0.0f) continue;  // stop once, not every frame
+      app.lastHaptic[h] = amplitude;
+      if (Status hs = app.session->ApplyHaptics(static_cast<xr::Hand>(h), amplitude); !hs) {
+        LogOnce("xr-haptics", LogLevel::kWarn, "%s", hs.message().c_str());
       }
     }
   }
-  if (!options.screenshotPath.empty()) {
-    if (lastMirror.width == 0) {
-      SPHXR_LOG_WARN("--screenshot %s: no frame was drawn, no picture", options.screenshotPath.c_str());
-    } else if (Status s = WritePng(options.screenshotPath, lastMirror); !s) {
-      SPHXR_LOG_WARN("%s", s.message().c_str());
-    } else {
-      SPHXR_LOG_INFO("mirror picture (the left eye, without the panel): %s (%dx%d)", options.screenshotPath.c_str(),
-                     lastMirror.width, lastMirror.height);
+
+  /// One eye's view drawn; the left eye is also mirrored into the window. True for the mirrored eye.
+  bool Eye(const render::FrameScene& frame, const xr::EyeView& eye) {
+    // The renderer writes display-ready colour (the desktop window shows its bytes as they are):
+    // no second sRGB encoding, so the headset looks like the desktop window.
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    render::View view;
+    view.view = ToGlm(eye.view) * sceneToPlay;
+    view.projection = ToGlm(eye.projection);
+    view.framebuffer = eye.framebuffer;
+    view.x = eye.x;
+    view.y = eye.y;
+    view.width = eye.width;
+    view.height = eye.height;
+    app.renderer->Draw(frame, std::span(&view, 1));
+    if (eye.eye != 0) return false;
+    app.Mirror(eye);
+    if (!app.options.screenshotPath.empty()) {  // the mirror as blitted, before the panel
+      int w = 0, h = 0;
+      glfwGetFramebufferSize(app.window, &w, &h);
+      if (w > 0 && h > 0) lastMirror = render::ReadPixels(0, 0, 0, w, h);
+      glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer);
+    }
+    ++outcome->rendered;
+    return true;
+  }
+
+  /// The panel over the mirrored eye, and the window's swap.
+  void PanelOnMirror(const SimSnapshot& snap) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(app.window, &w, &h);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, w, h);
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    app.Panel(snap, *outcome);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    glfwSwapBuffers(app.window);
+  }
+};
+
+// A lost session must not lose the water stirred in it: saved (to --save-state's file, else
+// "<scene>-lost.state", else that name in the temporary folder), and the window that takes over starts
+// from it (main.cpp). A session ended by a signal is saved the same way.
+void SaveLostWater(XrApp& app, XrOutcome* outcome) {
+  const Options& options = app.options;
+  if (outcome->interrupted) {
+    outcome->message = std::string("ended by ") + InterruptName(outcome->interrupted);
+  }
+  if (!outcome->lost && !outcome->interrupted) return;
+  std::vector<std::string> paths = {!options.saveState.empty() ? options.saveState : LostStatePath(app.scene.name)};
+  if (options.saveState.empty()) {
+    const char* tmp = std::getenv("TMPDIR");
+    paths.push_back((std::filesystem::path(tmp && *tmp ? tmp : "/tmp") / LostStatePath(app.scene.name)).string());
+  }
+  for (const std::string& path : paths) {
+    const uint64_t before = app.worker->SavesDone();
+    app.worker->SaveStateLogged(path, app.scene.name);
+    if (app.worker->SavesDone() > before) {
+      outcome->savedState = path;
+      break;
     }
   }
-  outcome->frameMsP50 = Percentile(intervals, 0.5);
-  outcome->frameMsP90 = Percentile(intervals, 0.9);
-  outcome->busyMsP50 = Percentile(busy, 0.5);
-  outcome->busyMsP90 = Percentile(busy, 0.9);
+}
+
+// --screenshot: the last mirror image (the left eye, without the panel).
+void WriteMirrorPicture(const std::string& path, const render::Image& lastMirror) {
+  if (path.empty()) return;
+  if (lastMirror.width == 0) {
+    SPHXR_LOG_WARN("--screenshot %s: no frame was drawn, no picture", path.c_str());
+  } else if (Status s = WritePng(path, lastMirror); !s) {
+    SPHXR_LOG_WARN("%s", s.message().c_str());
+  } else {
+    SPHXR_LOG_INFO("mirror picture (the left eye, without the panel): %s (%dx%d)", path.c_str(), lastMirror.width,
+                   lastMirror.height);
+  }
+}
+
+// The run's measures into `outcome`, and its summary on stdout.
+void Summarise(XrApp& app, const FrameLoop& loop, double seconds, XrOutcome* outcome) {
+  outcome->frameMsP50 = Percentile(loop.intervals, 0.5);
+  outcome->frameMsP90 = Percentile(loop.intervals, 0.9);
+  outcome->busyMsP50 = Percentile(loop.busy, 0.5);
+  outcome->busyMsP90 = Percentile(loop.busy, 0.9);
   const std::shared_ptr<const SimSnapshot> last = app.worker->Latest();
   outcome->meanFluidSpeed = MeanSpeed(last->fluid);
   outcome->peakMeanFluidSpeed = std::max(outcome->peakMeanFluidSpeed, outcome->meanFluidSpeed);
@@ -501,6 +476,35 @@ Status RunXr(const Options& options, XrOutcome* outcome) {
   std::printf("sphxr --xr: session states %s\n", outcome->states.c_str());
   std::printf("sphxr --xr: %s\n", RenderSummary(app.budget->Quality(), app.renderer->LastStats()).c_str());
   std::fflush(stdout);
+}
+
+}  // namespace
+
+sim::Vec3 XrSceneOffset(const sim::Aabb& tank, const XrPlacement& placement) {
+  return {placement.centerX - 0.5f * (tank.min.x + tank.max.x), placement.centerY - 0.5f * (tank.min.y + tank.max.y),
+          placement.centerZ - 0.5f * (tank.min.z + tank.max.z)};
+}
+
+bool XrRuntimeAvailable(std::string* why) {
+  const Status s = xr::ProbeRuntime();
+  if (!s && why) *why = s.message();
+  return static_cast<bool>(s);
+}
+
+Status RunXr(const Options& options, XrOutcome* outcome) {
+  *outcome = XrOutcome{};
+  XrApp app;
+  if (Status s = PrepareXr(options, app, outcome); !s) return s;
+  const glm::mat4 sceneToPlay = glm::translate(glm::mat4(1.0f), glm::vec3(app.offset.x, app.offset.y, app.offset.z));
+  FrameLoop loop{app, outcome, sceneToPlay};
+  const auto started = Clock::now();
+  InterruptScope interrupts;  // to the end: a signal while the water is saved does not cut the save
+  while (loop.Pass()) {
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  SaveLostWater(app, outcome);
+  WriteMirrorPicture(options.screenshotPath, loop.lastMirror);
+  Summarise(app, loop, seconds, outcome);
   return Status::Ok();
 }
 

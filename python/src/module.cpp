@@ -110,18 +110,8 @@ py::dict ReadState(const std::string& path) {
   return d;
 }
 
-}  // namespace
-}  // namespace sphxr::python
 
-PYBIND11_MODULE(_sphxr, m) {
-  using namespace sphxr::python;
-  using sphxr::Status;
-  m.doc() = "sphxr: SPH water runs from Python (docs/user/python.md); use the sphxr package, not _sphxr";
-  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
-  m.attr("build_scenes_dir") = SPHXR_SCENES_DIR;
-  m.attr("max_scene_depth") = sphxr::app::kMaxSceneDepth;
-  m.attr("max_run_time") = sphxr::app::kMaxRunTime;
-
+void BindRunOptions(py::module_& m) {
   py::class_<RunOptions>(m, "RunOptions")
       .def(py::init<>())
       .def_readwrite("scene", &RunOptions::scene)
@@ -136,9 +126,11 @@ PYBIND11_MODULE(_sphxr, m) {
       .def_readwrite("load_state", &RunOptions::loadState)
       .def_readwrite("probes_csv", &RunOptions::probesCsv)
       .def_readwrite("record_dam_break", &RunOptions::recordDamBreak);
+}
 
-  py::class_<Run>(m, "Run")
-      .def(py::init(&Make), py::arg("options"))
+// A run's steps and its saved state.
+void BindRunSteps(py::class_<Run>& run) {
+  run.def(py::init(&Make), py::arg("options"))
       .def(
           "step",
           [](Run& r, int64_t n) {
@@ -157,8 +149,12 @@ PYBIND11_MODULE(_sphxr, m) {
       .def(
           "save_state",
           [](Run& r, const std::string& path) { Check(Unlocked([&](const KeepGoing&) { return r.SaveState(path); })); },
-          py::arg("path"))
-      .def("particles",
+          py::arg("path"));
+}
+
+// What a run has recorded: its particles, probe rows, step rows and dam-break measures, as NumPy arrays.
+void BindRunTables(py::class_<Run>& run) {
+  run.def("particles",
            [](Run& r) {
              Particles p;
              Check(Unlocked([&](const KeepGoing&) { return r.Download(&p); }));
@@ -205,8 +201,12 @@ PYBIND11_MODULE(_sphxr, m) {
              std::vector<double> flat;
              for (const auto& row : h) flat.insert(flat.end(), row.begin(), row.end());
              return Array(flat, {static_cast<py::ssize_t>(h.size()), 3});
-           })
-      .def("summary", &Run::Summary)
+           });
+}
+
+// A run's summary, parameters and scene.
+void BindRunProperties(py::class_<Run>& run) {
+  run.def("summary", &Run::Summary)
       .def("parameters", [](Run& r) { return Parameters(r.Setup()); })
       .def_property_readonly("time", &Run::Time)
       .def_property_readonly("steps", &Run::Steps)
@@ -227,7 +227,10 @@ PYBIND11_MODULE(_sphxr, m) {
         const auto& g = r.Setup().gravity;
         return py::make_tuple(g.x, g.y, g.z);
       });
+}
 
+// State files and scenes: read, found, described.
+void BindScenes(py::module_& m) {
   m.def("read_state", &ReadState, py::arg("path"));
   m.def(
       "scene_info",
@@ -260,6 +263,10 @@ PYBIND11_MODULE(_sphxr, m) {
       },
       py::arg("name"), py::arg("install_dir") = "");
   m.def("scene_dirs", &sphxr::app::SceneSearchDirs, py::arg("install_dir") = "");
+}
+
+// The log level, the run arguments' checks, the escaping of shown text, the limits and the names.
+void BindChecks(py::module_& m) {
   m.def("set_log_level", [](const std::string& level) {
     static const std::pair<const char*, sphxr::LogLevel> kLevels[] = {
         {"debug", sphxr::LogLevel::kDebug}, {"info", sphxr::LogLevel::kInfo}, {"warn", sphxr::LogLevel::kWarn},
@@ -295,4 +302,23 @@ PYBIND11_MODULE(_sphxr, m) {
     for (const sphxr::app::ParamDesc& p : sphxr::app::ParamRegistry()) names.push_back(p.group == "solver" ? p.name : p.key);
     return names;
   });
+}
+
+}  // namespace
+}  // namespace sphxr::python
+
+PYBIND11_MODULE(_sphxr, m) {
+  using namespace sphxr::python;
+  m.doc() = "sphxr: SPH water runs from Python (docs/user/python.md); use the sphxr package, not _sphxr";
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+  m.attr("build_scenes_dir") = SPHXR_SCENES_DIR;
+  m.attr("max_scene_depth") = sphxr::app::kMaxSceneDepth;
+  m.attr("max_run_time") = sphxr::app::kMaxRunTime;
+  BindRunOptions(m);
+  py::class_<Run> run(m, "Run");
+  BindRunSteps(run);
+  BindRunTables(run);
+  BindRunProperties(run);
+  BindScenes(m);
+  BindChecks(m);
 }

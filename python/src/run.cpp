@@ -47,8 +47,8 @@ class Run::Recorder : public app::SimulationSink {
 
  private:
   void Measure(app::Simulation& simulation) {
-    // As the headless summary measures them (app/src/headless_sinks.cpp MeasureDamBreak, which lives
-    // beside the picture sinks that would bring GL into the module).
+    // As the headless summary measures them (app/src/dam_break_measure.cpp MeasureDamBreak, private to
+    // app/), the height divided in double.
     simulation.Solver().Download(&m_host);
     const app::DamBreakProbe& probe = *m_scene.damBreak;
     const float spacing = simulation.Setup().params.spacing;

@@ -9,6 +9,7 @@
 
 #include "refusal.h"
 #include "sphxr/app/cli.h"
+#include "sphxr/app/run_start.h"
 #include "sphxr/app/scene_file.h"
 #include "support.h"
 

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "sphxr/app/cli.h"
+#include "sphxr/app/run_start.h"
 #include "sphxr/app/headless.h"
 #include "sphxr/common/log.h"
 #include "sphxr/app/state_file.h"

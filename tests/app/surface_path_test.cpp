@@ -6,7 +6,8 @@
 #include <memory>
 #include <vector>
 
-#include "sim_worker.h"  // app/src: SimWorker, InteropSurface
+#include "interop_surface.h"  // app/src: InteropSurface
+#include "sim_worker.h"        // app/src: SimWorker
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/snapshot.h"
 #include "support.h"

@@ -21,7 +21,8 @@
 #include "sphxr/app/pictures.h"
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/snapshot.h"
-#include "sim_worker.h"  // app/src: SimWorker, InteropSurface
+#include "interop_surface.h"  // app/src: InteropSurface
+#include "sim_worker.h"        // app/src: SimWorker
 #include "sphxr/render/interop.h"
 #include "support.h"
 #include "xvfb.h"

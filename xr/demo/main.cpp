@@ -54,6 +54,62 @@ void DrawEye(const xr::FrameInfo& frame, const xr::EyeView& eye) {
   glDisable(GL_SCISSOR_TEST);
 }
 
+// The frame loop until the session ends: the triggers buzz their controllers, the left eye is mirrored
+// into the window. 1 when a frame failed.
+int RunSession(xr::Session& session, GLFWwindow* window, long maxFrames) {
+  long frames = 0;
+  bool exitAsked = false;
+  bool mirrored = false;
+  float lastAmplitude[xr::kHandCount] = {0, 0};
+  while (true) {
+    glfwPollEvents();
+    if ((glfwWindowShouldClose(window) || (maxFrames >= 0 && frames >= maxFrames)) && !exitAsked) {
+      if (Status e = session.RequestExit(); !e) std::fprintf(stderr, "sphxr_xr_demo: %s\n", e.message().c_str());
+      exitAsked = true;
+    }
+    xr::EventResult ev = session.PollEvents();
+    if (ev.exit) {
+      std::printf("sphxr_xr_demo: %s after %ld frames%s\n", ev.message.c_str(), frames,
+                  ev.lost ? " (the application would fall back to desktop mode)" : "");
+      break;
+    }
+    if (!ev.running) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      continue;
+    }
+    Status f = session.Frame(
+        [&](const xr::FrameInfo& frame) {
+          ++frames;
+          for (int h = 0; h < xr::kHandCount; ++h) {
+            float amplitude = frame.hands[size_t(h)].trigger;
+            if (amplitude == 0 && lastAmplitude[h] == 0) continue;  // stop once, not every frame
+            lastAmplitude[h] = amplitude;
+            if (Status hs = session.ApplyHaptics(xr::Hand(h), amplitude); !hs)
+              std::fprintf(stderr, "sphxr_xr_demo: %s\n", hs.message().c_str());
+          }
+        },
+        [&](const xr::FrameInfo& frame, const xr::EyeView& eye) {
+          DrawEye(frame, eye);
+          if (eye.eye != 0) return;
+          // Mirror now, while the image is ours: once released it belongs to the compositor.
+          int w = 0, h = 0;
+          glfwGetFramebufferSize(window, &w, &h);
+          glBindFramebuffer(GL_READ_FRAMEBUFFER, eye.framebuffer);
+          glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+          glDisable(GL_FRAMEBUFFER_SRGB);  // copy the encoded bytes as they are
+          glBlitFramebuffer(0, 0, eye.width, eye.height, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+          glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer);  // xr restores its own binding after
+          mirrored = true;
+        });
+    if (!f) {
+      std::fprintf(stderr, "sphxr_xr_demo: %s\n", f.message().c_str());
+      return 1;
+    }
+    if (mirrored) glfwSwapBuffers(window);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -95,57 +151,7 @@ int main(int argc, char** argv) {
     } else {
       std::printf("sphxr_xr_demo: runtime '%s', %dx%d per eye\n", session->runtimeName().c_str(), session->eyeWidth(),
                   session->eyeHeight());
-      long frames = 0;
-      bool exitAsked = false;
-      bool mirrored = false;
-      float lastAmplitude[xr::kHandCount] = {0, 0};
-      while (true) {
-        glfwPollEvents();
-        if ((glfwWindowShouldClose(window) || (maxFrames >= 0 && frames >= maxFrames)) && !exitAsked) {
-          if (Status e = session->RequestExit(); !e) std::fprintf(stderr, "sphxr_xr_demo: %s\n", e.message().c_str());
-          exitAsked = true;
-        }
-        xr::EventResult ev = session->PollEvents();
-        if (ev.exit) {
-          std::printf("sphxr_xr_demo: %s after %ld frames%s\n", ev.message.c_str(), frames,
-                      ev.lost ? " (the application would fall back to desktop mode)" : "");
-          break;
-        }
-        if (!ev.running) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(10));
-          continue;
-        }
-        Status f = session->Frame(
-            [&](const xr::FrameInfo& frame) {
-              ++frames;
-              for (int h = 0; h < xr::kHandCount; ++h) {
-                float amplitude = frame.hands[size_t(h)].trigger;
-                if (amplitude == 0 && lastAmplitude[h] == 0) continue;  // stop once, not every frame
-                lastAmplitude[h] = amplitude;
-                if (Status hs = session->ApplyHaptics(xr::Hand(h), amplitude); !hs)
-                  std::fprintf(stderr, "sphxr_xr_demo: %s\n", hs.message().c_str());
-              }
-            },
-            [&](const xr::FrameInfo& frame, const xr::EyeView& eye) {
-              DrawEye(frame, eye);
-              if (eye.eye != 0) return;
-              // Mirror now, while the image is ours: once released it belongs to the compositor.
-              int w = 0, h = 0;
-              glfwGetFramebufferSize(window, &w, &h);
-              glBindFramebuffer(GL_READ_FRAMEBUFFER, eye.framebuffer);
-              glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-              glDisable(GL_FRAMEBUFFER_SRGB);  // copy the encoded bytes as they are
-              glBlitFramebuffer(0, 0, eye.width, eye.height, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_LINEAR);
-              glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer);  // xr restores its own binding after
-              mirrored = true;
-            });
-        if (!f) {
-          std::fprintf(stderr, "sphxr_xr_demo: %s\n", f.message().c_str());
-          code = 1;
-          break;
-        }
-        if (mirrored) glfwSwapBuffers(window);
-      }
+      code = RunSession(*session, window, maxFrames);
     }
   }
   glfwDestroyWindow(window);

@@ -67,6 +67,39 @@ SessionState FromXr(XrSessionState s) {
 Session::Session(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
 Session::~Session() { m_impl->Destroy(); }
 
+// The session state machine of the spec: READY begins the session, STOPPING ends it, EXITING and
+// LOSS_PENDING end the run.
+void Session::Impl::OnSessionState(XrSessionState next) {
+  if (next == XR_SESSION_STATE_READY) {
+    XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
+    bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+    XrResult br = xrBeginSession(session, &bi);
+    if (XR_FAILED(br)) {
+      exited = true;
+      lost = IsLoss(br);
+      exitMessage = XrFailure("xrBeginSession", br, __FILE__, __LINE__).message();
+    } else {
+      running = true;
+    }
+  } else if (next == XR_SESSION_STATE_STOPPING) {
+    running = false;
+    XrResult er = xrEndSession(session);
+    if (XR_FAILED(er)) {
+      exited = true;
+      lost = IsLoss(er);
+      exitMessage = XrFailure("xrEndSession", er, __FILE__, __LINE__).message();
+    }
+  } else if (next == XR_SESSION_STATE_EXITING) {
+    running = false;
+    exited = true;
+    exitMessage = "OpenXR session ended";
+  } else if (next == XR_SESSION_STATE_LOSS_PENDING) {
+    running = false;
+    exited = lost = true;
+    exitMessage = "OpenXR session lost (the headset went away)";
+  }
+}
+
 EventResult Session::PollEvents() {
   Impl& m = *m_impl;
   EventResult result;
@@ -115,34 +148,7 @@ EventResult Session::PollEvents() {
         m.state = FromXr(e.state);
         result.transitions.push_back(m.state);
         SPHXR_LOG_DEBUG("OpenXR: session state %s", SessionStateName(m.state));
-        if (e.state == XR_SESSION_STATE_READY) {
-          XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
-          bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
-          XrResult br = xrBeginSession(m.session, &bi);
-          if (XR_FAILED(br)) {
-            m.exited = true;
-            m.lost = IsLoss(br);
-            m.exitMessage = XrFailure("xrBeginSession", br, __FILE__, __LINE__).message();
-          } else {
-            m.running = true;
-          }
-        } else if (e.state == XR_SESSION_STATE_STOPPING) {
-          m.running = false;
-          XrResult er = xrEndSession(m.session);
-          if (XR_FAILED(er)) {
-            m.exited = true;
-            m.lost = IsLoss(er);
-            m.exitMessage = XrFailure("xrEndSession", er, __FILE__, __LINE__).message();
-          }
-        } else if (e.state == XR_SESSION_STATE_EXITING) {
-          m.running = false;
-          m.exited = true;
-          m.exitMessage = "OpenXR session ended";
-        } else if (e.state == XR_SESSION_STATE_LOSS_PENDING) {
-          m.running = false;
-          m.exited = m.lost = true;
-          m.exitMessage = "OpenXR session lost (the headset went away)";
-        }
+        m.OnSessionState(e.state);
         break;
       }
       default: break;

@@ -10,6 +10,30 @@
 
 namespace sphxr::xr {
 
+// The composition layer's view of eye `e` (its depth image chained when the runtime takes depth).
+void Session::Impl::LayerView(int e, const XrView& view, XrCompositionLayerProjectionView* out) {
+  const Eye& eye = eyes[size_t(e)];
+  XrCompositionLayerProjectionView& lv = *out;
+  lv = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
+  lv.pose = view.pose;
+  lv.fov = view.fov;
+  lv.subImage.swapchain = eye.color;
+  lv.subImage.imageRect = {{0, 0}, {eye.width, eye.height}};
+  lv.subImage.imageArrayIndex = 0;
+  if (depthLayerOffered && eye.depth) {
+    XrCompositionLayerDepthInfoKHR& d = depthInfos[size_t(e)];
+    d = {XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR};
+    d.subImage.swapchain = eye.depth;
+    d.subImage.imageRect = lv.subImage.imageRect;
+    d.subImage.imageArrayIndex = 0;
+    d.minDepth = 0.0f;
+    d.maxDepth = 1.0f;
+    d.nearZ = options.nearZ;
+    d.farZ = options.farZ;
+    lv.next = &d;
+  }
+}
+
 Status Session::Impl::RenderEyes(const FrameInfo& info, const RenderEyeFn& renderEye,
                                  std::array<XrCompositionLayerProjectionView, 2>* layerViews, bool* rendered) {
   *rendered = false;
@@ -75,25 +99,7 @@ Status Session::Impl::RenderEyes(const FrameInfo& info, const RenderEyeFn& rende
     SPHXR_XR_CHECK(xrReleaseSwapchainImage(eye.color, &ri));
     if (eye.depth) SPHXR_XR_CHECK(xrReleaseSwapchainImage(eye.depth, &ri));
     if (!status) return status;
-    XrCompositionLayerProjectionView& lv = (*layerViews)[size_t(e)];
-    lv = {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
-    lv.pose = views[size_t(e)].pose;
-    lv.fov = views[size_t(e)].fov;
-    lv.subImage.swapchain = eye.color;
-    lv.subImage.imageRect = {{0, 0}, {eye.width, eye.height}};
-    lv.subImage.imageArrayIndex = 0;
-    if (depthLayerOffered && eye.depth) {
-      XrCompositionLayerDepthInfoKHR& d = depthInfos[size_t(e)];
-      d = {XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR};
-      d.subImage.swapchain = eye.depth;
-      d.subImage.imageRect = lv.subImage.imageRect;
-      d.subImage.imageArrayIndex = 0;
-      d.minDepth = 0.0f;
-      d.maxDepth = 1.0f;
-      d.nearZ = options.nearZ;
-      d.farZ = options.farZ;
-      lv.next = &d;
-    }
+    LayerView(e, views[size_t(e)], &(*layerViews)[size_t(e)]);
   }
   *rendered = true;
   return Status::Ok();

@@ -68,6 +68,8 @@ struct Session::Impl {
   Status CreateActions();
   Status CreateSwapchains();
   Status SyncHands(FrameInfo* info, bool* recentre);
+  void LayerView(int e, const XrView& view, XrCompositionLayerProjectionView* out);
+  void OnSessionState(XrSessionState next);  // begin, end, exit or loss (session.cpp)
   Status RenderEyes(const FrameInfo& info, const RenderEyeFn& renderEye,
                     std::array<XrCompositionLayerProjectionView, 2>* views, bool* rendered);
   Status RecentreAt(XrTime time);

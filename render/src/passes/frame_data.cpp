@@ -177,57 +177,74 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
   glm::vec3 placeLo = lo, placeHi = hi;
 
   const size_t groundDraw = solids.size();
-  if (scene.drawFloor) {
-    if (table > 0.0f) {  // a wooden table: a top a little wider than the tank, four legs
-      const float margin = std::max(0.1f, 0.35f * std::max(size.x, size.z));
-      const float thickness = std::clamp(0.12f * table, 0.02f, 0.05f), leg = std::clamp(0.06f * table, 0.02f, 0.06f);
-      const glm::vec3 topLo(lo.x - margin, tableTop - thickness, lo.z - margin);
-      const glm::vec3 topHi(hi.x + margin, tableTop, hi.z + margin);
-      auto box = [&](glm::vec3 a, glm::vec3 b) {
-        SolidDraw d;
-        d.model = BoxModel(a, b);
-        d.color = glm::vec3(0.62f, 0.42f, 0.25f);
-        d.material = Material::kWood;
-        d.buffer = cube.id;
-        d.count = cubeVertices;
-        solids.push_back(d);
-      };
-      box(topLo, topHi);
-      const float inset = 0.5f * leg + 0.03f;
-      for (int k = 0; k < 4; ++k) {
-        const float x = (k & 1) ? topHi.x - inset : topLo.x + inset, z = (k & 2) ? topHi.z - inset : topLo.z + inset;
-        box(glm::vec3(x - 0.5f * leg, groundY, z - 0.5f * leg), glm::vec3(x + 0.5f * leg, topLo.y, z + 0.5f * leg));
-      }
-      // The sun's view reaches the ground around the table, where the table's shadow falls.
-      placeLo = glm::min(placeLo, topLo - glm::vec3(table, 0.0f, table));
-      placeHi = glm::max(placeHi, topHi + glm::vec3(table, 0.0f, table));
-      placeLo.y = groundY;
-    }
+  if (scene.drawFloor && table > 0.0f) LayOutTable(lo, hi, table, &placeLo, &placeHi);
+  if (scene.drawFloor) LayOutGround(groundDraw, placeLo, placeHi, centre, extent);
+  LayOutSolids(scene);
+  if (scene.drawTank) LayOutGlass(lo, hi, tankSize);  // glass: five panes (no lid) and twelve edge bars
+
+  // The sun's view: an orthographic box around the tank, the table and what stands above them.
+  placeHi.y = std::max(placeHi.y, hi.y + 0.5f * tankSize);
+  m_shadowCentre = 0.5f * (placeLo + placeHi);
+  m_shadowRadius = 0.5f * glm::length(placeHi - placeLo) + 1e-3f;
+  shadowRange = 4.0f * m_shadowRadius;
+}
+
+// A wooden table: a top a little wider than the tank, four legs; the place grows to the ground around
+// it, where its shadow falls.
+void FrameData::LayOutTable(glm::vec3 lo, glm::vec3 hi, float table, glm::vec3* placeLo, glm::vec3* placeHi) {
+  const glm::vec3 size = glm::max(hi - lo, glm::vec3(1e-3f));
+  const float margin = std::max(0.1f, 0.35f * std::max(size.x, size.z));
+  const float thickness = std::clamp(0.12f * table, 0.02f, 0.05f), leg = std::clamp(0.06f * table, 0.02f, 0.06f);
+  const glm::vec3 topLo(lo.x - margin, tableTop - thickness, lo.z - margin);
+  const glm::vec3 topHi(hi.x + margin, tableTop, hi.z + margin);
+  auto box = [&](glm::vec3 a, glm::vec3 b) {
+    SolidDraw d;
+    d.model = BoxModel(a, b);
+    d.color = glm::vec3(0.62f, 0.42f, 0.25f);
+    d.material = Material::kWood;
+    d.buffer = cube.id;
+    d.count = cubeVertices;
+    solids.push_back(d);
+  };
+  box(topLo, topHi);
+  const float inset = 0.5f * leg + 0.03f;
+  for (int k = 0; k < 4; ++k) {
+    const float x = (k & 1) ? topHi.x - inset : topLo.x + inset, z = (k & 2) ? topHi.z - inset : topLo.z + inset;
+    box(glm::vec3(x - 0.5f * leg, groundY, z - 0.5f * leg), glm::vec3(x + 0.5f * leg, topLo.y, z + 0.5f * leg));
   }
-  if (scene.drawFloor) {
-    // The ground: the part under the sun's shadow map (around the tank and where the table's shadow
-    // falls) with the shadowed program, the rest to the horizon without it, in five quads.
-    auto ground = [&](glm::vec2 a, glm::vec2 b, bool shadowed) {
-      if (b.x <= a.x || b.y <= a.y) return;
-      SolidDraw d;
-      d.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.5f * (a.x + b.x), groundY, 0.5f * (a.y + b.y))),
-                           glm::vec3(b.x - a.x, 1.0f, b.y - a.y));
-      d.color = glm::vec3(0.80f, 0.76f, 0.68f);
-      d.material = Material::kGround;
-      d.buffer = quad.id;
-      d.count = 6;
-      d.castsShadow = false;
-      d.receivesShadow = shadowed;
-      solids.insert(solids.begin() + static_cast<std::ptrdiff_t>(groundDraw), d);
-    };
-    const glm::vec2 lo2(placeLo.x, placeLo.z), hi2(placeHi.x, placeHi.z);
-    const glm::vec2 far0(centre.x - 0.5f * extent, centre.z - 0.5f * extent), far1(centre.x + 0.5f * extent, centre.z + 0.5f * extent);
-    ground(lo2, hi2, true);
-    ground(far0, glm::vec2(far1.x, lo2.y), false);                 // in front of the tank's region
-    ground(glm::vec2(far0.x, hi2.y), far1, false);                 // behind it
-    ground(glm::vec2(far0.x, lo2.y), glm::vec2(lo2.x, hi2.y), false);  // to its left
-    ground(glm::vec2(hi2.x, lo2.y), glm::vec2(far1.x, hi2.y), false);  // to its right
-  }
+  // The sun's view reaches the ground around the table, where the table's shadow falls.
+  *placeLo = glm::min(*placeLo, topLo - glm::vec3(table, 0.0f, table));
+  *placeHi = glm::max(*placeHi, topHi + glm::vec3(table, 0.0f, table));
+  placeLo->y = groundY;
+}
+
+void FrameData::LayOutGround(size_t groundDraw, glm::vec3 placeLo, glm::vec3 placeHi, glm::vec3 centre, float extent) {
+  // The ground: the part under the sun's shadow map (around the tank and where the table's shadow
+  // falls) with the shadowed program, the rest to the horizon without it, in five quads.
+  auto ground = [&](glm::vec2 a, glm::vec2 b, bool shadowed) {
+    if (b.x <= a.x || b.y <= a.y) return;
+    SolidDraw d;
+    d.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.5f * (a.x + b.x), groundY, 0.5f * (a.y + b.y))),
+                         glm::vec3(b.x - a.x, 1.0f, b.y - a.y));
+    d.color = glm::vec3(0.80f, 0.76f, 0.68f);
+    d.material = Material::kGround;
+    d.buffer = quad.id;
+    d.count = 6;
+    d.castsShadow = false;
+    d.receivesShadow = shadowed;
+    solids.insert(solids.begin() + static_cast<std::ptrdiff_t>(groundDraw), d);
+  };
+  const glm::vec2 lo2(placeLo.x, placeLo.z), hi2(placeHi.x, placeHi.z);
+  const glm::vec2 far0(centre.x - 0.5f * extent, centre.z - 0.5f * extent), far1(centre.x + 0.5f * extent, centre.z + 0.5f * extent);
+  ground(lo2, hi2, true);
+  ground(far0, glm::vec2(far1.x, lo2.y), false);                 // in front of the tank's region
+  ground(glm::vec2(far0.x, hi2.y), far1, false);                 // behind it
+  ground(glm::vec2(far0.x, lo2.y), glm::vec2(lo2.x, hi2.y), false);  // to its left
+  ground(glm::vec2(hi2.x, lo2.y), glm::vec2(far1.x, hi2.y), false);  // to its right
+}
+
+// The obstacles, then the scene's meshes (paddles, controllers) in one buffer, one draw each.
+void FrameData::LayOutSolids(const FrameScene& scene) {
   for (const sim::Aabb& box : scene.obstacles) {
     SolidDraw d;
     d.model = BoxModel(V(box.min), V(box.max));
@@ -236,7 +253,6 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
     d.count = cubeVertices;
     solids.push_back(d);
   }
-  // The scene's meshes (paddles, controllers) into one buffer, one draw each.
   m_staging.clear();
   const size_t firstMeshDraw = solids.size();
   for (const SolidMesh& solid : scene.solids) {
@@ -265,38 +281,33 @@ void FrameData::LayOutPlace(const FrameScene& scene) {
       if (solids[k].buffer == 0) solids[k].buffer = solidTriangles.id;
     }
   }
+}
 
-  if (scene.drawTank) {  // glass: five panes (no lid) and twelve edge bars
-    GlassDraw panes;
-    panes.model = BoxModel(lo, hi);
-    panes.count = cubeVertices;
-    panes.panes = true;
-    panes.centre = centre;
-    glass.push_back(panes);
-    const float bar = std::clamp(0.012f * tankSize, 0.002f, 0.02f);
-    for (int axis = 0; axis < 3; ++axis) {
-      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-      for (int i = 0; i < 4; ++i) {
-        glm::vec3 from, to;
-        from[axis] = lo[axis];
-        to[axis] = hi[axis];
-        from[a] = to[a] = (i & 1) ? hi[a] : lo[a];
-        from[b] = to[b] = (i & 2) ? hi[b] : lo[b];
-        GlassDraw e;
-        e.model = BoxModel(glm::min(from, to) - glm::vec3(0.5f * bar), glm::max(from, to) + glm::vec3(0.5f * bar));
-        e.count = cubeVertices;
-        e.opacity = 0.45f;
-        e.centre = 0.5f * (from + to);
-        glass.push_back(e);
-      }
+void FrameData::LayOutGlass(glm::vec3 lo, glm::vec3 hi, float tankSize) {
+  const glm::vec3 centre = 0.5f * (lo + hi);
+  GlassDraw panes;
+  panes.model = BoxModel(lo, hi);
+  panes.count = cubeVertices;
+  panes.panes = true;
+  panes.centre = centre;
+  glass.push_back(panes);
+  const float bar = std::clamp(0.012f * tankSize, 0.002f, 0.02f);
+  for (int axis = 0; axis < 3; ++axis) {
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    for (int i = 0; i < 4; ++i) {
+      glm::vec3 from, to;
+      from[axis] = lo[axis];
+      to[axis] = hi[axis];
+      from[a] = to[a] = (i & 1) ? hi[a] : lo[a];
+      from[b] = to[b] = (i & 2) ? hi[b] : lo[b];
+      GlassDraw e;
+      e.model = BoxModel(glm::min(from, to) - glm::vec3(0.5f * bar), glm::max(from, to) + glm::vec3(0.5f * bar));
+      e.count = cubeVertices;
+      e.opacity = 0.45f;
+      e.centre = 0.5f * (from + to);
+      glass.push_back(e);
     }
   }
-
-  // The sun's view: an orthographic box around the tank, the table and what stands above them.
-  placeHi.y = std::max(placeHi.y, hi.y + 0.5f * tankSize);
-  m_shadowCentre = 0.5f * (placeLo + placeHi);
-  m_shadowRadius = 0.5f * glm::length(placeHi - placeLo) + 1e-3f;
-  shadowRange = 4.0f * m_shadowRadius;
 }
 
 void FrameData::BindView(const FrameScene& scene, const View& v, const RendererConfig& config, glm::vec2 targetSize) {

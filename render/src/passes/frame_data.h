@@ -91,6 +91,11 @@ struct FrameData {
   void UploadWater(const FrameScene& scene);
   void UploadDiffuse(const FrameScene& scene, const RenderSettings& settings);
   void LayOutPlace(const FrameScene& scene);
+  // Its parts: the table (growing the place the sun's view covers), the ground, the solids, the glass.
+  void LayOutTable(glm::vec3 lo, glm::vec3 hi, float table, glm::vec3* placeLo, glm::vec3* placeHi);
+  void LayOutGround(size_t groundDraw, glm::vec3 placeLo, glm::vec3 placeHi, glm::vec3 centre, float extent);
+  void LayOutSolids(const FrameScene& scene);
+  void LayOutGlass(glm::vec3 lo, glm::vec3 hi, float tankSize);
 };
 
 }  // namespace sphxr::render

@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "sphxr/app/headless.h"
+#include "sphxr/app/options.h"
 #include "sphxr/common/status.h"
 #include "sphxr/render/gl_context.h"
 
@@ -67,8 +67,5 @@ class DesktopApp {
 
 /// `sphxr --desktop`: runs the window until it closes. Fails (one line) when it cannot open one.
 Status RunDesktop(const Options& options);
-
-/// True when a display server is advertised (DISPLAY or WAYLAND_DISPLAY).
-bool DisplayAvailable();
 
 }  // namespace sphxr::app

@@ -1,11 +1,11 @@
 #pragma once
 // The headless runner: `sphxr --headless --scene FILE ...`. The runner is a library function so that
 // tests and benchmarks drive exactly what a user runs; its outputs are sinks of the Simulation
-// (app/src/headless_sinks.h).
+// (app/src/*_sink.h).
 #include <cstdint>
 #include <string>
 
-#include "sphxr/app/cli.h"
+#include "sphxr/app/options.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/solver.h"
 

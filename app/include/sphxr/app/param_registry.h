@@ -30,7 +30,8 @@ struct ParamDesc {
 std::span<const ParamDesc> ParamRegistry();
 /// By full key ("reuse.idle") or, for solver parameters, by bare name ("stiffness").
 const ParamDesc* FindParam(const std::string& key);
-/// Checks `value` (integer, range) and stores it. Errors name `where` and the range.
+/// Checks `value` (finite, range, integer) and stores it: the one check of a parameter, for the scene
+/// file and --set (the panel's sliders stay in the range). Errors name `where`, the value and the range.
 Status SetParam(const ParamDesc& p, double value, const std::string& where, sim::SceneSetup* s);
 
 /// The scene reference of the parameters (markdown: the solver's and the reuse section's tables, key,

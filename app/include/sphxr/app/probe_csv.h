@@ -14,23 +14,12 @@
 #include <optional>
 #include <string>
 
+#include "sphxr/app/probe_config.h"
 #include "sphxr/app/simulation.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/probes.h"
 
 namespace sphxr::app {
-
-/// The shortest probes.every, and the most rows one step may write: an interval the rows can be written
-/// at. (1e-46 s never finished its first step, growing 35 MB/s; 1e-9 s wrote 1.28 million rows in 3
-/// steps.) Together they bound a step's rows; a step longer than kMaxProbeRowsPerStep intervals is refused.
-inline constexpr double kMinProbeInterval = 1e-6;     // s
-inline constexpr int64_t kMaxProbeRowsPerStep = 10000;
-
-/// The scene's "probes" section.
-struct ProbeConfig {
-  double every = 0.001;  // s of simulated time between rows
-  sim::ProbeSet set;     // force probes carry the index of their paddle's body
-};
 
 /// The CSV header for `set`: time,step, then per probe `NAME_p` | `NAME_level` | `NAME_fx` ... `NAME_tz`.
 std::string ProbeCsvHeader(const sim::ProbeSet& set);

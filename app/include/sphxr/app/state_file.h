@@ -7,7 +7,7 @@
 //
 //   "SPHXRST1"  u32 0x01020304 (byte order)  u32 version
 //   f64 time  f32 last max speed  f32 last max |a|  i64 step  f32 spacing  i32 fluid  i32 boundary
-//   u32 n + n bytes: the scene's name   u32 n + n bytes: the solver method ("wcsph" | "dfsph")
+//   u32 n + n bytes: the scene's name   u32 n + n bytes: the solver method (a name of sim::SolverTable())
 //   u32 bodies; per body: pose, from, to (7 f32 each: position x y z, orientation w x y z),
 //     f64 fromTime, f64 toTime, 3 f32 velocity, 3 f32 angular velocity (sim::BodyMotionState)
 //   u32 paddles; per paddle: i32 mode, 7 f32 commanded pose, 3+3+3 f32 force, torque, raw force,

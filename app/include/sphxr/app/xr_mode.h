@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <string>
 
-#include "sphxr/app/headless.h"
+#include "sphxr/app/options.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/params.h"
 

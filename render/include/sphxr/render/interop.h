@@ -2,7 +2,7 @@
 // A surface mesh that lives in OpenGL buffers and is written by CUDA in place (CUDA-GL interop), so a
 // GPU backend's HPMC output reaches the screen without a host copy. The GL side is always built (the
 // renderer draws these buffers like any mesh); Map/Unmap exist only in builds with the CUDA backend
-// (SPHXR_HAVE_CUDA) and need a GPU, which none of our CI machines has: there they are compiled, not run.
+// (SPHXR_HAVE_CUDA) and need a GPU: on a machine without one they are compiled, not run.
 #include <cstdint>
 #include <memory>
 
