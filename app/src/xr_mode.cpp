@@ -261,9 +261,9 @@ struct FrameLoop {
   XrApp& app;
   XrOutcome* outcome;
   glm::mat4 sceneToPlay;
-  std::vector<double> intervals, busy;  // ms between frames; ms of a frame outside xrWaitFrame
-  std::shared_ptr<const SimSnapshot> previousSnap;
-  render::Image lastMirror;  // --screenshot: the window's last mirror image
+  std::vector<double> intervals{}, busy{};  // ms between frames; ms of a frame outside xrWaitFrame
+  std::shared_ptr<const SimSnapshot> previousSnap{};
+  render::Image lastMirror{};  // --screenshot: the window's last mirror image
   Clock::time_point previousFrame{};
   int64_t previousPeriodNs = 0;
   Clock::time_point interruptedAt{};
