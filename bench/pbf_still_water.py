@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""PBF's still water against the real-time issue's targets (mean compression below 1 %, mean speed below
+"""PBF's still water against the real-time targets (mean compression below 1 %, mean speed below
 5 mm/s, 1 s after the lattice): what each of the two costs, in one invocation. No timings.
 
 1. The compression against substeps S and iterations N: `tank_rest` (20 layers of 1 cm) from the lattice

@@ -38,7 +38,7 @@ namespace {
 using sim::Vec3;
 using sim::Vec4;
 
-// Targets of the issue, reported next to the numbers (never asserted).
+// The targets, reported next to the numbers (never asserted).
 constexpr double kTargetMsPerStep50k = 17.0;      // on the 2-core reference machine
 constexpr double kReferenceLibraryMs50k = 68.0;   // a widely used CPU SPH library, same scene, same machine
 constexpr double kTargetBytesPerParticle = 250.0;
@@ -408,7 +408,7 @@ int main(int argc, char** argv) {
   }
   for (const Result& r : results) {
     if (r.fluid > 60000) continue;
-    std::printf("\nTargets of the issue (reported, not asserted), %s fluid particles:\n", Thousands(r.fluid).c_str());
+    std::printf("\nTargets (reported, not asserted), %s fluid particles:\n", Thousands(r.fluid).c_str());
     std::printf("- step time <= %.0f ms on a 2-core machine (a widely used CPU SPH library: %.0f ms here): %.2f ms, %s\n",
                 kTargetMsPerStep50k, kReferenceLibraryMs50k, r.medianMs,
                 r.medianMs <= kTargetMsPerStep50k ? "met" : "NOT met");

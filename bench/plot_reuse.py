@@ -37,7 +37,7 @@ def current_preset(r):
 def main():
     src, dst = sys.argv[1], sys.argv[2]
     rows = list(csv.DictReader(open(src)))
-    # Each scene's deviation column and the targets for `balanced`: at most that deviation, at
+    # Each scene's deviation column and the targets for `balanced`: at most that deviation, at
     # least that speed-up (drawn dashed).
     scenes = [("deep_tank", "surface_rms_spacings", "free-surface RMS vs reuse off (spacings)", 0.5, 2.0),
               ("dam_break_1m", "front_deviation", "surge-front deviation vs reuse off", 3.0, 1.3)]
@@ -72,7 +72,7 @@ def main():
                 ax.plot(x, y, ".", ms=8, color="0.4", label="impulse hold, live density")
         ax.axhline(1.0, color="0.7", lw=0.8)
         ax.axhline(least, color="tab:blue", lw=0.8, ls="--")
-        ax.axvline(worst, color="tab:blue", lw=0.8, ls="--", label="issue's targets for balanced")
+        ax.axvline(worst, color="tab:blue", lw=0.8, ls="--", label="targets for balanced")
         ax.set_xscale("log")
         ax.set_xlabel(label + (" (%)" if key == "front_deviation" else ""))
         ax.set_ylabel("speed-up of the whole step, wall time (reuse off = 1)")

@@ -1,6 +1,6 @@
 // sphxr_bench_probes: the cost of the probes per step (sphxr/sim/probes.h) on scenes/dam_break_1m.json
 // with 20 probes (14 pressure sensors on the walls and the floor, 6 level gauges along the tank), against
-// the same scene without probes. The issue asks for under 2 % of a step.
+// the same scene without probes. The target is under 2 % of a step.
 //
 // Two solvers step in lock-step (with, without, with, without, ...), so that the machine's load hits both
 // alike, each step timed around Solver::Step. Reported: the median ms per step of each, their difference,

@@ -44,7 +44,7 @@ TEST(CutBlock, WholeLayersSayNothing) {
   s.fluid.push_back(::sphxr::test::Block({0, 0, 0}, {0.1f, 0.54f, 0.1f}));
   s.params.spacing = 0.02f;
   EXPECT_TRUE(InfoLinesOfCreate(s).empty());
-  // The column at a spacing that divides it (0.55 / 0.0212 is not whole either: 25.9 layers).
+  // The dam-break column at a spacing that divides it (0.55 / 0.0212 is not whole either: 25.9 layers).
   SceneSetup t = ::sphxr::test::TankScene({0, 0, 0}, {0.3f, 0.7f, 0.11f}, 0.011f);
   t.fluid.push_back(::sphxr::test::Block({0, 0, 0}, {0.11f, 0.55f, 0.11f}));
   EXPECT_TRUE(InfoLinesOfCreate(t).empty());

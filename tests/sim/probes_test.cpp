@@ -97,7 +97,7 @@ ProbeSet CornerSensors(float dx, float surface) {
 // Still water: the wall sensors measure hydrostatics, a gauge reads the free surface within half a
 // spacing, and probes above the water read dry. Hydrostatics as the validation measures it
 // (tests/validation/hydrostatic_test.cpp): the least-squares slope of p against depth through the
-// origin, here held to the 2 % of rho0 g. Each single sensor is not held to 2 % here: the
+// origin, here held to the 2 % target of rho0 g. Each single sensor is not held to 2 % here: the
 // settled state's own pressure field stands +0.1 .. +3 % (and up to +11 % two spacings under the
 // surface) off rho0 g depth around the sensors, which the disabled test below shows (the solver's
 // pressure field, not the probes: their sums themselves are exact, the brute-force test).
@@ -139,7 +139,7 @@ TEST(Probes, StillWaterReadsHydrostaticsAndTheSurface) {
   EXPECT_DOUBLE_EQ(sample.time, s.solver->Time());
 }
 
-// The test: every probe in still water reads rho0 g depth within 2 %, the depth from the free
+// The target: every probe in still water reads rho0 g depth within 2 %, the depth from the free
 // surface as the hydrostatic tests define it. Disabled: the settled state (summation density) fails it,
 // the sensors reading -4.2 .. +3.7 % off below 4 cm of depth and up to +11 % two spacings under the
 // surface, points in the water +0.8 .. +4.8 %. Near the surface the Shepard average is biased deep (its
@@ -486,7 +486,7 @@ TEST(Probes, TheFloorCornerSensorReadsWheneverTheSensorAboveItReads) {
                                   << " steps at which the sensor above it read (corner wet " << cornerWet << ")";
 }
 
-// The target: each flooded corner sensor reads rho0 g depth within 10 %. Disabled: the sensors
+// The target: each flooded corner sensor reads rho0 g depth within 10 %. Disabled: the sensors
 // read the particles, and in the settled state (summation density, wall_density walls) the particles
 // along the tank's vertical edges carry 0.70 of rho0 g depth in the lowest 5 cm (0.93-0.95 above; the
 // walls' and the interior's particles 0.98-1.03): the corner sensor reads 1,313 Pa where rho0 g depth is

@@ -38,7 +38,7 @@ TEST(DfsphStillWater, WallsHoldItWithoutTheDomainClamp) {
   const sim::Totals& t = solver->GetTotals();
   const double rate = static_cast<double>(t.clampedEvents) / (static_cast<double>(solver->FluidCount()) * t.steps);
   EXPECT_LT(rate, 1e-3) << t.clampedEvents << " clamps in " << t.steps << " steps";
-  // Still water started from the lattice keeps a residual motion (the 5 mm/s after 1 s is not
+  // Still water started from the lattice keeps a residual motion (the target's 5 mm/s after 1 s is not
   // met: about 1 cm/s, docs/design/dfsph.md): recorded, and held to well below the speed a particle gains
   // falling through one spacing, sqrt(2 g dx) (14 cm/s here), so a boiling pool fails.
   const sim::HostFluid f = test::DownloadFluid(*solver);

@@ -168,23 +168,23 @@ TEST_P(Hydrostatic, PressureFollowsDepthAndParticlesStayPut) {
   meanDensityError /= static_cast<float>(steps);
   RecordProperty("median_drift_spacings", std::to_string(worstMedian));
   RecordProperty("max_drift_spacings", std::to_string(worstMax));
-  // Drift bounds per 0.5 s window (the issue asks for at most 0.1 spacing; docs/dev/physics.md):
+  // Drift bounds per 0.5 s window (the target is at most 0.1 spacing; docs/dev/physics.md):
   // - wall_density_settled: from the settled state (docs/design/settle.md) the plain solver keeps every
   //   particle within 0.009-0.054 spacing per window over 20 s on several trajectories (sphxr_bench_rest
-  //   --settle 45). Held to the issue's 0.1, the median to 0.01, over four windows.
+  //   --settle 45). Held to the target's 0.1, the median to 0.01, over four windows.
   // - wall_density from the lattice: the water comes to rest (median drift per window 0.13, 0.18, 0.06,
   //   0.05, 0.02, 0.01, ... spacings) but a few particles keep rattling, near the floor and at the free
   //   surface, because the simple cubic lattice and its free surface are not rest states. Their maximum
   //   per window levels off at 0.11-0.32 spacing from 3.5 s on, by instruction-set tier (another rounding,
   //   another trajectory). So the window starts at 4 s, the median is held to 0.1 and the maximum to 0.4:
-  //   this case records the plain solver from the lattice, which the issue's bound is not about.
+  //   this case records the plain solver from the lattice, which the bound is not about.
   // - mirrored: p_b = p_i is not the derivative of any energy and keeps a ~1 cm/s circulation going
   //   (median 0.34, maximum 1.8 spacings per window); held to what is met, so real flow still fails.
   EXPECT_LT(meanDensityError, 0.01f) << "mean compression over the observation window";
 
   // Hydrostatics: layer-averaged pressure (layers one spacing thick) against rho0 g depth over the lower
   // 80 % of the depth, depth measured from the free surface = the top particle's centre plus half a
-  // spacing (each particle fills a cube of side dx). The issue asks for 5 %. Hydrostatics is a statement
+  // spacing (each particle fills a cube of side dx). The target is 5 %. Hydrostatics is a statement
   // about the mean: each layer's pressure is averaged over the last window (a sample every kSampleEvery
   // steps, each with its own free surface), not read from the window's last step. A single snapshot
   // of water that still rattles (the unsettled cases) carries its sound: on one tier the last step of

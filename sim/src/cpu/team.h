@@ -12,8 +12,8 @@
 // 1); after `interval` steps it tries a neighbouring size for kWindow steps and keeps whichever had the
 // smaller median step (the other by at least kMargin). A confirmed size multiplies the interval by kGrowth (up to
 // kMaxInterval), a change resets it; a step median that rises by half since the last decision tries at
-// once. Every size gives the same bits (the stages never depend on the schedule: determinism_test), so
-// the choice changes only the speed.
+// once. Every size gives the same bits (the stages never depend on the schedule:
+// Conformance.TheSameBitsAtEveryThreadCount), so the choice changes only the speed.
 #include <algorithm>
 #include <array>
 #include <vector>

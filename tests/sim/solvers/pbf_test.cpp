@@ -316,7 +316,7 @@ void RunFor(sim::Solver& solver, double seconds) {
 }
 
 /// The pressure estimate (p / rho^2 = -Lambda / (rho0 dt^2)) against rho0 g depth in 2-cm bands over the
-/// lower 80 % of the depth: within 10 % (the real-time issue's bound).
+/// lower 80 % of the depth: within 10 % (the real-time bound).
 void ExpectHydrostaticPressureBands(const sim::HostFluid& f, const SceneSetup& scene) {
   float top = 0.0f;
   for (const Vec4& x : f.position) top = std::max(top, x.y);
@@ -349,7 +349,7 @@ TEST(Pbf, StillWaterHoldsItsHydrostaticPressureAndCalms) {
   ExpectHydrostaticPressureBands(f, scene);
 }
 
-// The real-time issue's compression target (below 1 %, 1 s from the lattice) is a matter of work per
+// The real-time compression target (below 1 %, 1 s from the lattice) is a matter of work per
 // frame: the steady compression under a column falls as 1 / (S^2 N) with S substeps of N iterations a
 // frame (a Jacobi iteration carries a correction one support; bench/pbf_still_water.py measures
 // S^2 N C = 94-98.5 % over seven settings here). At 6 x 4 (S^2 N = 144) the water holds its depth within
@@ -390,14 +390,14 @@ TEST(Pbf, AColumnTooDeepForItsSubstepsIsNamedAtStartUp) {
   EXPECT_EQ(log.Count("pbf: expect"), 0) << log.All();
 }
 
-// The issue's still-water targets at the defaults (3 substeps of 3 iterations a 90 Hz frame): not met,
+// The still-water targets (docs/design/pbf.md) at the defaults (3 substeps of 3 iterations a 90 Hz frame): not met,
 // and neither can be bought without undoing what the defaults are for. Measured (bench/pbf_still_water.py,
 // bench/results/pbf_still_water.csv): mean compression 3.5 % at 1 s (below 1 % needs S^2 N >= 100, twice
 // the frame's cost, which is already twice the real-time budget); mean speed 9.9 mm/s at 1 s (4.2 at 2 s),
 // 8.9-10.1 mm/s at every S x N, so the solve is not what keeps it moving: the lattice's settling, damped
 // by XSPH alone. c = 0.1 calms it to 4.6 mm/s but takes a third of stirred water's kinetic energy
 // (13.5 against 20.3 mJ/kg after 4 s of `stir`; WCSPH 20.2). docs/design/pbf.md.
-TEST(Pbf, DISABLED_StillWaterMeetsTheRealTimeIssuesTargets) {
+TEST(Pbf, DISABLED_StillWaterMeetsTheRealTimeTargets) {
   SceneSetup scene = StillWater();
   auto solver = test::CreateOrFail(scene);
   ASSERT_TRUE(solver);

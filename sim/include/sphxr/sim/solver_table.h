@@ -41,7 +41,8 @@ struct SolverInfo {
   bool reuse;        // activity-based reuse (Huang et al. 2013, §3.3)
   ContactUse wallContact;  // tank.wall_contact (stages/contact.h)
   bool acoustic;     // its step and its compression follow the sound speed (the scene check's Mach warnings)
-  /// Its stable step for the current state, solver.max_dt included (solver.fixed_dt is clamped to it).
+  /// Its stable step for the current state (solver.fixed_dt is clamped to it): under solver.max_dt for a
+  /// method whose step follows the sound or the flow; PBF's is pbf_frame over pbf_substeps.
   float (*stableDt)(const StableDtInput& in);
   std::span<const SolveColumn> columns;  // its statistics (its SolveReport's fields), in the stats CSV's order
   /// Bytes of its own per fluid particle, given the neighbour-list slots per particle.

@@ -1,4 +1,4 @@
-// `--stats FILE.csv` (app/src/headless_sinks.cpp StatsSink) when things go wrong: a full disk leaves
+// `--stats FILE.csv` (app/src/stats_sink.cpp) when things go wrong: a full disk leaves
 // the file at a whole row and says so in one line; a run continued under another method refuses to
 // rewrite the first half's rows.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// The headless run's outputs (app/src/headless_sinks.cpp): a directory is made only in one that exists,
-// and a state that cannot be saved after the run is one error line after the summary.
+// The save-state sink (app/src/save_state_sink.cpp): a state that cannot be saved after the run is one error
+// line after the summary.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -7,40 +7,14 @@
 #include <filesystem>
 #include <string>
 
-#include "refusal.h"
-#include "sphxr/app/headless.h"
 #include "support.h"
 
 namespace sphxr::app {
 namespace {
 
-using test::ExpectBriefRefusal;
-
-TEST(HeadlessSinks, OutputDirectoriesAreMadeOnlyInADirectoryThatExists) {
-  test::TempDir dir("sinks_outdir");
-  const std::string scene = dir.Write("scene.json", test::kSmallTankScene);
-  Options options;
-  options.scenePath = scene;
-  options.steps = 1;
-  options.threads = 1;
-  options.progress = 0;
-  options.exportEvery = 1;
-  options.outDir = dir.File("missing/out");
-  RunSummary summary;
-  ExpectBriefRefusal(RunHeadless(options, &summary), "does not exist; make it first");
-  EXPECT_FALSE(std::filesystem::exists(dir.File("missing")));
-  options.outDir = dir.File("out/");  // one level is made
-  EXPECT_TRUE(RunHeadless(options, &summary).ok());
-  EXPECT_TRUE(std::filesystem::is_directory(dir.File("out")));
-  options.exportEvery = 0;
-  options.outDir = "out";
-  options.statsPath = dir.File("missing/stats.csv");
-  ExpectBriefRefusal(RunHeadless(options, &summary), "does not exist; make it first");
-}
-
 // A --save-state that fails after the run (a full disk; here its temporary file's place is taken by
 // a directory) is one error line after the summary, not instead of it.
-TEST(HeadlessSinks, AFailedSaveStillPrintsTheSummary) {
+TEST(SaveStateSink, AFailedSaveStillPrintsTheSummary) {
   test::TempDir dir("sinks_save");
   const std::string scene = dir.Write("scene.json", test::kSmallTankScene);
   const std::string state = dir.File("end.state");
