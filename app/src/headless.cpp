@@ -383,14 +383,21 @@ struct RunSinks {
   }
 };
 
-/// The steps to the target, or to a signal (then the run stops after the step in progress), and the
-/// sinks' Finish: the rows of a run stopped by a signal too.
+/// The frames to the target time (the last one ends at the first step at or past it) or the steps to
+/// the target count, or to a signal (then the run stops after the step in progress), and the sinks'
+/// Finish: the rows of a run stopped by a signal too.
 Status StepToTarget(Simulation& simulation, const Target& target, RunSinks& sinks, RunSummary* summary) {
   sim::Solver& solver = simulation.Solver();
   if (Status s = simulation.Start(); !s) return s;
-  while (target.steps > 0 ? solver.GetTotals().steps < target.steps : solver.Time() < target.time - 1e-9) {
-    if (g_interrupt) break;
-    if (Status s = simulation.Step(); !s) return s;
+  if (target.steps > 0) {
+    while (solver.GetTotals().steps < target.steps && !g_interrupt) {
+      if (Status s = simulation.Step(); !s) return s;
+    }
+  } else {
+    const auto running = [&] { return !g_interrupt && solver.Time() < target.time - 1e-9; };
+    while (running()) {
+      if (Status s = simulation.AdvanceFrame({}, running); !s) return s;
+    }
   }
   summary->wallSeconds = sinks.progressSink->WallSeconds();
   summary->interrupted = g_interrupt;  // also a signal during the last step

@@ -248,15 +248,29 @@ void SimWorker::ApplyPendingReset(Pacing* pacing) {
   Publish(zero, 0.0);
 }
 
-void SimWorker::StepWithNewestHands() {
+void SimWorker::AdvanceWithNewestHands(bool oneStep) {
   std::unique_lock solverLock = LockSolver();
   std::vector<interaction::HandInput> hands;  // the newest: the paddles' targets at their next frame
   {
     std::lock_guard lock(m_mutex);
     hands = m_hands;
   }
-  const Status stepped = m_sim->Step(hands);
-  if (stepped) m_probes.Add(m_sim->Solver().LastProbes());
+  // After every step: the probes' plots, a turn for a waiting surface writer (the GL thread), and the
+  // frame cut short by a pause or the end (the next frame call finishes it).
+  const auto afterStep = [&] {
+    m_probes.Add(m_sim->Solver().LastProbes());
+    if (m_surfaceWriters.load() > 0) {
+      solverLock.unlock();
+      solverLock = LockSolver();
+    }
+    return !m_stop && !m_paused;
+  };
+  Status stepped;
+  if (oneStep) {
+    if (stepped = m_sim->Step(hands); stepped) afterStep();
+  } else {
+    stepped = m_sim->AdvanceFrame(hands, afterStep);
+  }
   if (Status s = stepped; !s) {
     std::lock_guard lock(m_mutex);
     m_error = std::isfinite(m_sim->Solver().LastStep().maxSpeed)
@@ -295,7 +309,7 @@ void SimWorker::Run() {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));  // ahead of real time
     } else {
       if (stepRequested) --m_stepRequests;
-      StepWithNewestHands();
+      AdvanceWithNewestHands(stepRequested);  // the window's single step, else a frame
       pacing.dirty = true;
     }
     const Clock::time_point now = Clock::now();

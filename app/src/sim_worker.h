@@ -1,9 +1,9 @@
 #pragma once
-// The simulation on its own thread, so the frame loop never waits on it. The worker steps a Simulation
-// (simulation.h; no faster than real time) with the paddles driven by the newest hands (SetHands), and publishes a
-// snapshot (particles, the water surface, the paddles' poses, the haptic amplitudes) at most ~60 times
-// a second; the frame loop draws the newest snapshot with the newest camera, again and again when a
-// step is slower than a frame.
+// The simulation on its own thread, so the frame loop never waits on it. The worker advances a
+// Simulation (simulation.h) frame by frame (AdvanceFrame; no more than a frame ahead of real time) with
+// the paddles driven by the newest hands (SetHands), and publishes a snapshot (particles, the water
+// surface, the paddles' poses, the haptic amplitudes) at most ~60 times a second; the frame loop draws
+// the newest snapshot with the newest camera, again and again when the simulation is slower than it.
 #include <atomic>
 #include <chrono>
 #include <initializer_list>
@@ -49,7 +49,7 @@ class SimWorker {
   /// The same paddles and surface with new parameters.
   void Reset(const sim::SceneSetup& setup);
   /// The hands that drive the hand-held paddles (index 0 left, 1 right; missing or untracked hands: the
-  /// paddle holds, then withdraws). The worker uses the newest hands for each paddle frame (every
+  /// paddle holds, then withdraws). The worker uses the newest hands for each frame (every
   /// 1/paddleFrameRate simulated s) and sets their `time` to that frame's simulated time. Poses are in
   /// the simulation's world frame; a measured velocity (hasVelocity) is taken as per simulated second.
   void SetHands(const std::vector<interaction::HandInput>& hands);
@@ -57,6 +57,7 @@ class SimWorker {
   void SetSurface(const SurfaceRequest& surface);
   void SetPaused(bool paused);
   bool Paused() const { return m_paused.load(); }
+  /// One solver step (Simulation::Step), taken even while paused.
   void StepOnce();
   /// Newest published state (never null after Start()).
   std::shared_ptr<const SimSnapshot> Latest() const;
@@ -101,7 +102,8 @@ class SimWorker {
   void Run();
   void ApplyPendingReset(Pacing* pacing);
   void SaveIfAsked();
-  void StepWithNewestHands();
+  /// A frame (Simulation::AdvanceFrame) with the newest hands, or one step (`oneStep`: StepOnce).
+  void AdvanceWithNewestHands(bool oneStep);
   void PublishNow(Pacing* pacing, std::chrono::steady_clock::time_point now);
   void Publish(double stageMs[], double stepMs);
   /// Builds the Simulation for `scene` with the worker's solver configuration. `strict` (the first

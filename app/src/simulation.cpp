@@ -53,7 +53,6 @@ Status Simulation::Create(const SimScene& scene, const SimulationConfig& config,
       return Status::Error(config.errorPrefix + s.message());
     }
     run->m_paddles->AddBodies(&run->m_setup);
-    run->m_paddles->SetFrameRate(scene.paddleFrameRate);
   }
   if (Status s = sim::Solver::Create(run->m_setup, config.solver, &run->m_solver); !s) {
     return Status::Error(config.errorPrefix + s.message());
@@ -75,13 +74,10 @@ Status Simulation::Create(const SimScene& scene, const SimulationConfig& config,
       run->m_stepsBefore = scene.start->step;  // -1 (unknown) stays unknown in what it saves
     }
   }
-  run->m_startTime = run->m_solver->Time();
+  run->m_nextFrame = run->m_solver->Time();  // the first step begins the first frame
   if (run->m_paddles) {
     if (Status s = run->m_paddles->Attach(run->m_solver.get()); !s) return s;
-    double clock = run->m_paddles->NextFrame();
-    if (run->m_restored && RestorePaddles(*scene.start, *run->m_solver, run->m_paddles.get(), &clock)) {
-      run->m_paddles->SetNextFrame(clock);
-    }
+    if (run->m_restored) RestorePaddles(*scene.start, *run->m_solver, run->m_paddles.get(), &run->m_nextFrame);
   }
   *out = std::move(run);
   return Status::Ok();
@@ -89,10 +85,27 @@ Status Simulation::Create(const SimScene& scene, const SimulationConfig& config,
 
 int64_t Simulation::WholeStep() const { return std::max<int64_t>(m_stepsBefore, 0) + m_solver->GetTotals().steps; }
 
-double Simulation::PaddleClock() const { return m_paddles ? m_paddles->NextFrame() : m_startTime; }
+Status Simulation::AdvanceFrame(const std::vector<interaction::HandInput>& hands,
+                                const std::function<bool()>& afterStep) {
+  do {
+    if (Status s = Step(hands); !s) return s;
+    if (afterStep && !afterStep()) return Status::Ok();
+  } while (m_solver->Time() < m_nextFrame - 1e-9);
+  return Status::Ok();
+}
 
 Status Simulation::Step(const std::vector<interaction::HandInput>& hands) {
-  const Status stepped = m_paddles ? m_paddles->Step(hands) : m_solver->Step();
+  if (m_solver->Time() >= m_nextFrame - 1e-9) {
+    // A frame: the hands become the paddles' targets one frame ahead in simulated time.
+    m_nextFrame += FramePeriod();
+    if (m_paddles) {
+      std::vector<interaction::HandInput> framed = hands;
+      for (interaction::HandInput& h : framed) h.time = m_nextFrame;
+      if (Status s = m_paddles->BeginFrame(m_nextFrame, framed); !s) return s;
+    }
+  }
+  const Status stepped = m_solver->Step();
+  if (stepped && m_paddles) m_paddles->AfterStep();
   if (!stepped) {
     // --validate names the step by the solver's count, this run's; after a state file, say which step
     // of the whole run (the CSV's numbering) that is.
@@ -128,7 +141,7 @@ Status Simulation::Finish(bool interrupted) {
 }
 
 Status Simulation::WriteState(const std::string& path, const std::string& sceneName) const {
-  return WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), PaddleClock(), m_stepsBefore);
+  return WriteStateFile(path, *m_solver, sceneName, m_paddles.get(), m_nextFrame, m_stepsBefore);
 }
 
 }  // namespace sphxr::app

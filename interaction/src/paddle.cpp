@@ -249,7 +249,6 @@ Status PaddleSystem::Attach(sim::Solver* solver) {
                                 solver->BodyCount(), m_firstBody + Count()));
   }
   m_solver = solver;
-  m_nextFrame = solver->Time();
   // The commanded pose starts where the solver's body is: the scene's start pose, or the pose a restart
   // from a state file put it at (app/src/state_file.cpp).
   for (int k = 0; k < Count(); ++k) {
@@ -352,28 +351,6 @@ void PaddleSystem::AfterStep() {
     st.torque += (load.torque - st.torque) * a;
     st.haptic = std::min(1.0f, Length(st.force) / p.desc.haptics.fullScaleForce);
   }
-}
-
-Status PaddleSystem::Step(const std::vector<HandInput>& hands) {
-  if (!m_solver) return Status::Error("paddles: Step before Attach");
-  if (m_solver->Time() >= m_nextFrame - 1e-9) {
-    // A frame: the hands become the paddles' targets one frame ahead in simulated time.
-    m_nextFrame += 1.0 / m_frameRate;
-    std::vector<HandInput> framed = hands;
-    for (HandInput& h : framed) h.time = m_nextFrame;
-    if (Status s = BeginFrame(m_nextFrame, framed); !s) return s;
-  }
-  if (Status s = m_solver->Step(); !s) return s;
-  AfterStep();
-  return Status::Ok();
-}
-
-Status PaddleSystem::Advance(double time, const std::vector<HandInput>& hands) {
-  if (!m_solver) return Status::Error("paddles: Advance before Attach");
-  while (m_solver->Time() < time - 1e-9) {
-    if (Status s = Step(hands); !s) return s;
-  }
-  return Status::Ok();
 }
 
 float PaddleSystem::HapticAmplitude(Holder hand) const {

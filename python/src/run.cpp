@@ -176,9 +176,18 @@ Status Run::Step(int64_t steps, double untilTime, const KeepGoing& keepGoing) {
   sim::Solver& solver = m_simulation->Solver();
   const auto t0 = std::chrono::steady_clock::now();
   Status status;
-  for (int64_t k = 0; steps >= 0 ? k < steps : solver.Time() < untilTime - 1e-9; ++k) {
-    if (status = m_simulation->Step(); !status) break;
-    if (keepGoing && !keepGoing()) break;
+  bool stopped = false;  // keepGoing said no (a signal): asked once after every step
+  const auto goOn = [&] { return !(stopped = keepGoing && !keepGoing()); };
+  if (steps >= 0) {
+    for (int64_t k = 0; k < steps && !stopped; ++k) {
+      if (status = m_simulation->Step(); !status) break;
+      goOn();
+    }
+  } else {  // by frames, the last one ending at the first step at or past the time
+    const auto running = [&] { return goOn() && solver.Time() < untilTime - 1e-9; };
+    while (!stopped && solver.Time() < untilTime - 1e-9) {
+      if (status = m_simulation->AdvanceFrame({}, running); !status) break;
+    }
   }
   m_recorder->wallSeconds += Seconds(t0);
   if (m_probes && status) status = m_probes->Flush();

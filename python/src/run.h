@@ -66,7 +66,8 @@ class Run {
   static Status Create(const RunOptions& options, std::unique_ptr<Run>* out, const KeepGoing& keepGoing = {});
   ~Run();
 
-  /// `steps` steps; or, with steps < 0, until the clock reaches `untilTime` (s). `keepGoing` is asked
+  /// `steps` steps; or, with steps < 0, frames (Simulation::AdvanceFrame) until the clock reaches
+  /// `untilTime` (s), the last frame ending at the first step at or past it. `keepGoing` is asked
   /// after every step; when it says no, the loop stops there (status ok). The probe rows the steps made
   /// are written before it returns: a write that fails (a full disk) is its error.
   Status Step(int64_t steps, double untilTime, const KeepGoing& keepGoing);

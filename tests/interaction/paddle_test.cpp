@@ -1,5 +1,6 @@
 // Paddles in water: momentum transfer and drag, no fluid inside after a fast swing, teleports and
-// tracking loss, deterministic replay. Small tanks (a few thousand particles, CPU backend, one thread).
+// tracking loss, deterministic replay; the paddles never step the solver. Small tanks (a few thousand
+// particles, CPU backend, one thread).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -55,9 +56,28 @@ TrajectoryKey Key(double t, Vec3 p, bool tracked = true) {
   return k;
 }
 
+/// Paddles on a solver, with the frame loop written out here (the paddles never step the solver; in the
+/// program app::Simulation::AdvanceFrame is this loop): a frame every kFrame from the solver's start.
 struct Rig {
   std::unique_ptr<PaddleSystem> paddles;
   std::unique_ptr<sim::Solver> solver;
+  double nextFrame = 0.0;  // the first step at or past it begins a frame
+
+  /// Steps until the solver's time reaches `time`: BeginFrame with `hands` at each frame, the step,
+  /// AfterStep.
+  Status Advance(double time, const std::vector<HandInput>& hands = {}) {
+    while (solver->Time() < time - 1e-9) {
+      if (solver->Time() >= nextFrame - 1e-9) {
+        nextFrame += kFrame;
+        std::vector<HandInput> framed = hands;
+        for (HandInput& h : framed) h.time = nextFrame;
+        if (Status s = paddles->BeginFrame(nextFrame, framed); !s) return s;
+      }
+      if (Status s = solver->Step(); !s) return s;
+      paddles->AfterStep();
+    }
+    return Status::Ok();
+  }
 };
 
 /// A solver with the given paddles (scripted or hand-held), or a failed test.
@@ -71,6 +91,7 @@ Rig MakeRig(sim::SceneSetup scene, std::vector<PaddleDesc> descs) {
   if (!rig.solver) return rig;
   const Status a = rig.paddles->Attach(rig.solver.get());
   EXPECT_TRUE(a.ok()) << a.message();
+  rig.nextFrame = rig.solver->Time();
   return rig;
 }
 
@@ -129,6 +150,29 @@ TEST(PaddleSampling, SheetHalfASpacingInsideTheSurfaceAndNoGaps) {
       EXPECT_LT(nearest, dx) << "hole in the sampling near " << q.x << ", " << q.y << ", " << q.z;
     }
   }
+}
+
+// ---- the frame clock is the caller's -----------------------------------------------------------------
+
+// The paddles take targets (BeginFrame) and read loads (AfterStep); the step loop is app::Simulation's.
+template <typename T>
+concept StepsTheSolver = requires(T& p) { p.Step(); } || requires(T& p) { p.Advance(1.0); };
+static_assert(!StepsTheSolver<PaddleSystem>, "the paddles never step the solver: app::Simulation does");
+
+TEST(PaddleSystem, BeginFrameAndAfterStepNeverStepTheSolver) {
+  PaddleDesc d;
+  d.holder = Holder::kRightHand;
+  d.shapes = Blade();
+  Rig rig = MakeRig(SmallTank(0.02f), {d});
+  ASSERT_TRUE(rig.solver);
+  HandInput hand;
+  hand.tracked = true;
+  hand.pose.position = Vec3{0.1f, 0.12f, 0.06f};
+  ASSERT_TRUE(rig.paddles->BeginFrame(kFrame, {HandInput{}, hand}).ok());
+  rig.paddles->AfterStep();
+  EXPECT_EQ(rig.solver->GetTotals().steps, 0);
+  EXPECT_EQ(rig.solver->Time(), 0.0);
+  EXPECT_EQ(rig.paddles->State(0).mode, PaddleMode::kReentering) << "the frame took the hand as its target";
 }
 
 // ---- pushing and dragging ---------------------------------------------------------------------------
@@ -283,7 +327,7 @@ TEST(PaddleFluid, OneMetreTeleportIsNotAHugeVelocity) {
       t += kFrame;
       hand.pose.position = p;
       hand.time = t;
-      ASSERT_TRUE(rig.paddles->Advance(t, {HandInput{}, hand}).ok());
+      ASSERT_TRUE(rig.Advance(t, {HandInput{}, hand}).ok());
       bodySpeed = std::max(bodySpeed, Length(rig.solver->BodyVelocity(0)));
       const sim::HostFluid f = test::DownloadFluid(*rig.solver);
       ASSERT_EQ(test::FirstNonFinite(f), "") << "at t = " << t;
@@ -328,7 +372,7 @@ TEST(PaddleFluid, TrackingLossHoldsThenWithdraws) {
   bool held = true;
   while (t < lost + 2.0 - 1e-9) {
     t += kFrame;
-    ASSERT_TRUE(rig.paddles->Advance(t).ok());
+    ASSERT_TRUE(rig.Advance(t).ok());
     const Vec3 p = rig.solver->BodyPose(0).position;
     const sim::HostFluid f = test::DownloadFluid(*rig.solver);
     ASSERT_EQ(test::FirstNonFinite(f), "") << "at t = " << t;
@@ -372,7 +416,7 @@ TEST(PaddleFluid, ScriptedTrajectoryReplaysBitwise) {
     Rig rig = MakeRig(SmallTank(0.02f, 20000.0f), {d});
     ASSERT_TRUE(rig.solver);
     for (double t = kFrame; t < 0.4; t += kFrame) {
-      ASSERT_TRUE(rig.paddles->Advance(t).ok());
+      ASSERT_TRUE(rig.Advance(t).ok());
       loads->push_back(rig.solver->LastBodyLoad(0));
     }
     rig.solver->Download(out);
@@ -424,7 +468,7 @@ void HeldCubeFeelsArchimedesBuoyancy(sim::SolverMethod method, double band) {
   double sum[3] = {0, 0, 0};
   int samples = 0;
   for (double t = kFrame; t < 0.6; t += kFrame) {
-    ASSERT_TRUE(rig.paddles->Advance(t).ok());
+    ASSERT_TRUE(rig.Advance(t).ok());
     if (t < 0.3) continue;  // the lattice settles first
     const sim::BodyLoad& load = rig.solver->LastBodyLoad(0);
     sum[0] += load.force.x, sum[1] += load.force.y, sum[2] += load.force.z;
@@ -482,7 +526,7 @@ TEST(PaddleFluid, ParticlesNearAPaddleStayActiveUnderReuse) {
   const float reach = 0.7f * rig.solver->SupportRadius();  // a step moves a particle less than 0.2 support
   int checked = 0, idleFar = 0;
   for (double t = kFrame; t < 0.2; t += kFrame) {
-    ASSERT_TRUE(rig.paddles->Advance(t).ok());
+    ASSERT_TRUE(rig.Advance(t).ok());
     const sim::HostFluid f = test::DownloadFluid(*rig.solver);
     std::vector<Vec4> body, vel;
     rig.solver->DownloadBodies(&body, &vel);

@@ -1,15 +1,23 @@
 #pragma once
 // One run of a scene, under every mode: the headless runner, the desktop window's and the headset's
-// simulation thread (SimWorker), the benchmarks and the tests build it the same way and step it the
-// same way. A Simulation owns the solver and the paddles; outputs (the stats CSV, exports, pictures,
-// checkpoints, progress, probes) are sinks attached to it, called after every step.
+// simulation thread (SimWorker), the Python module, the benchmarks and the tests build it the same way
+// and advance it the same way. A Simulation owns the solver, the paddles and the frame clock; outputs
+// (the stats CSV, exports, pictures, checkpoints, progress, probes) are sinks attached to it, called
+// after every step.
 //
 //   SimScene ──Create──> paddles sampled and added as bodies, Solver::Create, Restore (a state file),
-//                        PaddleSystem::Attach, the paddles' saved state and clock
-//   Step(hands) ───────> PaddleSystem::Step (a frame when due, the solver step, the paddles' loads)
-//                        or Solver::Step; then every sink's OnStep
+//                        PaddleSystem::Attach, the paddles' saved state and the frame clock
+//   AdvanceFrame(hands)  one displayed frame (1/paddleFrameRate simulated s): Step until the first step
+//                        at or past the frame's end
+//   Step(hands) ───────> one solver step of the current frame:
+//                          the first step at or past NextFrame() begins a frame: NextFrame() moves one
+//                          period on, PaddleSystem::BeginFrame(hands at that time)
+//                          Solver::Step (PBF: its substeps; WCSPH, DFSPH: their CFL steps)
+//                          PaddleSystem::AfterStep (the fluid's load on each paddle)
+//                          every sink's OnStep
 //   Finish() ──────────> every sink's Finish
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <memory>
 #include <string>
@@ -73,9 +81,18 @@ class Simulation {
  public:
   static Status Create(const SimScene& scene, const SimulationConfig& config, std::unique_ptr<Simulation>* out);
 
-  /// One step: the paddles (a frame with `hands` when one is due; index 0 left, 1 right; poses in the
-  /// simulation's world frame) or the solver alone, then every sink. Errors: the solver's (--validate's
-  /// named with the whole run's step after a state file), and water that became non-finite.
+  /// One displayed frame: Step with `hands` until the solver reaches the frame's end (the first step at
+  /// or past NextFrame() after the frame began; called mid-frame, after single Steps, it finishes that
+  /// frame). `afterStep`, when given, is called after every step: false ends the frame there (a
+  /// signal, a run that ends at a time), and the next call goes on with the same frame. Errors: Step's.
+  Status AdvanceFrame(const std::vector<interaction::HandInput>& hands = {},
+                      const std::function<bool()>& afterStep = {});
+  /// One solver step of the current frame (runs that end at a step count, the window's single step).
+  /// At or past NextFrame() a frame begins first: the clock moves one period on and the paddles take
+  /// `hands` (index 0 left, 1 right; poses in the simulation's world frame; their `time` set to the new
+  /// NextFrame()) as their targets at that time. Then the solver's step, the paddles' loads and every
+  /// sink. Errors: the solver's (--validate's named with the whole run's step after a state file), and
+  /// water that became non-finite.
   Status Step(const std::vector<interaction::HandInput>& hands = {});
   /// The sinks' OnStart (call once, before the first Step) and Finish.
   Status Start();
@@ -102,8 +119,12 @@ class Simulation {
   /// The whole run's step number (the CSV's, the exports' file names): StepsBefore (0 when unknown)
   /// plus this solver's steps.
   int64_t WholeStep() const;
-  /// The paddles' next frame (the state file's paddle clock); the start time without paddles.
-  double PaddleClock() const;
+  /// The frame clock: the display time the current frame ends at and the next begins at (the first step
+  /// at or past it begins it). It starts at the solver's time; a state file with paddles saves it as
+  /// the paddle clock and restores it.
+  double NextFrame() const { return m_nextFrame; }
+  /// 1/SimScene::paddleFrameRate: the displayed frame, in simulated s.
+  double FramePeriod() const { return 1.0 / m_scene.paddleFrameRate; }
 
  private:
   Simulation() = default;
@@ -114,7 +135,7 @@ class Simulation {
   std::unique_ptr<interaction::PaddleSystem> m_paddles;  // bound to m_solver (destroyed before it)
   bool m_restored = false;
   int64_t m_stepsBefore = 0;
-  double m_startTime = 0.0;
+  double m_nextFrame = 0.0;
   std::vector<SimulationSink*> m_sinks;
 };
 

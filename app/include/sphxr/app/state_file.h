@@ -12,7 +12,7 @@
 //     f64 fromTime, f64 toTime, 3 f32 velocity, 3 f32 angular velocity (sim::BodyMotionState)
 //   u32 paddles; per paddle: i32 mode, 7 f32 commanded pose, 3+3+3 f32 force, torque, raw force,
 //     f32 haptic, i64 teleports, u8 lost, f64 lostSince, f64 lastFrame (interaction::PaddleRestart);
-//     then f64 the next paddle frame's time (the runner's paddle clock)
+//     then f64 the next frame's time (the paddle clock: app::Simulation::NextFrame)
 //   u32 fields; per field: u32 n + n bytes of name, u32 element bytes, fluid x element bytes
 //   u32 diffuse particles d; d Vec4 positions (w: lifetime left), d Vec4 velocities (w: kind), oldest
 //     first (sim::HostDiffuse)

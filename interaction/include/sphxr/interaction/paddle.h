@@ -101,28 +101,16 @@ class PaddleSystem {
   /// Appends one rigid body per paddle to the scene (before sim::Solver::Create). Scripted paddles start
   /// at their trajectory's first pose, hand-held ones withdrawn above the tank's centre.
   void AddBodies(sim::SceneSetup* scene);
-  /// Binds to the solver created from that scene. The paddle clock starts at the solver's time.
+  /// Binds to the solver created from that scene.
   Status Attach(sim::Solver* solver);
-
-  /// The paddle clock: display frames every 1/frameRate simulated s (default 90 Hz, a headset's).
-  void SetFrameRate(double hz) { m_frameRate = hz; }
-  double FrameRate() const { return m_frameRate; }
-  /// The display time of the frame that drives the paddles now (a state file saves it); the next frame
-  /// begins at the first step at or past it.
-  double NextFrame() const { return m_nextFrame; }
-  void SetNextFrame(double time) { m_nextFrame = time; }
-  /// One solver step with the paddles: every mode's paddle-frame loop. When the solver's time has
-  /// reached NextFrame(), the next frame (1/frameRate later) begins with `hands`, their `time` set to
-  /// it (BeginFrame); then the step and AfterStep.
-  Status Step(const std::vector<HandInput>& hands = {});
 
   /// One display frame: the hands' poses for `displayTime` (index 0 left, 1 right; missing hands are
   /// untracked; scripted paddles sample their trajectory) become the paddles' targets at that time.
+  /// The frame clock that calls it is the caller's (app::Simulation::AdvanceFrame); the paddles never
+  /// step the solver.
   Status BeginFrame(double displayTime, const std::vector<HandInput>& hands = {});
   /// After every solver step: reads and filters the fluid's load on each paddle.
   void AfterStep();
-  /// Steps (Step, with `hands` at every frame) until the solver's time reaches `time`.
-  Status Advance(double time, const std::vector<HandInput>& hands = {});
 
   /// Paddle k's state for a restart, and setting it back (after Attach, which resets it).
   PaddleRestart Restart(int k) const { return m_paddles[k]; }
@@ -151,8 +139,6 @@ class PaddleSystem {
   sim::SceneSetup m_scene;  // spacing, tank
   sim::Solver* m_solver = nullptr;
   int m_firstBody = 0;
-  double m_frameRate = 90.0;
-  double m_nextFrame = 0.0;
 };
 
 }  // namespace sphxr::interaction
