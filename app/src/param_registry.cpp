@@ -121,7 +121,7 @@ void Table(const char* group, std::string* out) {
         meaning += std::string(" `") + row.name + "`, " + row.summary + ";";
       }
       meaning.back() = ' ';
-      *out += Format("| `method` | | `\"%s\"` | %s | %s|\n", sim::SolverMethodName(sim::SolverMethod::kWcsph), names.c_str(),
+      *out += Format("| `method` | | `\"%s\"` | %s | %s|\n", sim::SolverMethodName(sim::SceneSetup{}.method), names.c_str(),
                      meaning.c_str());
       *out += "| `density` | | `\"summation\"` | `\"summation\"`, `\"delta_sph\"` | wcsph: how a particle's density is "
               "found: summed over its neighbours every step (Becker & Teschner 2007), or integrated by the continuity "
