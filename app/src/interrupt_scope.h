@@ -22,7 +22,8 @@ inline const char* InterruptName(int signal) {
 /// way) set g_interrupt while a run steps, however many arrive: a second Ctrl-C soon after the first
 /// must not end the run by the default action, without its summary, cutting a row and leaving
 /// FILE.state.tmp.
-/// (SIGQUIT, Ctrl-\, still ends it at once.) The previous handlers come back afterwards.
+/// (SIGQUIT, Ctrl-\, still ends it at once.) The previous handlers come back afterwards, unless the run
+/// was interrupted: the process is then ending, and the three stay ignored until it exits.
 class InterruptScope {
  public:
   InterruptScope() {
@@ -40,18 +41,19 @@ class InterruptScope {
     if (m_hup.sa_handler != SIG_IGN) sigaction(SIGHUP, &action, nullptr);
   }
   ~InterruptScope() {
-    sigaction(SIGINT, &m_int, nullptr);
-    sigaction(SIGTERM, &m_term, nullptr);
-    // After a hang-up the terminal is gone and more SIGHUPs may follow: they are ignored until the
-    // process exits, so one arriving after the run (while the summary prints) cannot end it by default.
-    if (g_interrupt == SIGHUP) {
+    // After an interrupt the process is ending (exit 128 + the signal): more of these signals may follow
+    // (a second Ctrl-C, the hang-ups of a closed terminal) while the run's end is written or the process
+    // exits, so they are ignored until it does instead of ending it by the default action.
+    if (g_interrupt != 0) {
       struct sigaction ignore {};
       ignore.sa_handler = SIG_IGN;
       sigemptyset(&ignore.sa_mask);
-      sigaction(SIGHUP, &ignore, nullptr);
-    } else {
-      sigaction(SIGHUP, &m_hup, nullptr);
+      for (int signal : {SIGINT, SIGTERM, SIGHUP}) sigaction(signal, &ignore, nullptr);
+      return;
     }
+    sigaction(SIGINT, &m_int, nullptr);
+    sigaction(SIGTERM, &m_term, nullptr);
+    sigaction(SIGHUP, &m_hup, nullptr);
   }
   InterruptScope(const InterruptScope&) = delete;
   InterruptScope& operator=(const InterruptScope&) = delete;
