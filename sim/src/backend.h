@@ -7,6 +7,7 @@
 
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
+#include "sphxr/sim/launch_counts.h"
 #include "sphxr/sim/solver.h"
 #include "stages/bodies.h"
 #include "stages/probes.h"
@@ -85,6 +86,8 @@ class Backend {
   /// docs/design/simd_stages.md). The same bits; tests and sphxr_bench_blocks hold the two together.
   /// Before the first step. The other backends have no blocks and ignore it.
   virtual void UsePairDensityBlocks() {}
+  /// What the backend asked of its device since it was made (sphxr/sim/launch_counts.h).
+  virtual LaunchCounts Counts() const = 0;
 };
 
 /// The constants every stage shares, for `scene` (physics.cpp): Solver::Create makes them once, and

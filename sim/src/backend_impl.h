@@ -18,6 +18,7 @@
 #include "backend.h"
 #include "backend_guard.h"
 #include "diffuse_pool.h"
+#include "launch/counter.h"
 #include "post_step.h"
 #include "solvers/factory.h"
 #include "surface_impl.h"
@@ -99,6 +100,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     if constexpr (requires { m_launch.UsePairBlocks(); }) m_launch.UsePairBlocks();
   }
   SurfaceExtractor* Surface() override { return &m_surface; }
+  LaunchCounts Counts() const override { return m_counter.Counts(); }
   int DiffuseCount() const override { return m_diffuse.Count(); }
   void DownloadDiffuse(HostDiffuse* out) const override { m_diffuse.Download(out); }
   int UploadDiffuse(const HostDiffuse& in) override { return m_diffuse.Upload(in); }
@@ -195,6 +197,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   DiffusePool<Traits> m_diffuse;   // spray, foam and bubbles: a post-step stage (capacity 0: off)
   typename Traits::Launcher m_launch;
   std::unique_ptr<PressureSolver<Traits>> m_solver;
+  LaunchCounter m_counter;        // launches, waits, allocations and copies back (launch/counter.h)
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the
   // step's sort. Re-sorting here does not change the next step (its stable sort then keeps this order).

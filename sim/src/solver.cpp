@@ -153,6 +153,7 @@ void Solver::SceneChanged() {
 }
 
 int Solver::FluidCount() const { return m_backend->FluidCount(); }
+LaunchCounts Solver::Counts() const { return m_backend->Counts(); }
 int Solver::BoundaryCount() const { return m_backend->BoundaryCount(); }
 float Solver::ParticleMass() const { return m_physics->mass; }
 float Solver::SoundSpeed() const { return m_physics->soundSpeed; }

@@ -13,6 +13,7 @@
 #include "sphxr/common/status.h"
 #include "sphxr/sim/diffuse.h"
 #include "sphxr/sim/fields.h"
+#include "sphxr/sim/launch_counts.h"
 #include "sphxr/sim/params.h"
 #include "sphxr/sim/probes.h"
 #include "sphxr/sim/rigid.h"
@@ -200,6 +201,9 @@ class Solver {
   /// which must hold that many vertices (device memory on the CUDA backend, host memory on the CPU).
   Status BuildSurface(const SurfaceParams& params, SurfaceStats* stats);
   Status WriteSurface(const SurfaceTarget& target, SurfaceStats* stats);
+  /// What the backend asked of its device since the solver was made: launches, host waits, device
+  /// allocations, copies back (sphxr/sim/launch_counts.h). A frame's counts: the difference of two.
+  LaunchCounts Counts() const;
   /// Access to the backend for tests and benchmarks (they include the private headers on purpose).
   Backend* BackendForTests() { return m_backend.get(); }
 

@@ -1,0 +1,33 @@
+#pragma once
+// What a backend asked of its device: kernel launches, host synchronisations, device allocations and
+// device-to-host copies. The launch layer (sim/src/launch/) counts them on every backend; cpu-reference
+// runs the CUDA backend's orchestration, so its counts are what the CUDA backend does. Counts are
+// cumulative since the backend was made; a frame's are the difference of two readings.
+#include <cstdint>
+
+namespace sphxr::sim {
+
+struct LaunchCounts {
+  int64_t launches = 0;     // kernels (a thrust or CUB algorithm counts the kernels it runs)
+  int64_t syncs = 0;        // the host waited for the device (a blocking copy, a reduction's result, a device sync)
+  int64_t allocations = 0;  // device memory allocated (cudaMalloc, or a vector or temporary grown)
+  int64_t downloads = 0;    // device-to-host copies
+
+  LaunchCounts& operator+=(const LaunchCounts& o) {
+    launches += o.launches;
+    syncs += o.syncs;
+    allocations += o.allocations;
+    downloads += o.downloads;
+    return *this;
+  }
+  friend LaunchCounts operator-(LaunchCounts a, const LaunchCounts& b) {
+    a.launches -= b.launches;
+    a.syncs -= b.syncs;
+    a.allocations -= b.allocations;
+    a.downloads -= b.downloads;
+    return a;
+  }
+  friend bool operator==(const LaunchCounts&, const LaunchCounts&) = default;
+};
+
+}  // namespace sphxr::sim
