@@ -175,7 +175,7 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
 /// again after a pause or a reset), the half-second windows of the rates, and the totals at the last
 /// snapshot (the snapshot's per-step times are over the steps since).
 struct SimWorker::Pacing {
-  Clock::time_point anchorWall{}, lastPublish{}, rateWindow{};
+  Clock::time_point anchorWall{}, lastPublish{}, rateWindow{}, started{};
   double anchorSim = 0.0, rateSim0 = 0.0;
   int64_t rateSteps0 = 0;
   sim::Totals published;
@@ -189,6 +189,7 @@ struct SimWorker::Pacing {
     rateSteps0 = published.steps;
     rateSim0 = solver.Time();  // a state file's start is not 0
     rateWindow = Clock::now();
+    started = rateWindow;
   }
 };
 
@@ -244,6 +245,7 @@ void SimWorker::ApplyPendingReset(Pacing* pacing) {
     m_error.clear();
   }
   pacing->Restart(m_sim->Solver());
+  m_notice.reset();  // the new scene is judged anew
   double zero[static_cast<int>(sim::Stage::kCount)] = {};
   Publish(zero, 0.0);
 }
@@ -278,6 +280,15 @@ void SimWorker::AdvanceWithNewestHands(bool oneStep) {
                   : "the simulation became non-finite: press reset, and lower the time step or raise the stiffness";
     m_paused = true;
   }
+}
+
+RealTimeNotice& SimWorker::RealTimeNoticeOf(const sim::Solver& solver) {
+  if (!m_notice) {
+    m_notice = std::make_unique<RealTimeNotice>(m_scene.name, solver.FluidCount(),
+                                                sim::SolverMethodName(solver.Scene().method),
+                                                sim::DeviceName(solver.ActiveDevice()), omp_get_max_threads());
+  }
+  return *m_notice;
 }
 
 void SimWorker::Run() {
@@ -319,6 +330,9 @@ void SimWorker::Run() {
       pacing.rateWindow = now;
       pacing.rateSteps0 = m_sim->Solver().GetTotals().steps;
       pacing.rateSim0 = m_sim->Solver().Time();
+      if (auto line = RealTimeNoticeOf(m_sim->Solver()).Observe(m_rateSim, Seconds(now - pacing.started))) {
+        SPHXR_LOG_WARN("%s", line->c_str());
+      }
     }
     if (pacing.dirty && (Seconds(now - pacing.lastPublish) >= 1.0 / 60.0 || m_paused)) PublishNow(&pacing, now);
   }

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "realtime_notice.h"
 #include "sphxr/app/simulation.h"
 #include "sphxr/app/snapshot.h"
 #include "sphxr/app/state_file.h"
@@ -130,6 +131,8 @@ class SimWorker {
   std::atomic<bool> m_stop{false}, m_paused{false};
   std::atomic<int> m_stepRequests{0};
   double m_rateSteps = 0.0, m_rateSim = 0.0;
+  std::unique_ptr<RealTimeNotice> m_notice;  // the worker thread's: the line when real time is out of reach
+  RealTimeNotice& RealTimeNoticeOf(const sim::Solver& solver);
   std::chrono::steady_clock::time_point m_lastSurface{};
   // The solver lock: the worker holds it while it steps, extracts or replaces the solver; the GL thread
   // while it writes the surface (WriteSurfaceInto). Pending writers go first (LockSolver).
