@@ -80,6 +80,12 @@ void SimWorker::SetHands(const std::vector<interaction::HandInput>& hands) {
   m_hands = hands;
 }
 
+void SimWorker::SetFrameRate(double hz) {
+  if (!(hz >= Simulation::kMinFrameRate && hz <= Simulation::kMaxFrameRate)) return;
+  std::lock_guard lock(m_mutex);
+  m_frameRate = hz;
+}
+
 void SimWorker::SetSurface(const SurfaceRequest& surface) {
   std::lock_guard lock(m_mutex);
   const bool changed = surface.enabled != m_surface.enabled || surface.params.cellSize != m_surface.params.cellSize ||
@@ -175,7 +181,7 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
 /// again after a pause or a reset), the half-second windows of the rates, and the totals at the last
 /// snapshot (the snapshot's per-step times are over the steps since).
 struct SimWorker::Pacing {
-  Clock::time_point anchorWall{}, lastPublish{}, rateWindow{}, started{};
+  Clock::time_point anchorWall{}, rateWindow{}, started{};
   double anchorSim = 0.0, rateSim0 = 0.0;
   int64_t rateSteps0 = 0;
   sim::Totals published;
@@ -193,7 +199,7 @@ struct SimWorker::Pacing {
   }
 };
 
-void SimWorker::PublishNow(Pacing* p, Clock::time_point now) {
+void SimWorker::PublishNow(Pacing* p) {
   const sim::Totals& t = m_sim->Solver().GetTotals();
   const double n = std::max<double>(1.0, static_cast<double>(t.steps - p->published.steps));
   double stageMs[static_cast<int>(sim::Stage::kCount)];
@@ -202,7 +208,6 @@ void SimWorker::PublishNow(Pacing* p, Clock::time_point now) {
   }
   Publish(stageMs, 1e3 * (t.stepSeconds - p->published.stepSeconds) / n);
   p->published = t;
-  p->lastPublish = now;
   p->dirty = false;
 }
 
@@ -253,9 +258,16 @@ void SimWorker::ApplyPendingReset(Pacing* pacing) {
 void SimWorker::AdvanceWithNewestHands(bool oneStep) {
   std::unique_lock solverLock = LockSolver();
   std::vector<interaction::HandInput> hands;  // the newest: the paddles' targets at their next frame
+  double frameRate;
   {
     std::lock_guard lock(m_mutex);
     hands = m_hands;
+    frameRate = m_frameRate;
+  }
+  // The display's rate becomes the frame's, between two frames (a change of more than 0.1 %).
+  if (frameRate > 0.0 && std::abs(frameRate * m_sim->FramePeriod() - 1.0) > 1e-3 && m_sim->SetFrameRate(frameRate)) {
+    SPHXR_LOG_INFO("frame: %.2f Hz, the display's rate (the scene's paddles.frame_rate is %g Hz)", frameRate,
+                   m_scene.paddleFrameRate);
   }
   // After every step: the probes' plots, a turn for a waiting surface writer (the GL thread), and the
   // frame cut short by a pause or the end (the next frame call finishes it).
@@ -298,7 +310,6 @@ void SimWorker::Run() {
   omp_set_num_threads(m_config.threads > 0 ? m_config.threads : omp_get_num_procs());
   Pacing pacing;
   pacing.Restart(m_sim->Solver());
-  pacing.lastPublish = Clock::now();
   while (!m_stop) {
     ApplyPendingReset(&pacing);
     SaveIfAsked();  // between two steps, after a reset asked for before it
@@ -309,7 +320,7 @@ void SimWorker::Run() {
       surfaceChanged = m_surfaceChanged;
     }
     if (m_paused && !stepRequested) {
-      if (pacing.dirty || surfaceChanged) PublishNow(&pacing, Clock::now());  // the last steps before the pause are shown
+      if (pacing.dirty || surfaceChanged) PublishNow(&pacing);  // the last steps before the pause are shown
       std::unique_lock lock(m_mutex);
       m_wake.wait_for(lock, std::chrono::milliseconds(20));
       pacing.anchorWall = Clock::now();
@@ -334,7 +345,7 @@ void SimWorker::Run() {
         SPHXR_LOG_WARN("%s", line->c_str());
       }
     }
-    if (pacing.dirty && (Seconds(now - pacing.lastPublish) >= 1.0 / 60.0 || m_paused)) PublishNow(&pacing, now);
+    if (pacing.dirty) PublishNow(&pacing);  // a frame (or the window's single step) taken
   }
   SaveIfAsked();  // a save asked for just before the end is not lost
 }

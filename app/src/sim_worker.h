@@ -2,7 +2,8 @@
 // The simulation on its own thread, so the frame loop never waits on it. The worker advances a
 // Simulation (simulation.h) frame by frame (AdvanceFrame; no more than a frame ahead of real time) with
 // the paddles driven by the newest hands (SetHands), and publishes a snapshot (particles, the water
-// surface, the paddles' poses, the haptic amplitudes) at most ~60 times a second; the frame loop draws
+// surface, the paddles' poses, the haptic amplitudes) after every frame; the frame's period is the
+// scene's, or the headset's display period (SetFrameRate); the frame loop draws
 // the newest snapshot with the newest camera, again and again when the simulation is slower than it.
 #include <atomic>
 #include <chrono>
@@ -54,6 +55,9 @@ class SimWorker {
   /// 1/paddleFrameRate simulated s) and sets their `time` to that frame's simulated time. Poses are in
   /// the simulation's world frame; a measured velocity (hasVelocity) is taken as per simulated second.
   void SetHands(const std::vector<interaction::HandInput>& hands);
+  /// The displayed frame's rate (the headset's display rate, Hz): the worker's simulation takes it at its
+  /// next frame, and every scene after a reset keeps it. Not finite or out of Simulation's range: ignored.
+  void SetFrameRate(double hz);
   /// Surface extraction for the snapshots (off in particle mode; the cell size from the panel).
   void SetSurface(const SurfaceRequest& surface);
   void SetPaused(bool paused);
@@ -105,7 +109,7 @@ class SimWorker {
   void SaveIfAsked();
   /// A frame (Simulation::AdvanceFrame) with the newest hands, or one step (`oneStep`: StepOnce).
   void AdvanceWithNewestHands(bool oneStep);
-  void PublishNow(Pacing* pacing, std::chrono::steady_clock::time_point now);
+  void PublishNow(Pacing* pacing);
   void Publish(double stageMs[], double stepMs);
   /// Builds the Simulation for `scene` with the worker's solver configuration. `strict` (the first
   /// build): a state file that does not fit is an error; on a reset it is a logged fallback to the
@@ -131,6 +135,7 @@ class SimWorker {
   std::atomic<bool> m_stop{false}, m_paused{false};
   std::atomic<int> m_stepRequests{0};
   double m_rateSteps = 0.0, m_rateSim = 0.0;
+  double m_frameRate = 0.0;  // SetFrameRate's (under m_mutex); 0: the scene's
   std::unique_ptr<RealTimeNotice> m_notice;  // the worker thread's: the line when real time is out of reach
   RealTimeNotice& RealTimeNoticeOf(const sim::Solver& solver);
   std::chrono::steady_clock::time_point m_lastSurface{};

@@ -94,6 +94,14 @@ Status Simulation::AdvanceFrame(const std::vector<interaction::HandInput>& hands
   return Status::Ok();
 }
 
+Status Simulation::SetFrameRate(double hz) {
+  if (!(hz >= kMinFrameRate && hz <= kMaxFrameRate)) {
+    return Status::Error(Format("frame rate %g Hz is out of range [%g, %g]", hz, kMinFrameRate, kMaxFrameRate));
+  }
+  m_scene.paddleFrameRate = hz;
+  return Status::Ok();
+}
+
 Status Simulation::Step(const std::vector<interaction::HandInput>& hands) {
   if (m_solver->Time() >= m_nextFrame - 1e-9) {
     // A frame: the hands become the paddles' targets one frame ahead in simulated time.

@@ -345,6 +345,7 @@ struct FrameLoop {
     std::vector<interaction::HandInput> hands;
     for (int h = 0; h < xr::kHandCount; ++h) hands.push_back(ToHandInput(info.hands[size_t(h)], app.offset, app.setup.tank, displayTime));
     app.worker->SetHands(hands);
+    if (info.displayPeriodNs > 0) app.worker->SetFrameRate(1e9 / static_cast<double>(info.displayPeriodNs));
     Haptics(snap, now);
     if (info.resetRequested) {
       SPHXR_LOG_INFO("reset button: the scene starts again");

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -175,6 +176,25 @@ TEST(SimulationTest, WithoutPaddlesAFrameIsStillOnePeriod) {
   EXPECT_EQ(run->NextFrame(), 1.0 / 90.0);
   EXPECT_GE(run->Solver().Time(), run->NextFrame() - 1e-9);
   EXPECT_GT(run->Solver().GetTotals().steps, 1);
+}
+
+TEST(SimulationTest, ANewFrameRateTakesEffectAtTheNextFrameAndOutOfRangeIsRefused) {
+  std::unique_ptr<Simulation> run;
+  ASSERT_TRUE(Simulation::Create(Scene(), Config(), &run).ok());
+  ASSERT_TRUE(run->AdvanceFrame().ok());
+  const double firstEnd = run->NextFrame();
+  ASSERT_TRUE(run->SetFrameRate(72.0).ok());  // a headset displaying at 72 Hz
+  EXPECT_EQ(run->NextFrame(), firstEnd);       // the frame under way keeps its end
+  EXPECT_EQ(run->FramePeriod(), 1.0 / 72.0);
+  ASSERT_TRUE(run->AdvanceFrame().ok());
+  EXPECT_EQ(run->NextFrame(), firstEnd + 1.0 / 72.0);
+  for (double hz : {0.0, -90.0, 0.5, 5000.0, std::numeric_limits<double>::quiet_NaN(),
+                    std::numeric_limits<double>::infinity()}) {
+    const Status s = run->SetFrameRate(hz);
+    EXPECT_FALSE(s.ok()) << hz;
+    EXPECT_NE(s.message().find("out of range"), std::string::npos) << s.message();
+  }
+  EXPECT_EQ(run->FramePeriod(), 1.0 / 72.0);  // a refused rate changes nothing
 }
 
 // The frame call is the single steps grouped: a run by frames and a run by steps, given the same hands

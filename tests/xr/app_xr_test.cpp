@@ -435,6 +435,19 @@ TEST(XrApp, ResetButtonRestartsTheScene) {
   ExpectNoValidationErrors(headset);
 }
 
+// The headset's display period is the simulation's frame: a runtime displaying at 72 Hz makes the
+// scene's 90 Hz frame 1/72 s, said once in the log.
+TEST(XrApp, TheFrameFollowsTheHeadsetsDisplayRate) {
+  SimHeadset headset("app_frame_rate");
+  SetUpHeadset(headset);
+  headset.env.Set("SPHXR_SIM_XR_RATE_HZ", "72");
+  const AppRun r = RunSphxr("--xr --scene " + WriteScene(headset.dir).string() + " --frame-limit 20" + kCommon,
+                            headset.dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(CountOf(r.out, "frame: 72.00 Hz, the display's rate (the scene's paddles.frame_rate is 90 Hz)"), 1) << r.out;
+  ExpectNoValidationErrors(headset);
+}
+
 // --load-state in the headset: the session starts from a state a headless run saved (the same scene,
 // its spacing from the file); a file that is not a state file is one line before any session starts.
 TEST(XrApp, StartsFromAStateFile) {

@@ -125,6 +125,10 @@ class Simulation {
   double NextFrame() const { return m_nextFrame; }
   /// 1/SimScene::paddleFrameRate: the displayed frame, in simulated s.
   double FramePeriod() const { return 1.0 / m_scene.paddleFrameRate; }
+  /// The displayed frame's rate from the next frame on (the headset's display rate): the frame under
+  /// way ends where it was planned. Refused unless finite and in [kMinFrameRate, kMaxFrameRate] Hz.
+  Status SetFrameRate(double hz);
+  static constexpr double kMinFrameRate = 1.0, kMaxFrameRate = 1000.0;
 
  private:
   Simulation() = default;
