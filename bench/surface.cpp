@@ -159,6 +159,7 @@ int Run(int argc, char** argv) {
     double field, pyramid, traversal, reference;
     std::vector<double> runTraversal, runTraversalMin, runTraversalCpu;  // per --compare-runs entry
     bool runsAgree = true;
+    sim::LaunchCounts extract, buildWrite;  // one steady ExtractSurface; one BuildSurface + WriteSurface
   };
   std::vector<Row> rows;
   for (float factor : {1.0f, 0.5f}) {
@@ -166,12 +167,15 @@ int Run(int argc, char** argv) {
     params.cellSize = factor * spacing;
     std::vector<double> field, pyramid, traversal;
     sim::SurfaceStats stats;
+    sim::LaunchCounts extractCounts;
     for (int r = 0; r < repeat; ++r) {
       sim::SurfaceMeshView view;
+      const sim::LaunchCounts before = solver->Counts();
       if (Status s = solver->ExtractSurface(params, &view, &stats); !s) {
         std::fprintf(stderr, "%s\n", s.message().c_str());
         return 1;
       }
+      extractCounts = solver->Counts() - before;
       field.push_back(1e3 * stats.fieldSeconds);
       pyramid.push_back(1e3 * stats.pyramidSeconds);
       traversal.push_back(1e3 * stats.traversalSeconds);
@@ -191,7 +195,17 @@ int Run(int argc, char** argv) {
       std::fprintf(stderr, "warning: the reference has %lld vertices, HPMC %lld\n",
                    static_cast<long long>(referenceVertices), static_cast<long long>(stats.vertices));
     }
-    Row row{params.cellSize, stats, Median(field), Median(pyramid), Median(traversal), Median(reference), {}, {}, {}, true};
+    Row row{params.cellSize, stats, Median(field), Median(pyramid), Median(traversal), Median(reference), {}, {}, {}, true,
+            extractCounts, {}};
+    {  // the renderer's two phases into a buffer of its own (host memory here), as the GPU path runs them
+      std::vector<float> positions(static_cast<size_t>(3 * stats.capacity)), normals(positions.size());
+      uint32_t draw[4] = {};
+      sim::SurfaceStats phases;
+      const sim::LaunchCounts before = solver->Counts();
+      if (Status s = solver->BuildSurface(params, &phases); !s) return 1;
+      if (Status s = solver->WriteSurface({positions.data(), normals.data(), stats.capacity, draw}, &phases); !s) return 1;
+      row.buildWrite = solver->Counts() - before;
+    }
     if (!compareRuns.empty()) {
       // The last pyramid again, each run length in turn per round; the meshes against the first one's.
       std::vector<std::vector<double>> ms(compareRuns.size()), cpuMs(compareRuns.size());
@@ -251,6 +265,15 @@ int Run(int argc, char** argv) {
           << static_cast<double>(r.stats.pyramidBytes) / static_cast<double>(r.stats.baseBytes) << ','
           << r.stats.baseBytes << ',' << r.stats.pyramidBytes << ',' << r.stats.fieldBytes << '\n';
     }
+  }
+  std::printf("\nCounts per surface (the launch layer's: kernels, host waits, device allocations, copies back):\n\n"
+              "| cell size | ExtractSurface (host copy's path) | BuildSurface + WriteSurface (in place) |\n|---|---|---|\n");
+  for (const Row& r : rows) {
+    auto text = [](const sim::LaunchCounts& c) {
+      return Format("%lld / %lld / %lld / %lld", static_cast<long long>(c.launches), static_cast<long long>(c.syncs),
+                    static_cast<long long>(c.allocations), static_cast<long long>(c.downloads));
+    };
+    std::printf("| %.4g m | %s | %s |\n", r.cell, text(r.extract).c_str(), text(r.buildWrite).c_str());
   }
   if (!compareRuns.empty()) {
     std::printf("\nThe traversal alone by run length (vertices per work item), %d alternating rounds (the minimum: the "

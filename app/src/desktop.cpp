@@ -211,7 +211,7 @@ bool DesktopApp::Frame(render::Image* capture) {
   // GPU path: the snapshot's mesh is still in the solver; it is written into the GL buffers here (once per build).
   const render::InteropMesh* deviceSurface = m.interop.Update(*m.worker, *snap);
   const render::FrameScene frame = MakeFrameScene(*snap, m.mode, m.color, deviceSurface);
-  m.surfaceTriangles = (frame.deviceSurface ? frame.deviceSurface->VertexCount() : frame.surface.vertexCount) / 3;
+  m.surfaceTriangles = frame.deviceSurface ? snap->SurfaceTriangles() : frame.surface.vertexCount / 3;
   const auto t0 = std::chrono::steady_clock::now();
   if (fbw > 0 && fbh > 0) {
     render::View view;

@@ -14,7 +14,7 @@ const render::InteropMesh* InteropSurface::Update(SimWorker& worker, const SimSn
     if (build == 0) return nullptr;  // the solver was replaced and has built nothing yet
     m_written = build;               // the newest build: at least the snapshot's
   }
-  return m_mesh && m_mesh->VertexCount() > 0 ? m_mesh.get() : nullptr;
+  return m_mesh && m_mesh->Written() ? m_mesh.get() : nullptr;
 }
 
 void InteropSurface::Reset() {

@@ -146,13 +146,14 @@ void SimWorker::Publish(double stageMs[], double stepMs) {
   if (reuseSurface) request.enabled = false;
   {
     std::unique_lock solverLock = LockSolver();
-    if (Status s = CaptureSnapshot(m_sim->Solver(), m_sim->Paddles(), request, snap.get(), path); !s) {
+    if (Status s = CaptureSnapshot(m_sim->Solver(), m_sim->Paddles(), request, snap.get(), path,
+                                   ParticlesFor(path, surface));
+        !s) {
       std::lock_guard lock(m_mutex);
       m_error = "surface: " + s.message();
     }
     if (snap->surfaceOnDevice) {  // built in the solver: the GL thread writes this build (WriteSurfaceInto)
       m_builtBuild = ++m_builds;
-      m_builtVertices = snap->surfaceVertices;
       snap->surfaceBuild = m_builtBuild;
     }
   }
@@ -422,31 +423,43 @@ Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, u
   std::unique_lock solverLock(m_solverMutex);
   --m_surfaceWriters;
   if (m_builtBuild == 0) return Status::Ok();
-  const int64_t vertices = m_builtVertices;
+  const sim::SurfaceWriteReport last = m_sim->Solver().LastSurfaceWrite();
   constexpr int64_t kMaxVertices = int64_t{1} << 26;  // InteropMesh::Create's limit
-  if (vertices > kMaxVertices) {
+  if (last.vertices > kMaxVertices) {
     return Status::Error(Format("surface: %lld vertices do not fit the interop buffers (at most %lld): raise "
                                 "surface.cell_size",
-                                static_cast<long long>(vertices), static_cast<long long>(kMaxVertices)));
+                                static_cast<long long>(last.vertices), static_cast<long long>(kMaxVertices)));
   }
-  if (!*mesh || (*mesh)->Capacity() < vertices) {
-    // Geometric growth, as the solver's own buffer (docs/dev/surface.md): O(log) re-creations, each logged.
-    const int64_t old = *mesh ? (*mesh)->Capacity() : 0;
-    const int64_t grown = std::min(kMaxVertices, std::max<int64_t>({vertices + vertices / 4, old + old / 2, 3 * 4096}));
+  const int64_t old = *mesh ? (*mesh)->Capacity() : 0;
+  const int64_t grown = InteropCapacity(old, last);
+  if (grown != old) {
     mesh->reset();  // unregisters the old buffers from CUDA before the new ones are made
     if (Status s = render::InteropMesh::Create(static_cast<int>(grown), mesh); !s) return s;
-    SPHXR_LOG_INFO("surface: interop buffers grown from %lld to %lld vertices (%.1f MiB) for a mesh of %lld triangles",
+    SPHXR_LOG_INFO("surface: interop buffers grown from %lld to %lld vertices (%.1f MiB)%s",
                    static_cast<long long>(old), static_cast<long long>(grown), 24.0 * static_cast<double>(grown) / 1048576.0,
-                   static_cast<long long>(vertices / 3));
+                   last.Clamped() ? Format(" after a mesh of %lld triangles was clamped to %lld",
+                                           static_cast<long long>(last.vertices / 3),
+                                           static_cast<long long>(last.written / 3)).c_str()
+                                  : "");
   }
   render::InteropMesh::DevicePointers target;
   if (Status s = (*mesh)->Map(&target); !s) return s;
   sim::SurfaceStats stats;
-  const Status written = m_sim->Solver().WriteSurface({target.positions, target.normals, target.capacity}, &stats);
-  if (Status s = (*mesh)->Unmap(written ? static_cast<int>(vertices) : 0); !s) return s;
+  const Status written =
+      m_sim->Solver().WriteSurface({target.positions, target.normals, target.capacity, target.drawCommand}, &stats);
+  if (Status s = (*mesh)->Unmap(); !s) return s;
   if (!written) return written;
   *build = m_builtBuild;
   return Status::Ok();
+}
+
+int64_t InteropCapacity(int64_t capacity, const sim::SurfaceWriteReport& last) {
+  constexpr int64_t kMaxVertices = int64_t{1} << 26;
+  constexpr int64_t kLeast = 3 * 4096;
+  if (capacity >= kLeast && !(last.vertices > capacity)) return capacity;
+  // Geometric growth, as the solver's own buffer (docs/dev/surface.md): O(log) re-creations, each logged.
+  int64_t grown = std::min(kMaxVertices, std::max<int64_t>({last.vertices + last.vertices / 4, capacity + capacity / 2, kLeast}));
+  return grown - grown % 3;
 }
 
 void SimWorker::FallBackToHostCopy(const std::string& why) {

@@ -87,8 +87,9 @@ class SimWorker {
   SurfacePath Path() const { return m_path.load(); }
   /// The GPU path's GL side (call on the GL thread, context current): writes the solver's newest surface
   /// (its last BuildSurface) into `*mesh` through CUDA-GL interop: grows it first (a new InteropMesh,
-  /// at least 1.25x the vertices) when the mesh does not fit, Maps, Solver::WriteSurface, Unmaps with the
-  /// vertex count. Holds the solver lock, so the worker neither steps nor extracts meanwhile (the call
+  /// InteropCapacity) when the last write's report says the mesh did not fit (it was clamped, or this
+  /// is the first write), Maps, Solver::WriteSurface (the vertex count goes into the mesh's indirect
+  /// draw command on the device; nothing is read back), Unmaps. Holds the solver lock, so the worker neither steps nor extracts meanwhile (the call
   /// waits for a step in progress). `*build` gets the build written (SimSnapshot::surfaceBuild), 0 when
   /// the solver has built none. Errors: the host-copy path, and any interop failure.
   Status WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, uint64_t* build);
@@ -146,7 +147,11 @@ class SimWorker {
   std::atomic<SurfacePath> m_path{SurfacePath::kHostCopy};
   uint64_t m_builds = 0;        // surfaces built so far (all solvers); guarded by m_solverMutex
   uint64_t m_builtBuild = 0;    // the current solver's last build on the interop path (0: none)
-  int64_t m_builtVertices = 0;  // its vertex count
 };
+
+/// Vertices for the interop buffers of the next write, from their current capacity and the solver's
+/// last write report (Solver::LastSurfaceWrite, a frame late on the CUDA device): unchanged while the
+/// mesh fits; else max(1.25x the mesh, 1.5x the capacity, 3 x 4096), whole triangles, at most 2^26.
+int64_t InteropCapacity(int64_t capacity, const sim::SurfaceWriteReport& last);
 
 }  // namespace sphxr::app

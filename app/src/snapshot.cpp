@@ -26,9 +26,17 @@ SurfacePath ChooseSurfacePath(sim::Device activeDevice) {
   return activeDevice == sim::Device::kCuda ? SurfacePath::kInterop : SurfacePath::kHostCopy;
 }
 
+ParticleCopy ParticlesFor(SurfacePath path, const SurfaceRequest& surface) {
+  return path == SurfacePath::kInterop && surface.enabled ? ParticleCopy::kNone : ParticleCopy::kAll;
+}
+
 Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* paddles, const SurfaceRequest& surface,
-                       SimSnapshot* out, SurfacePath path) {
-  solver.Download(&out->fluid);
+                       SimSnapshot* out, SurfacePath path, ParticleCopy particles) {
+  if (particles == ParticleCopy::kAll) {
+    solver.Download(&out->fluid);
+  } else {
+    out->fluid = {};
+  }
   solver.DownloadDiffuse(&out->diffuse);
   out->last = solver.LastStep();
   out->steps = solver.GetTotals().steps;

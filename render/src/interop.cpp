@@ -23,11 +23,14 @@ Status InteropMesh::Create(int maxVertices, std::unique_ptr<InteropMesh>* out) {
   glNamedBufferStorage(m->m_positions, bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
   glCreateBuffers(1, &m->m_normals);
   glNamedBufferStorage(m->m_normals, bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+  const GLuint nothing[4] = {0, 1, 0, 0};  // glDrawArraysIndirect's {count, instanceCount, first, baseInstance}
+  glCreateBuffers(1, &m->m_drawCommand);
+  glNamedBufferStorage(m->m_drawCommand, sizeof(nothing), nothing, GL_DYNAMIC_STORAGE_BIT);
 #if SPHXR_HAVE_CUDA
   int devices = 0;
   if (cudaGetDeviceCount(&devices) == cudaSuccess && devices > 0) {
-    const GLuint buffers[2] = {m->m_positions, m->m_normals};
-    for (int i = 0; i < 2; ++i) {
+    const GLuint buffers[kBuffers] = {m->m_positions, m->m_normals, m->m_drawCommand};
+    for (int i = 0; i < kBuffers; ++i) {
       cudaGraphicsResource_t resource = nullptr;
       const cudaError_t e = cudaGraphicsGLRegisterBuffer(&resource, buffers[i], cudaGraphicsRegisterFlagsWriteDiscard);
       if (e != cudaSuccess) {
@@ -50,23 +53,28 @@ InteropMesh::~InteropMesh() {
 #endif
   glDeleteBuffers(1, &m_positions);
   glDeleteBuffers(1, &m_normals);
+  glDeleteBuffers(1, &m_drawCommand);
 }
 
 Status InteropMesh::Map(DevicePointers* out) {
 #if SPHXR_HAVE_CUDA
   if (!m_resources[0]) return Status::Error("CUDA-GL interop: no CUDA device registered these buffers");
-  cudaGraphicsResource_t resources[2] = {static_cast<cudaGraphicsResource_t>(m_resources[0]),
-                                         static_cast<cudaGraphicsResource_t>(m_resources[1])};
-  if (cudaError_t e = cudaGraphicsMapResources(2, resources, 0); e != cudaSuccess) {
+  cudaGraphicsResource_t resources[kBuffers];
+  for (int i = 0; i < kBuffers; ++i) resources[i] = static_cast<cudaGraphicsResource_t>(m_resources[i]);
+  if (cudaError_t e = cudaGraphicsMapResources(kBuffers, resources, 0); e != cudaSuccess) {
     return Status::Error(std::string("CUDA-GL interop: map failed: ") + cudaGetErrorString(e));
   }
-  size_t bytes = 0;
-  void* p = nullptr;
-  void* n = nullptr;
-  cudaGraphicsResourceGetMappedPointer(&p, &bytes, resources[0]);
-  cudaGraphicsResourceGetMappedPointer(&n, &bytes, resources[1]);
-  out->positions = static_cast<float*>(p);
-  out->normals = static_cast<float*>(n);
+  void* pointers[kBuffers] = {nullptr, nullptr, nullptr};
+  for (int i = 0; i < kBuffers; ++i) {
+    size_t bytes = 0;
+    if (cudaError_t e = cudaGraphicsResourceGetMappedPointer(&pointers[i], &bytes, resources[i]); e != cudaSuccess) {
+      cudaGraphicsUnmapResources(kBuffers, resources, 0);
+      return Status::Error(std::string("CUDA-GL interop: mapped pointer: ") + cudaGetErrorString(e));
+    }
+  }
+  out->positions = static_cast<float*>(pointers[0]);
+  out->normals = static_cast<float*>(pointers[1]);
+  out->drawCommand = static_cast<uint32_t*>(pointers[2]);
   out->capacity = m_capacity;
   m_mapped = true;
   return Status::Ok();
@@ -76,19 +84,16 @@ Status InteropMesh::Map(DevicePointers* out) {
 #endif
 }
 
-Status InteropMesh::Unmap(int vertexCount) {
-  if (vertexCount < 0 || vertexCount > m_capacity || vertexCount % 3 != 0) {
-    return Status::Error(Format("interop mesh: %d vertices written, capacity %d (a multiple of 3)", vertexCount, m_capacity));
-  }
+Status InteropMesh::Unmap() {
 #if SPHXR_HAVE_CUDA
   if (!m_mapped) return Status::Error("interop mesh: Unmap without Map");
-  cudaGraphicsResource_t resources[2] = {static_cast<cudaGraphicsResource_t>(m_resources[0]),
-                                         static_cast<cudaGraphicsResource_t>(m_resources[1])};
-  if (cudaError_t e = cudaGraphicsUnmapResources(2, resources, 0); e != cudaSuccess) {
+  cudaGraphicsResource_t resources[kBuffers];
+  for (int i = 0; i < kBuffers; ++i) resources[i] = static_cast<cudaGraphicsResource_t>(m_resources[i]);
+  if (cudaError_t e = cudaGraphicsUnmapResources(kBuffers, resources, 0); e != cudaSuccess) {
     return Status::Error(std::string("CUDA-GL interop: unmap failed: ") + cudaGetErrorString(e));
   }
   m_mapped = false;
-  m_count = vertexCount;
+  m_written = true;
   return Status::Ok();
 #else
   return Status::Error("CUDA-GL interop: this build has no CUDA backend");
@@ -104,7 +109,9 @@ Status InteropMesh::Upload(const float* positions, const float* normals, int ver
     glNamedBufferSubData(m_positions, 0, bytes, positions);
     glNamedBufferSubData(m_normals, 0, bytes, normals);
   }
-  m_count = vertexCount;
+  const GLuint command[4] = {static_cast<GLuint>(vertexCount), 1, 0, 0};
+  glNamedBufferSubData(m_drawCommand, 0, sizeof(command), command);
+  m_written = true;
   return Status::Ok();
 }
 

@@ -204,7 +204,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   SurfaceImpl<Traits> m_surface{[this] {
     m_fluid.Regrid(View());
     return SurfaceParticles{m_fluid.View().position, FluidCount(), View()};
-  }};
+  }, &m_counter};
 };
 
 }  // namespace sphxr::sim

@@ -35,6 +35,8 @@ Status Solver::BuildSurface(const SurfaceParams& params, SurfaceStats* stats) {
   job.cellSize = params.cellSize > 0.0f ? params.cellSize : spacing;
   job.isoLevel = params.isoLevel;
   job.margin = params.margin >= 0.0f ? params.margin : SupportRadius();
+  job.boxMin = m_physics->domainMin;
+  job.boxMax = m_physics->domainMax;
   job.volume = spacing * spacing * spacing;  // m / rho0
   job.kernel = CubicSpline::Make(SupportRadius());
   job.maxSamples = kMaxSurfaceSamples;
@@ -48,6 +50,8 @@ Status Solver::WriteSurface(const SurfaceTarget& target, SurfaceStats* stats) {
   SurfaceStats local;
   return m_backend->Surface()->WriteTo(target, stats ? stats : &local);
 }
+
+SurfaceWriteReport Solver::LastSurfaceWrite() const { return m_backend->Surface()->LastWrite(); }
 
 Status Solver::ExtractSurface(const SurfaceParams& params, SurfaceMeshView* view, SurfaceStats* stats) {
   SurfaceStats local;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kernel.h"
+#include "sphxr/sim/vec.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/surface.h"
 
@@ -16,6 +17,7 @@ struct SurfaceJob {
   float cellSize;      // m
   float isoLevel;
   float margin;        // m
+  Vec3 boxMin, boxMax; // m, the box the domain clamp keeps every fluid particle in: the lattice covers it
   float volume;        // m / rho0 of one fluid particle
   CubicSpline kernel;  // the solver's kernel
   int64_t maxSamples;  // refuse a lattice with more samples than this
@@ -24,19 +26,21 @@ struct SurfaceJob {
 class SurfaceExtractor {
  public:
   virtual ~SurfaceExtractor() = default;
-  /// Field from the backend's particles (bounding box + margin), then the pyramid.
+  /// Field from the backend's particles (the clamp box + margin), then the pyramid. Reads nothing back.
   virtual Status BuildFromParticles(const SurfaceJob& job, SurfaceStats* stats) = 0;
   /// The pyramid over a given host field of grid.Samples() values (tests, benchmarks).
   virtual Status BuildFromField(const SurfaceGrid& grid, const std::vector<float>& field, float isoLevel,
                                 SurfaceStats* stats) = 0;
-  /// Vertices of the last build (the apex).
-  virtual int64_t VertexCount() const = 0;
+  /// The report of the last write whose report has reached the host (no copy, no wait).
+  virtual SurfaceWriteReport LastWrite() const = 0;
   /// Vertices per traversal work item (TraverseStage::run); 0 = this backend's default. The mesh is the
   /// same for every value (tests, benchmarks).
   virtual void SetTraversalRun(int vertices) = 0;
-  /// Traversal into caller memory of this backend's memory space; an error when capacity is too small.
+  /// Traversal into caller memory of this backend's memory space, clamped to its capacity (and
+  /// reported); reads nothing back.
   virtual Status WriteTo(const SurfaceTarget& target, SurfaceStats* stats) = 0;
-  /// Traversal into the extractor's own buffer, grown (and logged) when the mesh does not fit.
+  /// Traversal into the extractor's own buffer, then one wait for its report: a mesh that did not fit
+  /// grows the buffer (logged) and is written again, so the view holds the whole mesh.
   virtual Status WriteOwned(SurfaceMeshView* view, SurfaceStats* stats) = 0;
   /// Host copies of the last mesh written to the own buffer, and of the last field.
   virtual void DownloadMesh(SurfaceMesh* out) const = 0;

@@ -3,14 +3,17 @@
 // marching cubes using histogram pyramids"), written once as host+device functors over raw pointers.
 // surface_impl.h launches them with thrust on the OpenMP system (CPU backend) or the CUDA system.
 //
-//   1. bounds     the fluid's bounding box (a reduction); the sample lattice covers it plus a margin
+//   1. lattice    the box the domain clamp keeps the particles in, plus a margin (host arithmetic from
+//                 the scene: nothing is read back, and the lattice keeps its size from frame to frame)
 //   2. field      phi at every sample, through the neighbour grid's cellStart/cellEnd: one work item
 //                 per block of neighbour cells adds each candidate particle's kernel to the block's
 //                 samples within its reach (a clipped box); a block with no particle in reach writes zeros
 //   3. base       level 0 of the pyramid: the vertex count of each cell's marching-cubes case (and the
 //                 case), fused with level 1 (the 2x2x2 sums of the base) in one pass over the field
 //   4. reduce     level l node = sum of its 2x2x2 children in level l-1, up to the apex (the total)
-//   5. traverse   one work item per run of consecutive output vertices (one vertex on the GPU): the
+//   5. traverse   launched over the target's capacity, not the apex (which stays on the device): items
+//                 past the apex return at once, item 0 reports the count (and fills an indirect draw);
+//                 one work item per run of consecutive output vertices (one vertex on the GPU): the
 //                 first walks down from the apex, at each level skipping the children whose counts
 //                 lie before the vertex's index, to its cell and the vertex's slot there; the others
 //                 step to the next slot or the next cell with vertices (the in-order successor); the
@@ -29,26 +32,6 @@
 namespace sphxr::sim {
 
 inline constexpr int kMaxPyramidLevels = 32;
-
-struct Bounds {
-  Vec3 min{1e30f, 1e30f, 1e30f};
-  Vec3 max{-1e30f, -1e30f, -1e30f};
-};
-
-struct BoundsOfPoint {
-  const Vec4* position;
-  SPHXR_HD Bounds operator()(int i) const {
-    const Vec3 p = Xyz(position[i]);
-    return Bounds{p, p};
-  }
-};
-
-struct BoundsCombine {
-  SPHXR_HD Bounds operator()(const Bounds& a, const Bounds& b) const {
-    return Bounds{{fminf(a.min.x, b.min.x), fminf(a.min.y, b.min.y), fminf(a.min.z, b.min.z)},
-                  {fmaxf(a.max.x, b.max.x), fmaxf(a.max.y, b.max.y), fmaxf(a.max.z, b.max.z)}};
-  }
-};
 
 /// The sample lattice and its field on the device.
 struct FieldView {
@@ -331,14 +314,43 @@ struct ReduceLevelStage {
 /// GPU's many threads), longer runs replace most descents by a step within the cell (the CPU's few
 /// threads, where the ~7 dependent levels per vertex were most of the traversal's time), and a run
 /// copies a vertex it computed already on the same edge instead of interpolating it again (EdgeCache).
+/// A write's report as the device stores it (host-visible memory; SurfaceWriteReport is the host's copy).
+struct DeviceWriteReport {
+  int64_t vertices;  // the apex
+  int64_t written;   // min(apex, capacity)
+  int64_t capacity;
+  int64_t write;     // stored last: the report is complete when the host sees the number it expects
+};
+
 struct TraverseStage {
   FieldView field;
   PyramidView pyramid;
   const int8_t* edges;  // McTables::edges on this system, kMcMaxVertices per case
   float* positions;     // xyz per vertex
   float* normals;
-  int64_t vertices;     // the apex
+  const uint32_t* apex; // the mesh's vertex count, on the device (the host does not read it)
+  int64_t capacity;     // vertices the target holds: the launch covers it, items past the apex return
   int run;              // vertices per work item (>= 1)
+  DeviceWriteReport* report;  // host-visible; item 0 fills it
+  uint64_t write;             // this write's number, stored last in the report
+  uint32_t* drawCommand;      // glDrawArraysIndirect's {count, instanceCount, first, baseInstance}, or null
+
+  /// Item 0: what the write holds, for the host (read a frame later) and for the indirect draw.
+  SPHXR_HD void Report(int64_t vertices, int64_t written) const {
+    if (drawCommand) {
+      drawCommand[0] = static_cast<uint32_t>(written);
+      drawCommand[1] = 1u;
+      drawCommand[2] = 0u;
+      drawCommand[3] = 0u;
+    }
+    report->vertices = vertices;
+    report->written = written;
+    report->capacity = capacity;
+#if defined(__CUDA_ARCH__)
+    __threadfence_system();  // the counts reach the host before the write's number does
+#endif
+    report->write = static_cast<int64_t>(write);
+  }
 
   /// The child whose range of running sums holds key (the number of sums at or below it; sums are
   /// non-decreasing and the last is above key), and key made relative to that child. Branch-free, so
@@ -459,7 +471,11 @@ struct TraverseStage {
   }
 
   SPHXR_HD void operator()(int64_t item) const {
+    const int64_t total = *apex, room = capacity - capacity % 3;  // whole triangles
+    const int64_t vertices = total < room ? total : room;
+    if (item == 0) Report(total, vertices);
     const int64_t first = item * run;
+    if (first >= vertices) return;
     const int64_t end = first + run < vertices ? first + run : vertices;
     uint32_t key = static_cast<uint32_t>(first);
     uint32_t cellSums[8];

@@ -96,5 +96,52 @@ TEST(SurfacePathTest, InteropCaptureBuildsTheMeshWithoutCopyingIt) {
   EXPECT_EQ(device.SurfaceTriangles(), 0);
 }
 
+TEST(SurfacePathTest, InteropBuffersGrowFromTheLastWriteReport) {
+  // The GL thread never reads the mesh's size before a write: it sizes the buffers from the solver's
+  // last write report (a frame late on the CUDA device) and grows them after a clamped write.
+  sim::SurfaceWriteReport none;
+  EXPECT_EQ(InteropCapacity(0, none), 3 * 4096) << "the first buffers";
+  sim::SurfaceWriteReport fits;
+  fits.vertices = fits.written = 9000;
+  fits.capacity = 3 * 4096;
+  fits.write = 1;
+  EXPECT_EQ(InteropCapacity(3 * 4096, fits), 3 * 4096);
+  sim::SurfaceWriteReport clamped;
+  clamped.vertices = 30000;
+  clamped.written = clamped.capacity = 3 * 4096;
+  clamped.write = 2;
+  ASSERT_TRUE(clamped.Clamped());
+  const int64_t grown = InteropCapacity(3 * 4096, clamped);
+  EXPECT_GE(grown, 30000 + 30000 / 4 - 2);
+  EXPECT_EQ(grown % 3, 0) << "whole triangles";
+  EXPECT_EQ(InteropCapacity(grown, clamped), grown) << "grown once";
+  clamped.vertices = int64_t{1} << 26;
+  EXPECT_LE(InteropCapacity(grown, clamped), int64_t{1} << 26);
+}
+
+TEST(SurfacePathTest, AnInteropSnapshotInWaterModeCopiesNoParticles) {
+  // Its reader draws the mesh written in place: the particles are not copied back. Particle mode, and
+  // the host path, copy them all.
+  SurfaceRequest water, particles;
+  particles.enabled = false;
+  EXPECT_EQ(ParticlesFor(SurfacePath::kInterop, water), ParticleCopy::kNone);
+  EXPECT_EQ(ParticlesFor(SurfacePath::kInterop, particles), ParticleCopy::kAll);
+  EXPECT_EQ(ParticlesFor(SurfacePath::kHostCopy, water), ParticleCopy::kAll);
+  SceneFile scene;
+  ASSERT_TRUE(ParseScene(kSmallTankScene, "small", &scene).ok());
+  sim::SolverConfig config;
+  config.device = sim::Device::kCpu;
+  config.threads = 1;
+  std::unique_ptr<sim::Solver> solver;
+  ASSERT_TRUE(sim::Solver::Create(scene.setup, config, &solver).ok());
+  SimSnapshot snap;
+  ASSERT_TRUE(CaptureSnapshot(*solver, nullptr, water, &snap, SurfacePath::kInterop, ParticleCopy::kNone).ok());
+  EXPECT_EQ(snap.fluid.size(), 0u);
+  EXPECT_EQ(snap.fluidCount, solver->FluidCount());
+  EXPECT_TRUE(snap.surfaceOnDevice);
+  ASSERT_TRUE(CaptureSnapshot(*solver, nullptr, particles, &snap, SurfacePath::kInterop).ok());
+  EXPECT_EQ(static_cast<int>(snap.fluid.size()), solver->FluidCount());
+}
+
 }  // namespace
 }  // namespace sphxr::app

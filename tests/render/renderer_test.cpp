@@ -394,6 +394,58 @@ TEST_F(RendererTest, MeshInGlBuffersDrawsLikeTheSameMeshFromTheHost) {
   m_renderer.reset();  // before the mesh's buffers go
 }
 
+TEST_F(RendererTest, MeshInGlBuffersIsDrawnWithTheCountOfItsIndirectCommand) {
+  // The mesh written in place is drawn by glDrawArraysIndirect: its vertex count is the one in the draw
+  // command buffer (which CUDA fills on the device), not one the host knows. Upload fills the command
+  // with the whole mesh; the command is then rewritten here as the device would: the first 18 vertices
+  // draw what a host mesh of those 18 vertices draws, and 0 draws no water.
+  const BoxMesh box(glm::vec3(-0.3f, 0.2f, -0.2f), glm::vec3(0.3f, 0.8f, 0.0f));
+  std::vector<float> positions, normals;
+  for (uint32_t i : box.indices) {
+    positions.insert(positions.end(), {box.positions[3 * i], box.positions[3 * i + 1], box.positions[3 * i + 2]});
+    normals.insert(normals.end(), {box.normals[3 * i], box.normals[3 * i + 1], box.normals[3 * i + 2]});
+  }
+  ASSERT_GT(positions.size() / 3, 18u);
+  const glm::vec3 eye(0.4f, 0.9f, 2.0f);
+  const render::View v = FullView(glm::lookAt(eye, glm::vec3(0, 0.5f, 0), glm::vec3(0, 1, 0)), Perspective(float(kW) / kH));
+  auto differing = [](const render::Image& a, const render::Image& b) {
+    int n = 0;
+    for (size_t i = 0; i < a.rgba.size(); ++i) n += a.rgba[i] != b.rgba[i];
+    return n;
+  };
+  render::FrameScene scene = EmptyScene();
+  render::MeshView part;
+  part.positions = positions.data();
+  part.normals = normals.data();
+  part.vertexCount = 18;
+  scene.surface = part;
+  const render::Image hostPart = DrawAndRead(scene, std::span(&v, 1));
+  scene.surface.vertexCount = static_cast<int>(positions.size() / 3);
+  const render::Image hostWhole = DrawAndRead(scene, std::span(&v, 1));
+  ASSERT_GT(differing(hostPart, hostWhole), 100) << "the two counts must draw different pictures";
+
+  std::unique_ptr<render::InteropMesh> device;
+  ASSERT_TRUE(render::InteropMesh::Create(64, &device).ok());
+  EXPECT_FALSE(device->Written());
+  ASSERT_TRUE(device->Upload(positions.data(), normals.data(), static_cast<int>(positions.size() / 3)).ok());
+  EXPECT_TRUE(device->Written());
+  uint32_t command[4] = {};
+  glGetNamedBufferSubData(device->DrawCommandBuffer(), 0, sizeof(command), command);
+  EXPECT_EQ(command[0], positions.size() / 3);
+  EXPECT_EQ(command[1], 1u);
+  scene.surface = render::MeshView{};
+  scene.deviceSurface = device.get();
+  EXPECT_EQ(differing(DrawAndRead(scene, std::span(&v, 1)), hostWhole), 0);
+  command[0] = 18;
+  glNamedBufferSubData(device->DrawCommandBuffer(), 0, sizeof(command), command);
+  EXPECT_EQ(differing(DrawAndRead(scene, std::span(&v, 1)), hostPart), 0);
+  command[0] = 0;
+  glNamedBufferSubData(device->DrawCommandBuffer(), 0, sizeof(command), command);
+  const render::Image none = DrawAndRead(scene, std::span(&v, 1));
+  EXPECT_EQ(differing(none, DrawAndRead(EmptyScene(), std::span(&v, 1))), 0) << "0 vertices: no water";
+  m_renderer.reset();  // before the mesh's buffers go
+}
+
 }  // namespace
 }  // namespace sphxr::test
 

@@ -467,7 +467,7 @@ TEST(Surface, AMillionTrianglesGrowTheBufferAndMatchTheReference) {
   ExpectSameTriangles(m, ReferenceMarchingCubes(g, f, 0.1f));
 }
 
-TEST(Surface, BufferGrowsOnlyWhenTheMeshDoesNotFitAndWriteToRefusesASmallTarget) {
+TEST(Surface, BufferGrowsOnlyWhenTheMeshDoesNotFitAndWriteToClampsASmallTarget) {
   auto backend = sim::MakeCpuBackend(1);
   sim::SurfaceExtractor* s = backend->Surface();
   const SurfaceGrid g = CubeGrid(40, -0.5f, 0.5f);
@@ -491,18 +491,43 @@ TEST(Surface, BufferGrowsOnlyWhenTheMeshDoesNotFitAndWriteToRefusesASmallTarget)
   ASSERT_TRUE(s->BuildFromField(g, sphere(0.45), 0.0f, &stats).ok());
   ASSERT_TRUE(s->WriteOwned(&view, &stats).ok());
   EXPECT_TRUE(stats.grew);
+  EXPECT_FALSE(stats.clamped);
   EXPECT_GE(stats.capacity, stats.vertices);
   EXPECT_EQ(view.vertexCount, stats.vertices);
-  // Caller memory: too small is an error naming both sizes; big enough gives the same mesh.
-  std::vector<float> pos(static_cast<size_t>(3 * stats.vertices)), nor(pos.size());
-  const Status small = s->WriteTo(sim::SurfaceTarget{pos.data(), nor.data(), stats.vertices - 1}, &stats);
-  EXPECT_FALSE(small.ok());
-  EXPECT_NE(small.message().find(std::to_string(stats.vertices)), std::string::npos) << small.message();
-  ASSERT_TRUE(s->WriteTo(sim::SurfaceTarget{pos.data(), nor.data(), stats.vertices}, &stats).ok());
   SurfaceMesh own;
   s->DownloadMesh(&own);
+  const int64_t n = stats.vertices;
+  // Caller memory too small by one vertex: the whole triangles that fit are written, nothing past the
+  // capacity, and the report says so (the indirect draw command counts what was written).
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> pos(static_cast<size_t>(3 * n), nan), nor(pos.size(), nan);
+  uint32_t draw[4] = {7, 7, 7, 7};
+  ASSERT_TRUE(s->WriteTo(sim::SurfaceTarget{pos.data(), nor.data(), n - 1, draw}, &stats).ok());
+  const sim::SurfaceWriteReport r = s->LastWrite();
+  EXPECT_EQ(r.vertices, n);
+  EXPECT_EQ(r.written, n - 3);
+  EXPECT_EQ(r.capacity, n - 1);
+  EXPECT_TRUE(r.Clamped());
+  EXPECT_TRUE(stats.clamped);
+  EXPECT_EQ(stats.vertices, n);
+  EXPECT_EQ(draw[0], static_cast<uint32_t>(n - 3));
+  EXPECT_EQ(draw[1], 1u);
+  EXPECT_EQ(draw[2], 0u);
+  EXPECT_EQ(draw[3], 0u);
+  EXPECT_TRUE(std::equal(pos.begin(), pos.end() - 9, own.positions.begin()));
+  EXPECT_TRUE(std::equal(nor.begin(), nor.end() - 9, own.normals.begin()));
+  for (size_t i = pos.size() - 9; i < pos.size(); ++i) EXPECT_TRUE(std::isnan(pos[i]) && std::isnan(nor[i])) << i;
+  // Big enough: the same mesh, not clamped.
+  ASSERT_TRUE(s->WriteTo(sim::SurfaceTarget{pos.data(), nor.data(), n, draw}, &stats).ok());
+  EXPECT_FALSE(s->LastWrite().Clamped());
+  EXPECT_GT(s->LastWrite().write, r.write);
+  EXPECT_EQ(draw[0], static_cast<uint32_t>(n));
   EXPECT_EQ(own.positions, pos);
   EXPECT_EQ(own.normals, nor);
+  // No target at all: nothing written, the size still reported.
+  ASSERT_TRUE(s->WriteTo(sim::SurfaceTarget{}, &stats).ok());
+  EXPECT_EQ(s->LastWrite().vertices, n);
+  EXPECT_EQ(s->LastWrite().written, 0);
 }
 
 TEST(Surface, RunsOfVerticesGiveBitwiseTheMeshOfOneDescentPerVertex) {
@@ -557,7 +582,9 @@ TEST(Surface, RunsOfVerticesGiveBitwiseTheMeshOfOneDescentPerVertex) {
     sim::SurfaceExtractor* s = backend->Surface();
     SurfaceStats stats;
     ASSERT_TRUE(s->BuildFromField(c.grid, c.field, c.iso, &stats).ok());
-    const int64_t n = stats.vertices;
+    sim::SurfaceMeshView view;
+    ASSERT_TRUE(s->WriteOwned(&view, &stats).ok());  // the size, read back once
+    const int64_t n = view.vertexCount;
     ASSERT_GT(n, 30);
     auto write = [&](int run, std::vector<float>* pos, std::vector<float>* nor) {
       pos->assign(static_cast<size_t>(3 * n + kGuard), nan);
@@ -646,10 +673,9 @@ TEST(SurfaceParticles, EmptySceneGivesNoTriangles) {
   EXPECT_EQ(mesh.VertexCount(), 0);
 }
 
-// Positions that are all non-finite along an axis leave the bounding box at its initial +-1e30: the
-// lattice size was converted from an out-of-range double (undefined; a silent empty mesh on x86). It is
-// an error now; a few NaN particles among finite ones are skipped, as before.
-TEST(SurfaceParticles, ANonFiniteBoundingBoxIsAnError) {
+// The lattice is the clamp box's, so no particle position sizes it: non-finite particles add nothing to
+// the field (a few among finite ones, or all of them).
+TEST(SurfaceParticles, NonFiniteParticlesAddNothingToTheField) {
   auto solver = CreateOrFail(SmallDamBreak());
   ASSERT_TRUE(solver);
   HostFluid f = DownloadFluid(*solver);
@@ -660,9 +686,8 @@ TEST(SurfaceParticles, ANonFiniteBoundingBoxIsAnError) {
   EXPECT_GT(mesh.TriangleCount(), 0);
   for (Vec4& p : f.position) p.x = std::nanf("");
   ASSERT_TRUE(solver->Upload(f).ok());
-  const Status s = solver->ExtractSurface(sim::SurfaceParams{}, &mesh);
-  ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("not finite"), std::string::npos) << s.message();
+  ASSERT_TRUE(solver->ExtractSurface(sim::SurfaceParams{}, &mesh).ok());
+  EXPECT_EQ(mesh.VertexCount(), 0);
 }
 
 TEST(SurfaceParticles, BadParametersAreRefusedWithTheKey) {
@@ -747,10 +772,23 @@ void CompareFieldWithBruteForce(const SurfaceGrid& g, const std::vector<float>& 
                                 const sim::CubicSpline& w, float volume, double* worst, double* peak) {
   *worst = 0.0;
   *peak = 0.0;
+  // Farther than the support from the particles' bounding box the field is exactly 0 (no sum needed).
+  Vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  for (const Vec4& q : positions) {
+    lo = Vec3{std::min(lo.x, q.x), std::min(lo.y, q.y), std::min(lo.z, q.z)};
+    hi = Vec3{std::max(hi.x, q.x), std::max(hi.y, q.y), std::max(hi.z, q.z)};
+  }
+  const float reach = 1.001f * w.H;
   for (int kz = 0; kz < g.nz; ++kz)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i) {
         const Vec3 x{g.origin.x + i * g.cellSize, g.origin.y + j * g.cellSize, g.origin.z + kz * g.cellSize};
+        if (x.x < lo.x - reach || x.x > hi.x + reach || x.y < lo.y - reach || x.y > hi.y + reach ||
+            x.z < lo.z - reach || x.z > hi.z + reach) {
+          const float got = field[static_cast<size_t>(i + g.nx * (j + g.ny * kz))];
+          ASSERT_EQ(got, 0.0f) << "sample " << i << ", " << j << ", " << kz << " beyond every particle's support";
+          continue;
+        }
         double sum = 0.0;
         for (const Vec4& q : positions) {
           const Vec3 d = x - Xyz(q);
@@ -800,17 +838,17 @@ TEST(SurfaceParticles, FieldMatchesABruteForceSumAndExtractionDoesNotChangeTheSi
   if (HasFatalFailure()) return;
   EXPECT_LT(worst, 1e-5);
   EXPECT_GT(peak, 0.9);
-  // The lattice covers the particles' bounding box plus the margin (the support radius), no more.
-  Vec3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
-  for (const Vec4& q : fb.position) {
-    lo = Vec3{std::min(lo.x, q.x), std::min(lo.y, q.y), std::min(lo.z, q.z)};
-    hi = Vec3{std::max(hi.x, q.x), std::max(hi.y, q.y), std::max(hi.z, q.z)};
-  }
+  // The lattice covers the box the domain clamp keeps the particles in (a quarter spacing inside the
+  // tank) plus the margin (the support radius), no more.
+  const float inset = 0.25f * dx;
+  const Vec3 lo = scene.tank.min + Vec3{inset, inset, inset}, hi = scene.tank.max - Vec3{inset, inset, inset};
   const float m = b->SupportRadius();
   EXPECT_LE(g.origin.x, lo.x - m);
   EXPECT_GT(g.origin.x, lo.x - m - g.cellSize);
   EXPECT_GE(g.origin.y + (g.ny - 1) * g.cellSize, hi.y + m);
   EXPECT_LT(g.origin.y + (g.ny - 2) * g.cellSize, hi.y + m);
+  EXPECT_LE(g.origin.z, lo.z - m);
+  EXPECT_GE(g.origin.x + (g.nx - 1) * g.cellSize, hi.x + m);
 }
 
 TEST(SurfaceParticles, FieldMatchesABruteForceSumAtEveryCellSize) {

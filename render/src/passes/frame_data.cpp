@@ -84,10 +84,12 @@ void FrameData::Upload(const FrameScene& scene, const RenderSettings& settings) 
 }
 
 void FrameData::UploadWater(const FrameScene& scene) {
-  const bool deviceMesh = scene.deviceSurface != nullptr && scene.deviceSurface->VertexCount() > 0;
+  const bool deviceMesh = scene.deviceSurface != nullptr && scene.deviceSurface->Written();
   hasMesh = deviceMesh || !scene.surface.Empty();
-  if (deviceMesh) {  // no upload: the buffers were written in place (CUDA-GL interop)
-    meshVertexCount = scene.deviceSurface->VertexCount();
+  meshDrawCommand = 0;
+  if (deviceMesh) {  // no upload: the buffers were written in place (CUDA-GL interop), the count too
+    meshDrawCommand = scene.deviceSurface->DrawCommandBuffer();
+    meshVertexCount = 0;
     meshIndexCount = 0;
     glVertexArrayVertexBuffer(meshVao, 0, scene.deviceSurface->PositionBuffer(), 0, 3 * sizeof(float));
     glVertexArrayVertexBuffer(meshVao, 1, scene.deviceSurface->NormalBuffer(), 0, 3 * sizeof(float));
@@ -349,7 +351,11 @@ void FrameData::SetViewportOrigin(glm::vec2 origin) {
 void FrameData::DrawWater() const {
   if (waterFromMesh) {
     glBindVertexArray(meshVao);
-    if (meshIndexCount > 0) {
+    if (meshDrawCommand != 0) {  // the vertex count lives in the GL buffer its writer filled
+      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, meshDrawCommand);
+      glDrawArraysIndirect(GL_TRIANGLES, nullptr);
+      glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    } else if (meshIndexCount > 0) {
       glDrawElements(GL_TRIANGLES, meshIndexCount, GL_UNSIGNED_INT, nullptr);
     } else {
       glDrawArrays(GL_TRIANGLES, 0, meshVertexCount);

@@ -61,6 +61,7 @@ struct FrameData {
   // The water.
   bool hasMesh = false;
   int meshVertexCount = 0, meshIndexCount = 0;
+  GLuint meshDrawCommand = 0;  // a device-written mesh: its glDrawArraysIndirect buffer (else 0)
   Buffer meshPositions, meshNormals, meshIndices;
   int particleCount = 0;  // sprites uploaded (particle mode, or water without a mesh)
   Buffer particles;       // xyz + the colour scalar

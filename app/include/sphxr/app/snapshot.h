@@ -46,6 +46,8 @@ struct SimSnapshot {
   /// GPU path (SurfacePath::kInterop): the mesh was built in the solver (BuildSurface) and not copied:
   /// `surface` is empty, the mesh has `surfaceVertices` vertices and the GL thread writes it into its
   /// render::InteropMesh (SimWorker::WriteSurfaceInto). `surfaceBuild` numbers the worker's builds.
+  /// `surfaceVertices` is the solver's last write report (Solver::LastSurfaceWrite): the mesh of an
+  /// earlier build on the CUDA device, where the count is not read back.
   bool surfaceOnDevice = false;
   int64_t surfaceVertices = 0;
   uint64_t surfaceBuild = 0;
@@ -77,10 +79,20 @@ const char* SurfacePathName(SurfacePath path);
 /// kInterop exactly when the solver runs on the CUDA device (Solver::ActiveDevice()).
 SurfacePath ChooseSurfacePath(sim::Device activeDevice);
 
-/// Copies the solver's state into `out` (fluid, diffuse particles, step info, counts), the paddles' poses and loads
-/// (`paddles` may be null) and, when `surface.enabled`, extracts the surface (timed): a host copy, or
-/// with SurfacePath::kInterop only BuildSurface (`out->surfaceOnDevice`, `out->surfaceVertices`).
+/// Which of the fluid's particles a snapshot's reader uses. kAll: pictures, particle mode, water drawn
+/// from a host mesh or as sprites. kNone: water drawn from the mesh written in place (SurfacePath::kInterop
+/// in water mode), where nothing reads them: `fluid` stays empty and nothing of it is copied back.
+enum class ParticleCopy { kAll, kNone };
+/// The snapshot's reader on `path` with the surface request `surface`: kNone exactly for the water mode
+/// of the interop path.
+ParticleCopy ParticlesFor(SurfacePath path, const SurfaceRequest& surface);
+
+/// Copies the solver's state into `out` (fluid unless `particles` is kNone, diffuse particles, step info,
+/// counts), the paddles' poses and loads (`paddles` may be null) and, when `surface.enabled`, extracts the
+/// surface (timed): a host copy, or with SurfacePath::kInterop only BuildSurface (`out->surfaceOnDevice`;
+/// `out->surfaceVertices` is then the solver's last write report, which reads nothing back).
 Status CaptureSnapshot(sim::Solver& solver, const interaction::PaddleSystem* paddles, const SurfaceRequest& surface,
-                       SimSnapshot* out, SurfacePath path = SurfacePath::kHostCopy);
+                       SimSnapshot* out, SurfacePath path = SurfacePath::kHostCopy,
+                       ParticleCopy particles = ParticleCopy::kAll);
 
 }  // namespace sphxr::app

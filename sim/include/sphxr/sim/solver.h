@@ -196,11 +196,15 @@ class Solver {
   Status ExtractSurface(const SurfaceParams& params, SurfaceMeshView* view, SurfaceStats* stats = nullptr);
   /// The same, copied to the host.
   Status ExtractSurface(const SurfaceParams& params, SurfaceMesh* mesh, SurfaceStats* stats = nullptr);
-  /// In two phases, for a renderer that writes into its own (mapped) buffer: BuildSurface samples the
-  /// field and builds the pyramid (stats->vertices is the mesh's size); WriteSurface then fills target,
-  /// which must hold that many vertices (device memory on the CUDA backend, host memory on the CPU).
+  /// In two phases, for a renderer that writes into its own (mapped) buffer, neither reading anything
+  /// back nor waiting: BuildSurface samples the field over the clamp box and builds the pyramid (the
+  /// vertex count stays on the device); WriteSurface then fills target (device memory on the CUDA
+  /// backend, host memory on the CPU), clamped to its capacity, and its indirect draw command if given.
+  /// A write's count and clamp arrive in LastSurfaceWrite (a frame later on the CUDA backend): a
+  /// renderer grows its buffer from there for the next frame.
   Status BuildSurface(const SurfaceParams& params, SurfaceStats* stats);
   Status WriteSurface(const SurfaceTarget& target, SurfaceStats* stats);
+  SurfaceWriteReport LastSurfaceWrite() const;
   /// What the backend asked of its device since the solver was made: launches, host waits, device
   /// allocations, copies back (sphxr/sim/launch_counts.h). A frame's counts: the difference of two.
   LaunchCounts Counts() const;

@@ -39,8 +39,12 @@ struct SurfaceGrid {
 /// What one extraction did, and what it cost.
 struct SurfaceStats {
   SurfaceGrid grid;
-  int64_t vertices = 0;       // 3 per triangle
+  /// The mesh's size, 3 per triangle. Exact after ExtractSurface (which reads it back). BuildSurface and
+  /// WriteSurface read nothing back: there they are the last write's SurfaceWriteReport (on the CUDA
+  /// backend an earlier build's; 0 before the first write).
+  int64_t vertices = 0;
   int64_t triangles = 0;
+  bool clamped = false;       // that write's target was too small: it holds the first `capacity` vertices
   int pyramidLevels = 0;      // base level included
   int64_t baseBytes = 0;      // the pyramid's base level (vertex count per cell)
   int64_t pyramidBytes = 0;   // all levels, base included
@@ -62,11 +66,28 @@ struct SurfaceMeshView {
   bool onDevice = false;
 };
 
-/// Caller memory to write a mesh into (same memory space as SurfaceMeshView::onDevice says).
+/// Caller memory to write a mesh into (same memory space as SurfaceMeshView::onDevice says). A mesh
+/// larger than `capacity` is clamped to its first `capacity` vertices (whole triangles when capacity is a
+/// multiple of 3) and reported (SurfaceWriteReport); nothing is written past it.
 struct SurfaceTarget {
   float* positions = nullptr;
   float* normals = nullptr;
   int64_t capacity = 0;  // vertices
+  /// Optional: a glDrawArraysIndirect command {count, instanceCount, first, baseInstance} that the write
+  /// fills on the device with {vertices written, 1, 0, 0}, so the mesh is drawn without its count
+  /// reaching the host (a GL_DRAW_INDIRECT_BUFFER mapped through CUDA-GL interop).
+  uint32_t* drawCommand = nullptr;
+};
+
+/// What a write of the mesh found, reported by the device into host-visible memory (mapped pinned
+/// memory on the CUDA backend): read without a copy or a wait, so on the CUDA backend it is complete
+/// once the device has finished that write (`write` numbers the writes; 0: none reported yet).
+struct SurfaceWriteReport {
+  int64_t vertices = 0;  // the mesh's size (the pyramid's apex)
+  int64_t written = 0;   // min(vertices, capacity)
+  int64_t capacity = 0;  // of the target written
+  uint64_t write = 0;
+  bool Clamped() const { return vertices > written; }
 };
 
 /// A host copy of the mesh.
