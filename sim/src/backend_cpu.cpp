@@ -21,7 +21,8 @@ struct OmpTraits {
   static Status Sync(const char* /*stage*/) { return Status::Ok(); }  // thrust's OpenMP calls return when done
   static constexpr const char* kName = "cpu";
   static constexpr bool kOnDevice = false;  // where the surface mesh lives
-  static constexpr int kTraversalRun = 256;  // a descent per run of vertices: few threads, each stepping along the mesh
+  static constexpr int kTraversalRun = 256;
+  static constexpr bool kSurfaceOverParticles = true;  // host memory: the particles' bounds cost no wait  // a descent per run of vertices: few threads, each stepping along the mesh
   using Launcher = CpuLauncher<OmpTraits>;  // the SIMD density, force and wall-pressure stages (cpu/launcher.h)
 };
 

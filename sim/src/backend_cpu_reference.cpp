@@ -21,6 +21,7 @@ struct OmpReferenceTraits {
   static Status Sync(const char* /*stage*/) { return Status::Ok(); }
   static constexpr const char* kName = "cpu-reference";
   static constexpr bool kOnDevice = false;   // the mesh is host memory (CUDA's is device memory: the only difference)
+  static constexpr bool kSurfaceOverParticles = false;  // as CUDA: the lattice over the clamp box
   static constexpr int kTraversalRun = 1;    // as CUDA: one descent per vertex
   using Launcher = PlainLauncher<OmpReferenceTraits>;  // as CUDA: a work item per particle (launch/plain.h)
 };

@@ -26,6 +26,7 @@ struct CudaTraits {
   }
   static constexpr const char* kName = "cuda";
   static constexpr bool kOnDevice = true;  // where the surface mesh lives
+  static constexpr bool kSurfaceOverParticles = false;  // no read-back: the lattice over the clamp box
   static constexpr int kTraversalRun = 1;  // one descent per vertex: a thread each
   using Launcher = PlainLauncher<CudaTraits>;  // a thread per particle (launch/plain.h)
 };

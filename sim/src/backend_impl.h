@@ -28,7 +28,8 @@ namespace sphxr::sim {
 /// Traits: `template <class T> using Vector`, `static auto Policy()`, `static Status Sync(const char* stage)`
 /// (waits for the work launched so far; CUDA: its error, naming the stage), `using Launcher` (how the
 /// shared stages run: launch/plain.h or cpu/launcher.h), `static const char* kName`, `static bool
-/// kOnDevice` (where the surface mesh lives), `static int kTraversalRun` (the surface traversal's
+/// kOnDevice` (where the surface mesh lives), `static bool kSurfaceOverParticles` (the surface lattice
+/// over the particles' bounds, read back, instead of the clamp box), `static int kTraversalRun` (the surface traversal's
 /// vertices per work item).
 template <class Traits>
 class BackendImpl : public Backend {  // (the CPU backend adds its team, backend_cpu.cpp)

@@ -9,6 +9,7 @@
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform_reduce.h>
 
 #include <algorithm>
 #include <chrono>
@@ -63,7 +64,7 @@ class SurfaceImpl final : public SurfaceExtractor {
     auto policy = Traits::Policy();
     const SurfaceParticles p = m_source();
     SurfaceGrid grid;
-    if (Status s = Lattice(job, p.grid, &grid); !s) return s;
+    if (Status s = Lattice(LatticeBox(job, p), p.grid, &grid); !s) return s;
     const float cs = grid.cellSize;
     Resize(m_field, static_cast<size_t>(grid.Samples()));
     // Every sample is written by exactly one block of the field stage; NaN first makes a miss visible.
@@ -164,6 +165,26 @@ class SurfaceImpl final : public SurfaceExtractor {
   void Resize(Vector<T>& v, size_t n) {
     if (n > v.capacity()) m_counter.Allocation();
     v.resize(n);
+  }
+
+  /// The box the lattice covers: the clamp box; on a backend whose particles are host memory
+  /// (kSurfaceOverParticles: reading them costs no wait), the particles' bounding box within it, so the
+  /// lattice follows the water instead of sampling the empty tank. Same lattice lines either way.
+  static SurfaceJob LatticeBox(const SurfaceJob& job, const SurfaceParticles& p) {
+    SurfaceJob box = job;
+    if constexpr (Traits::kSurfaceOverParticles) {
+      if (p.count == 0) return box;
+      const Bounds b = thrust::transform_reduce(Traits::Policy(), thrust::counting_iterator<int>(0),
+                                                thrust::counting_iterator<int>(p.count), BoundsOfPoint{p.position},
+                                                Bounds{}, BoundsCombine{});
+      const bool finite = std::isfinite(b.min.x) && std::isfinite(b.min.y) && std::isfinite(b.min.z) &&
+                          std::isfinite(b.max.x) && std::isfinite(b.max.y) && std::isfinite(b.max.z);
+      if (!finite) return box;  // a non-finite particle: the clamp box, as on the other backends
+      box.boxMin = Vec3{std::max(job.boxMin.x, b.min.x), std::max(job.boxMin.y, b.min.y), std::max(job.boxMin.z, b.min.z)};
+      box.boxMax = Vec3{std::min(job.boxMax.x, b.max.x), std::min(job.boxMax.y, b.max.y), std::min(job.boxMax.z, b.max.z)};
+      if (!(box.boxMin.x <= box.boxMax.x && box.boxMin.y <= box.boxMax.y && box.boxMin.z <= box.boxMax.z)) return job;
+    }
+    return box;
   }
 
   /// The lattice: the clamp box plus the margin, on lattice lines through the neighbour grid's origin

@@ -33,6 +33,27 @@ namespace sphxr::sim {
 
 inline constexpr int kMaxPyramidLevels = 32;
 
+/// The particles' bounding box (the CPU backend's surface lattice: kSurfaceOverParticles).
+struct Bounds {
+  Vec3 min{1e30f, 1e30f, 1e30f};
+  Vec3 max{-1e30f, -1e30f, -1e30f};
+};
+
+struct BoundsOfPoint {
+  const Vec4* position;
+  SPHXR_HD Bounds operator()(int i) const {
+    const Vec3 p = Xyz(position[i]);
+    return Bounds{p, p};
+  }
+};
+
+struct BoundsCombine {
+  SPHXR_HD Bounds operator()(const Bounds& a, const Bounds& b) const {
+    return Bounds{{fminf(a.min.x, b.min.x), fminf(a.min.y, b.min.y), fminf(a.min.z, b.min.z)},
+                  {fmaxf(a.max.x, b.max.x), fmaxf(a.max.y, b.max.y), fmaxf(a.max.z, b.max.z)}};
+  }
+};
+
 /// The sample lattice and its field on the device.
 struct FieldView {
   Vec3 origin;
