@@ -47,6 +47,15 @@ Status Simulation::Create(const SimScene& scene, const SimulationConfig& config,
   std::unique_ptr<Simulation> run(new Simulation());
   run->m_scene = scene;
   run->m_setup = scene.setup;
+  // One frame clock: PBF substeps the displayed frame, whose period is the paddles' (pbf_frame is the
+  // period only where no Simulation sets it: the sim library alone).
+  const float period = static_cast<float>(run->FramePeriod());
+  float& pbfFrame = run->m_setup.params.pbfFrame;
+  if (pbfFrame != sim::SolverParams{}.pbfFrame && std::abs(pbfFrame - period) > 1e-6f * period) {
+    SPHXR_LOG_WARN("pbf_frame %.4g s is not used: PBF substeps the displayed frame, 1 / paddles.frame_rate = %.4g s",
+                   pbfFrame, period);
+  }
+  pbfFrame = period;
   // Paddles: sampled at the final spacing, added to the scene as moving bodies.
   if (!scene.paddles.empty()) {
     if (Status s = interaction::PaddleSystem::Create(scene.paddles, run->m_setup, &run->m_paddles); !s) {

@@ -14,6 +14,7 @@
 
 #include <chrono>
 #include <memory>
+#include <utility>
 
 #include "backend.h"
 #include "backend_guard.h"
@@ -67,6 +68,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
 
   void RebuildGrid(std::vector<uint32_t>* fluidStart, std::vector<uint32_t>* fluidEnd) override {
     m_fluid.Regrid(View());
+    m_resorted = true;
     fluidStart->resize(m_fluid.Cells());
     fluidEnd->resize(m_fluid.Cells());
     thrust::copy(m_fluid.StartVector().begin(), m_fluid.StartVector().end(), fluidStart->begin());
@@ -75,7 +77,10 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
 
   void Download(HostFluid* out) const override { m_fluid.Download(out); }
   void DownloadBoundary(HostBoundary* out) const override { m_walls.Download(out); }
-  void Upload(const HostFluid& fluid) override { m_fluid.Upload(fluid); }
+  void Upload(const HostFluid& fluid) override {
+    m_fluid.Upload(fluid);
+    m_resorted = true;
+  }
 
   FireSums FireReduce() override {
     const thrust::counting_iterator<int> first(0);
@@ -92,6 +97,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   void SampleProbesNow(const Physics& physics) override {
     if (m_probes.Empty()) return;
     m_fluid.Regrid(View());
+    m_resorted = true;
     m_probes.Evaluate(View(), m_fluid.View(), physics, m_launch);
   }
 
@@ -135,13 +141,17 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
       return s;
     };
     m_solver->BeforeGrid(m_fluid.View(), physics, dt);
-    // 1. the grid: cell codes, the Z-order sort of every field, the cells' ranges (Huang et al. 2013, §3.1)
-    m_fluid.CellCodes(View());
-    SPHXR_TRY(lap(Stage::kCells));
-    m_fluid.Sort();
-    SPHXR_TRY(lap(Stage::kSort));
-    m_fluid.CellRanges(View());
-    SPHXR_TRY(lap(Stage::kGrid));
+    // 1. the grid: cell codes, the Z-order sort of every field, the cells' ranges (Huang et al. 2013, §3.1);
+    //    gated where the solver's lists last several steps (PressureSolver::GridGate)
+    const int* gate = m_solver->GridGate(std::exchange(m_resorted, false));
+    if (m_launch.Launches(gate)) {
+      m_fluid.CellCodes(View(), gate);
+      SPHXR_TRY(lap(Stage::kCells));
+      m_fluid.Sort();
+      SPHXR_TRY(lap(Stage::kSort));
+      m_fluid.CellRanges(View());
+      SPHXR_TRY(lap(Stage::kGrid));
+    }
     // 2. the moving bodies at their start-of-step pose
     if (!m_bodies.Empty()) {
       m_bodies.Place(View());
@@ -160,7 +170,8 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     *report = ctx.report;
     SPHXR_TRY(lap(Stage::kIntegrate));
     // 5. the post-step stages, on the state the step ends in (they read the fluid, never write it)
-    return PostSteps(dt, physics, lap);
+    const float postDt = m_solver->PostStepDt(dt);
+    return postDt > 0.0f ? PostSteps(postDt, physics, lap) : Status::Ok();
   }
 
   /// The post-step stages (post_step.h) in their order; a new one is a member and one entry here.
@@ -200,10 +211,12 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   std::unique_ptr<PressureSolver<Traits>> m_solver;
   LaunchCounter m_counter;        // launches, waits, allocations and copies back (launch/counter.h)
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message
+  bool m_resorted = true;  // the particles were re-sorted or replaced outside a step (GridGate's argument)
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the
   // step's sort. Re-sorting here does not change the next step (its stable sort then keeps this order).
   SurfaceImpl<Traits> m_surface{[this] {
     m_fluid.Regrid(View());
+    m_resorted = true;
     return SurfaceParticles{m_fluid.View().position, FluidCount(), View()};
   }, &m_counter};
 };

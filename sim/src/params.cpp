@@ -9,7 +9,7 @@
 namespace sphxr::sim {
 namespace {
 
-const std::array<ParamInfo, 41> kParams = {{
+const std::array<ParamInfo, 42> kParams = {{
     {"spacing", "m", "rest spacing of the fluid particles; mass = rest_density * spacing^3", 1e-4, 1.0,
      &SolverParams::spacing},
     {"support_factor", "", "kernel support radius in spacings (cubic spline); below 1.8 the rest lattice alone is over-dense", 1.8, 4.0, &SolverParams::supportFactor},
@@ -37,12 +37,14 @@ const std::array<ParamInfo, 41> kParams = {{
      &SolverParams::minDivergenceIterations, true, "dfsph"},
     {"max_divergence_iterations", "", "dfsph: divergence solve iterations at most (0 = no divergence solve)", 0.0,
      10000.0, &SolverParams::maxDivergenceIterations, true, "dfsph"},
-    {"pbf_frame", "s", "pbf: the displayed frame it advances by, in pbf_substeps steps (pbf ignores max_dt and cfl)",
+    {"pbf_frame", "s", "pbf: the frame it substeps where no frame clock sets it (the sim library alone); a run of the app substeps the displayed frame, 1 / paddles.frame_rate, instead (pbf ignores max_dt and cfl)",
      1e-4, 0.1, &SolverParams::pbfFrame, false, "pbf"},
     {"pbf_iterations", "", "pbf: Jacobi iterations of the density constraint per step (the cost is fixed by it)", 1.0,
      100.0, &SolverParams::pbfIterations, true, "pbf"},
     {"pbf_substeps", "", "pbf: steps per pbf_frame", 1.0, 16.0,
      &SolverParams::pbfSubsteps, true, "pbf"},
+    {"pbf_skin", "", "pbf: the neighbour lists' margin beyond the support, in spacings: the grid, the sort and the lists are built once per frame and again when a particle has moved half of it (0 = every step)",
+     0.0, 2.0, &SolverParams::pbfSkin, false, "pbf"},
     {"pbf_relaxation", "", "pbf: constraint-force mixing epsilon, as a fraction of the rest lattice's sum of squared constraint gradients",
      1e-6, 10.0, &SolverParams::pbfRelaxation, false, "pbf"},
     {"pbf_corr_k", "", "pbf: artificial pressure s_corr = -k (W(r)/W(dq))^n against clumping at the surface (0 = off)",

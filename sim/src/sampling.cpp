@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "sphxr/common/log.h"
+#include "sphxr/sim/solver_table.h"
 
 namespace sphxr::sim {
 namespace {
@@ -352,13 +353,18 @@ int NeighbourCapacity(float supportFactor) {
 GridShape MakeGridShape(const SceneSetup& scene) {
   const float support = scene.params.spacing * scene.params.supportFactor;
   const float margin = static_cast<float>(scene.boundaryLayers) * scene.params.spacing * 1.1f + 0.5f * support;
+  // A solver whose neighbour lists last several steps (PBF's skin) searches its lists to the support
+  // plus their margin, and its stale cells must still hold every particle within the support of any
+  // point: cells of the support plus the margin (the 27 around a cell reach that far).
+  const SolverInfo& method = SolverInfoOf(scene.method);
+  const float cell = support + (method.listMargin ? method.listMargin(scene.params) : 0.0f);
   GridShape g;
-  g.cellSize = support;
+  g.cellSize = cell;
   g.origin = Vec3{scene.tank.min.x - margin, scene.tank.min.y - margin, scene.tank.min.z - margin};
   // In double, and saturated: a huge tank must come out as a huge grid (refused by ValidateScene), not
   // as a float-to-int overflow (undefined; INT_MIN on x86, which passed the size check).
   auto dim = [&](float lo, float hi) {
-    const double n = std::ceil((static_cast<double>(hi) - lo + 2.0 * margin) / support) + 1.0;
+    const double n = std::ceil((static_cast<double>(hi) - lo + 2.0 * margin) / cell) + 1.0;
     return n < 2147483647.0 ? static_cast<int>(n) : 2147483647;
   };
   g.nx = dim(scene.tank.min.x, scene.tank.max.x);

@@ -28,7 +28,7 @@ const std::array<SolverInfo, 3> kSolvers = {{
      "per displayed frame, so its cost per frame is fixed ([../design/pbf.md](../design/pbf.md))",
      false, false, false, ContactUse::kNone, false, PbfStableDt, kPbfColumns, PbfBytes,
      /*speedCapParam=*/"pbf_max_speed",  // the prediction's and the corrections' velocity are capped
-     PbfWarnAtStart, PbfParamsForSpacing},
+     PbfWarnAtStart, PbfParamsForSpacing, PbfListMargin},
 }};
 
 }  // namespace

@@ -40,6 +40,9 @@ class CpuLauncher {
       Loop(n, chunk, f);
     }
   }
+  /// Whether the host launches the work that the flag `gate` (1: run) gates (nullptr: always): the flag
+  /// is in host memory, so it is read here and the gated work is skipped entirely where it is 0.
+  bool Launches(const int* gate) const { return gate == nullptr || *gate != 0; }
   /// On the calling thread: a few dozen probes are tens of microseconds of work, and a parallel region
   /// for them cost more than that on a loaded machine (sphxr_bench_probes).
   template <class F>

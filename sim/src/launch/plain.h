@@ -19,6 +19,9 @@ class PlainLauncher {
   void ForEach(int n, int /*chunk*/, const F& f) {
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), n, f);
   }
+  /// Whether the host launches the work that the device flag `gate` (1: run) gates (nullptr: always).
+  /// Always here: the gated stages read the flag on the device, so the host never waits for it.
+  bool Launches(const int* /*gate*/) const { return true; }
   /// f(i) for a handful of items (the probes).
   template <class F>
   void Few(int n, const F& f) {

@@ -78,6 +78,12 @@ class StepContext {
     m_s.launch.Density(DensityStage{grid, fluid, Neighbours(), physics}, m_s.fluid, m_s.reuse, physics, computing,
                        computeList);
   }
+  /// The neighbour lists of every particle into `lists`, within `reach`'s kernel support: the density
+  /// stage with that kernel (its sums and pressures are meaningless and must be overwritten), gated by
+  /// the device flag `gate` (PressureSolver::GridGate).
+  void ListsWithin(const NeighbourList& lists, const Physics& reach, const int* gate) {
+    m_s.launch.Density(DensityStage{grid, fluid, lists, reach, gate}, m_s.fluid, m_s.reuse, reach, n, nullptr);
+  }
   /// Pressure, viscosity and gravity accelerations (stages/forces.h), with `ph`'s constants.
   void Forces(const Physics& ph) {
     m_s.launch.Forces(ForceStage{grid, fluid, Neighbours(), ph, BodyPressureTerm()}, computing, computeList);
@@ -140,6 +146,15 @@ class PressureSolver {
   /// Before the step's grid, on the particles in their last order: a solver that searches its
   /// neighbours at predicted positions moves the particles there (PBF); the others do nothing.
   virtual void BeforeGrid(const FluidView& /*fluid*/, const Physics& /*physics*/, float /*dt*/) {}
+  /// After BeforeGrid: the device flag (1: rebuild) that gates the step's grid, sort and the solver's
+  /// own list building, for a solver whose neighbour lists last several steps (PBF's skin); the
+  /// backend's launcher decides how (its Launches: the CPU reads it, the plain launcher gates each
+  /// stage on the device). nullptr: the grid every step. `resorted`: the particles were re-sorted or
+  /// replaced since the last step (the surface, the probes, an upload), so every kept list is stale.
+  virtual const int* GridGate(bool /*resorted*/) { return nullptr; }
+  /// The time the post-step stages advance by after this step: dt, or, for a solver that substeps
+  /// the displayed frame, the frame at its last substep and 0 (they do not run) at the others.
+  virtual float PostStepDt(float dt) { return dt; }
 };
 
 /// `if (Status s = expr; !s) return s;` for a solver's stage list.

@@ -31,8 +31,10 @@ struct DensityStage {
   FluidView fluid;
   NeighbourList list;
   Physics ph;
+  const int* gate = nullptr;  // a device flag (PressureSolver::GridGate): nothing where it is 0; nullptr: always
   SPHXR_HD void operator()(int i) const {
     SPHXR_ASSERT(i >= 0 && i < fluid.count);  // an entry of the compacted list, on CUDA a thread's index
+    if (gate && *gate == 0) return;
     const Vec3 xi = Xyz(fluid.position[i]);
     float sumFluid = 0.0f;
     uint32_t found = 0;

@@ -14,11 +14,16 @@ struct CellCodeStage {
   const Vec4* position;
   uint32_t* keys;
   uint32_t* order;
+  /// A device flag that gates the grid (PressureSolver::GridGate), or nullptr. Where it is 0 the keys
+  /// keep their sorted values: the stable sort then leaves every particle where it is and the ranges
+  /// come out as they were.
+  const int* gate = nullptr;
   SPHXR_HD void operator()(int i) const {
+    order[i] = static_cast<uint32_t>(i);
+    if (gate && *gate == 0) return;
     int cx, cy, cz;
     grid.CellOf(Xyz(position[i]), &cx, &cy, &cz);
     keys[i] = MortonEncode(static_cast<uint32_t>(cx), static_cast<uint32_t>(cy), static_cast<uint32_t>(cz));
-    order[i] = static_cast<uint32_t>(i);
   }
 };
 

@@ -64,10 +64,11 @@ class FluidStore {
     Sort();
     CellRanges(g);
   }
-  /// Each particle's Morton cell code and its index, the sort's keys and values (Huang et al. 2013, §3.1).
-  void CellCodes(const GridView& g) {
+  /// Each particle's Morton cell code and its index, the sort's keys and values (Huang et al. 2013, §3.1);
+  /// where the device flag `gate` is 0, the codes of the last sort (CellCodeStage).
+  void CellCodes(const GridView& g, const int* gate = nullptr) {
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), Count(),
-                       CellCodeStage{g, Raw(m_fields.position), Raw(m_keys), Raw(m_order)});
+                       CellCodeStage{g, Raw(m_fields.position), Raw(m_keys), Raw(m_order), gate});
   }
   /// The stable sort by cell code and the gather of every field of the list.
   void Sort() {

@@ -33,9 +33,10 @@ struct SolverParams {
   float maxDivergenceIterations = 100.0f;  // divergence solve iterations at most
   // pbf (Macklin & Müller 2013): the constraint solve and its corrections (docs/design/pbf.md says why
   // these values: the least work that holds a 20-spacing column at rest at 90 Hz).
-  float pbfFrame = 1.0f / 90.0f; // s: the displayed frame the solver advances by (max_dt is WCSPH's/DFSPH's)
+  float pbfFrame = 1.0f / 90.0f; // s: the frame it substeps (app::Simulation sets it to the displayed frame)
   float pbfIterations = 3.0f;    // Jacobi iterations of the density constraint per step
   float pbfSubsteps = 3.0f;      // steps per pbf_frame
+  float pbfSkin = 0.0f;          // spacings: the neighbour lists' margin beyond the support (0: lists every step)
   float pbfRelaxation = 1.0f;    // constraint-force mixing epsilon, relative to the rest lattice's sum |grad C|^2
   float pbfCorrK = 0.1f;         // artificial pressure s_corr = -k (W(r) / W(dq))^n
   float pbfCorrN = 4.0f;

@@ -58,6 +58,9 @@ struct SolverInfo {
   /// `spacing`, sets in `*out` the ones of this method that follow the spacing and returns what it set,
   /// for a message ("" when nothing). nullptr: none of its parameters depends on the spacing.
   std::string (*paramsForSpacing)(const SolverParams& scene, float spacing, SolverParams* out);
+  /// The margin (m) beyond the kernel's support that its neighbour lists keep so that they last several
+  /// steps, or nullptr (lists every step): the grid's cells are the support plus this (MakeGridShape).
+  float (*listMargin)(const SolverParams& params) = nullptr;
 };
 
 std::span<const SolverInfo> SolverTable();

@@ -8,6 +8,8 @@
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/transform_reduce.h>
 
+#include <utility>
+
 #include "solvers/pbf/pbf_stages.h"
 #include "solvers/step_context.h"
 
@@ -20,20 +22,45 @@ class PbfSolver final : public PressureSolver<Traits> {
 
  public:
   /// Its constants from the scene (pbf_constants.h).
-  void Init(const SceneSetup& scene, const Physics& physics) override { m_c = MakePbfConstants(scene, physics); }
+  void Init(const SceneSetup& scene, const Physics& physics) override {
+    m_c = MakePbfConstants(scene, physics);
+    m_reach = physics;
+    m_reach.kernel = CubicSpline::Make(physics.kernel.H + m_c.margin);
+    m_gate.resize(1);
+    thrust::fill(Traits::Policy(), m_gate.begin(), m_gate.end(), 1);
+    m_referenced = false;
+  }
 
-  /// 1. predict: v* = v + dt g, x* = x + dt v* (before the grid: it is built at x*)     [MM13 alg. 1]
+  /// 1. predict: v* = v + dt g, x* = x + dt v* (before the grid: it is built at x*), and with a skin
+  ///    the check of every particle's displacement since the lists                         [MM13 alg. 1]
   void BeforeGrid(const FluidView& fluid, const Physics& ph, float dt) override {
+    m_step = ph.step;
+    m_frameTime += dt;
+    const bool check = m_c.margin > 0.0f && m_referenced && m_reference.size() == static_cast<size_t>(fluid.count);
     thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), fluid.count,
-                       PbfPredictStage{fluid, ph, m_c, dt});
+                       PbfPredictStage{fluid, ph, m_c, dt, check ? Raw(m_reference) : nullptr, Raw(m_gate)});
+  }
+
+  /// The grid and the skin's lists once per displayed frame (its first substep), and again where the
+  /// prediction's check or a re-sort outside the step asks (pbf_skin 0: every step, ungated).
+  const int* GridGate(bool resorted) override {
+    if (m_c.margin <= 0.0f) return nullptr;
+    const bool frameStart = m_c.substeps <= 1 || (m_step - 1) % m_c.substeps == 0;
+    if (resorted || frameStart || !m_referenced) thrust::fill(Traits::Policy(), m_gate.begin(), m_gate.end(), 1);
+    return Raw(m_gate);
+  }
+
+  /// The post-step stages (the diffuse particles) once per displayed frame, over the frame's time.
+  float PostStepDt(float /*dt*/) override {
+    return m_c.substeps <= 1 || m_step % m_c.substeps == 0 ? std::exchange(m_frameTime, 0.0f) : 0.0f;
   }
 
   Status Step(StepContext<Traits>& ctx) override {
     const Physics& ph = ctx.physics;
     ctx.computing = ctx.n;
     Size(ctx.n);
-    // 2. the neighbour lists at x* (the density stage; its Tait pressure is not used)
-    ctx.Density();
+    // 2. the neighbour lists at x*: from the skin's (built with the grid), or the density stage's
+    Lists(ctx);
     SPHXR_TRY(ctx.Lap(Stage::kDensity));
     // 3. pbf_iterations Jacobi iterations of the density constraint                 [MM13 eq. 9-13]
     const NeighbourList list = ctx.Neighbours();
@@ -89,6 +116,31 @@ class PbfSolver final : public PressureSolver<Traits> {
   /// CPU's, solvers/pbf/pbf_simd.h); the others recompute them and need no pair array.
   static constexpr bool kPairCache = kLauncherPairCache<Traits>;
 
+  /// Every particle's neighbours within the support at x*. With a skin: where the gate is open (the
+  /// grid was just rebuilt), the lists within the support plus the margin and the positions they were
+  /// built at, the gate then closed; every step, the pairs within the support picked from those lists.
+  /// Without: the density stage's lists (its Tait pressure is not used).
+  void Lists(StepContext<Traits>& ctx) {
+    if (m_c.margin <= 0.0f) {
+      ctx.Density();
+      return;
+    }
+    const size_t n = static_cast<size_t>(ctx.n);
+    const size_t slots = n * static_cast<size_t>(m_c.skinCapacity);
+    if (m_skinIndex.size() != slots) m_skinIndex.resize(slots);
+    if (m_skinCount.size() != n) m_skinCount.resize(n);
+    if (m_reference.size() != n) m_reference.resize(n);
+    const NeighbourList skin{Raw(m_skinIndex), Raw(m_skinCount), m_c.skinCapacity};
+    const int* gate = Raw(m_gate);
+    if (ctx.Launch().Launches(gate)) {
+      ctx.ListsWithin(skin, m_reach, gate);
+      ctx.Map(PbfReferenceStage{ctx.fluid, Raw(m_reference), gate});
+      thrust::fill(Traits::Policy(), m_gate.begin(), m_gate.end(), 0);
+      m_referenced = true;
+    }
+    ctx.Launch().ForEach(ctx.n, 64, PbfNearListStage{ctx.fluid, skin, ctx.Neighbours(), ctx.physics.kernel.H2});
+  }
+
   void Size(int n) {
     const size_t count = static_cast<size_t>(n);
     if (m_lambda.size() == count) return;
@@ -110,6 +162,13 @@ class PbfSolver final : public PressureSolver<Traits> {
   }
 
   PbfConstants m_c{};
+  Physics m_reach{};                  // the physics with the kernel's support widened to the lists' reach
+  Vector<uint32_t> m_skinIndex, m_skinCount;  // the skin's lists (m_c.skinCapacity slots a particle)
+  Vector<Vec4> m_reference;           // every particle's position when the lists were built
+  Vector<int> m_gate;                 // 1: rebuild the grid and the lists this step (GridGate)
+  bool m_referenced = false;          // m_reference holds the last lists' positions
+  int64_t m_step = 0;                 // the step's number (Physics::step): its place in the frame
+  float m_frameTime = 0.0f;           // s: the frame's steps so far (PostStepDt)
   Vector<float> m_lambda, m_lambdaSum;
   Vector<Vec4> m_delta, m_boundaryGrad;
   Vector<float> m_pairGrad;        // the CPU's pair cache (PbfView::pairGrad)

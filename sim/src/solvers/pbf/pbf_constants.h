@@ -17,6 +17,10 @@ struct PbfConstants {
   float maxSpeed;
   float contact;       // m: the collision response's distance beyond the clamp box (the particle radius,
                        // half a spacing from a face, less the clamp's inset)
+  int substeps;        // steps a displayed frame
+  float margin;        // m: the neighbour lists' skin beyond the support (0: lists every step)
+  float halfMargin2;   // m^2: (margin / 2)^2, the displacement since the lists that rebuilds them
+  int skinCapacity;    // list slots a particle within the support plus the margin
 };
 
 /// The constants of `scene` (pbf_rules.cpp: built with the rest of the library, so their arithmetic

@@ -29,8 +29,14 @@ PbfConstants MakePbfConstants(const SceneSetup& scene, const Physics& ph) {
   // first layer) from a face: a quarter spacing beyond the clamp box's quarter-spacing inset.
   c.contact = 0.25f * p.spacing;
   c.maxSpeed = p.pbfMaxSpeed;
+  c.substeps = static_cast<int>(p.pbfSubsteps);
+  c.margin = PbfListMargin(p);
+  c.halfMargin2 = 0.25f * c.margin * c.margin;
+  c.skinCapacity = NeighbourCapacity(p.supportFactor + p.pbfSkin);
   return c;
 }
+
+float PbfListMargin(const SolverParams& params) { return params.pbfSkin * params.spacing; }
 
 float PbfStableDt(const StableDtInput& in) { return in.scene.params.pbfFrame / in.scene.params.pbfSubsteps; }
 

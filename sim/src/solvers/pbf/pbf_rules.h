@@ -16,6 +16,8 @@ float PbfStableDt(const StableDtInput& in);
 /// boundary gradients (16); on the CPU the own terms (16) and the pair cache (12 a slot, in batches of
 /// 16 slots: PairCacheStride). The step's start positions live in the acceleration field.
 int64_t PbfBytes(int64_t neighbourSlots);
+/// The neighbour lists' margin beyond the support (m): pbf_skin spacings (solver table's listMargin).
+float PbfListMargin(const SolverParams& params);
 /// The compression a column of water will keep at rest, when it is large (docs/design/pbf.md).
 void PbfWarnAtStart(const SceneSetup& scene, float waterHeight);
 /// pbf_substeps for `spacing` (PbfSubstepsForSpacing).

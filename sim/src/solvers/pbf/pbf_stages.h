@@ -74,12 +74,16 @@ SPHXR_HD SPHXR_INLINE void PbfCapSpeed(const PbfConstants& pbf, Vec4* v) {
 }
 
 /// x* = x + dt (v + dt g) and its collision response, the start position in acceleration.xyz.
-/// Before the grid: the neighbour grid is built once per step, at the predicted positions.
+/// Before the grid: where the grid is rebuilt, it is built at the predicted positions. With a skin
+/// (`reference`: every particle where the lists were built), a particle that is now more than half the
+/// margin from there sets `rebuild` (PressureSolver::GridGate): a race of equal writes, no reduction.
 struct PbfPredictStage {
   FluidView fluid;
   Physics ph;
   PbfConstants pbf;
   float dt;
+  const Vec4* reference = nullptr;
+  int* rebuild = nullptr;
   SPHXR_HD void operator()(int i) const {
     Vec4 x = fluid.position[i];
     Vec4 v = fluid.velocity[i];
@@ -94,6 +98,55 @@ struct PbfPredictStage {
     PbfCollide(ph, pbf, &x);
     fluid.position[i] = x;
     fluid.velocity[i] = v;
+    if (reference) {
+      const Vec3 moved = Xyz(x) - Xyz(reference[i]);
+      if (Dot(moved, moved) > pbf.halfMargin2) *rebuild = 1;
+    }
+  }
+};
+
+/// Where the gate is open (the lists were just built): every particle's position, the reference of
+/// PbfPredictStage's check; then the gate's own reset.
+struct PbfReferenceStage {
+  FluidView fluid;
+  Vec4* reference;
+  const int* gate;
+  SPHXR_HD void operator()(int i) const {
+    if (*gate == 0) return;
+    reference[i] = fluid.position[i];
+  }
+};
+
+/// Particle i's neighbours within the support at x*, from its skin list (the pairs within the support
+/// plus the margin when the lists were built; in that list's order). A skin list that overflowed makes
+/// this one overflow too, so that the passes scan the cells (whose size is the support plus the
+/// margin: a stale cell still holds every particle within the support of any point).
+struct PbfNearListStage {
+  FluidView fluid;
+  NeighbourList skin;
+  NeighbourList list;
+  float h2;
+  SPHXR_HD void operator()(int i) const {
+    const uint32_t capacity = static_cast<uint32_t>(list.maxNeighbours);
+    const uint32_t found = skin.count[i];
+    if (found > static_cast<uint32_t>(skin.maxNeighbours)) {
+      list.count[i] = capacity + 1u;
+      return;
+    }
+    const Vec3 xi = Xyz(fluid.position[i]);
+    const uint32_t* in = skin.index + static_cast<size_t>(i) * static_cast<size_t>(skin.maxNeighbours);
+    uint32_t* out = list.index + static_cast<size_t>(i) * static_cast<size_t>(list.maxNeighbours);
+    uint32_t near = 0;
+    for (uint32_t k = 0; k < found; ++k) {
+      const uint32_t j = in[k];
+      const Vec4 pj = fluid.position[j];
+      const Vec3 d{xi.x - pj.x, xi.y - pj.y, xi.z - pj.z};
+      if (Dot(d, d) < h2) {
+        if (near < capacity) out[near] = j;
+        ++near;
+      }
+    }
+    list.count[i] = near;
   }
 };
 
