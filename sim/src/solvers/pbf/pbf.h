@@ -3,10 +3,7 @@
 // [MM13]): the real-time solver. A fixed number of Jacobi iterations of the density constraint on
 // predicted positions per step, so a step costs the same at any speed and the water can advance by
 // one displayed frame per step (docs/design/pbf.md). The stages: solvers/pbf/pbf_stages.h.
-#include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/transform_reduce.h>
+#include <thrust/functional.h>
 
 #include "solvers/pbf/pbf_stages.h"
 #include "solvers/step_context.h"
@@ -24,8 +21,7 @@ class PbfSolver final : public PressureSolver<Traits> {
 
   /// 1. predict: v* = v + dt g, x* = x + dt v* (before the grid: it is built at x*)     [MM13 alg. 1]
   void BeforeGrid(const FluidView& fluid, const Physics& ph, float dt) override {
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), fluid.count,
-                       PbfPredictStage{fluid, ph, m_c, dt});
+    this->Device().ForEach(fluid.count, PbfPredictStage{fluid, ph, m_c, dt});
   }
 
   Status Step(StepContext<Traits>& ctx) override {
@@ -38,16 +34,15 @@ class PbfSolver final : public PressureSolver<Traits> {
     // 3. pbf_iterations Jacobi iterations of the density constraint                 [MM13 eq. 9-13]
     const NeighbourList list = ctx.Neighbours();
     const PbfView view = View(ph.maxNeighbours);
-    thrust::fill(Traits::Policy(), m_lambdaSum.begin(), m_lambdaSum.end(), 0.0f);
+    ctx.Device().Fill(m_lambdaSum, 0.0f);
     for (int k = 0; k < m_c.iterations; ++k) {
       ctx.Launch().ForEach(ctx.n, 64, PbfLambdaStage{ctx.grid, ctx.fluid, list, ph, m_c, view});
       ctx.Launch().ForEach(ctx.n, 64, PbfCorrectStage{ctx.grid, ctx.fluid, list, ph, m_c, view});
       ctx.Map(PbfApplyStage{ctx.fluid, ph, m_c, view});
     }
     ctx.report.densityIterations = m_c.iterations;
-    const thrust::counting_iterator<int> first(0);
-    const double residual = thrust::transform_reduce(Traits::Policy(), first, first + ctx.n,
-                                                     PbfResidual{ctx.fluid, ph.invRestDensity}, 0.0, thrust::plus<double>());
+    const double residual =
+        ctx.Device().TransformReduce(ctx.n, PbfResidual{ctx.fluid, ph.invRestDensity}, 0.0, thrust::plus<double>());
     ctx.report.densityError = ctx.n > 0 ? static_cast<float>(residual / ctx.n) : 0.0f;
     SPHXR_TRY(ctx.Lap(Stage::kPressure));
     // 4. velocities from the position change, the clamps, the pressure estimate            [MM13 alg. 1]
