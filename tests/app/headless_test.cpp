@@ -323,7 +323,8 @@ TEST(HeadlessTest, RunsASmallSceneWithStatsAndExports) {
   const std::vector<std::string> lines = Lines(test::ReadFile(csv));
   ASSERT_EQ(lines.size(), 21u) << "header + 20 steps expected in " << csv;
   const std::vector<std::string> header = Split(lines[0], ',');
-  EXPECT_EQ(lines[0], "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction");
+  EXPECT_EQ(lines[0], "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction,"
+                      "launches,host_waits,allocations,copies_back,copies_back_unasked,uploads");
   double timeSum = 0.0;
   for (size_t i = 1; i < lines.size(); ++i) {
     const std::vector<std::string> cells = Split(lines[i], ',');
@@ -393,10 +394,11 @@ TEST(HeadlessTest, DfsphStatsCarryTheSolvesIterationsAndErrors) {
   const std::vector<std::string> lines = Lines(test::ReadFile(csv));
   ASSERT_EQ(lines.size(), 11u);
   EXPECT_EQ(lines[0], "step,time,dt,max_speed,mean_density_error,max_density_error,clamped,active_fraction,"
-                      "density_iterations,divergence_iterations,solver_density_error,solver_divergence_error");
+                      "density_iterations,divergence_iterations,solver_density_error,solver_divergence_error,"
+                      "launches,host_waits,allocations,copies_back,copies_back_unasked,uploads");
   for (size_t i = 1; i < lines.size(); ++i) {
     const std::vector<std::string> cells = Split(lines[i], ',');
-    ASSERT_EQ(cells.size(), 12u) << "row " << i << ": " << lines[i];
+    ASSERT_EQ(cells.size(), 18u) << "row " << i << ": " << lines[i];
     EXPECT_EQ(cells[0], std::to_string(i)) << "row " << i << ": " << lines[i];
     EXPECT_GE(std::stoi(cells[8]), 2) << "at least min_iterations density iterations: " << lines[i];
     EXPECT_LE(std::stod(cells[10]), 0.01 * sim::SolverParams{}.densityTolerance)

@@ -37,7 +37,10 @@ std::unique_ptr<app::Simulation> Start(const std::string& scene, SolverMethod me
   std::unique_ptr<app::Simulation> run;
   const Status made = app::Simulation::Create(app::SimSceneFromFile(file), config, &run);
   EXPECT_TRUE(made.ok()) << made.message();
-  if (run) EXPECT_TRUE(run->Start().ok());
+  if (run) {
+    const Status started = run->Start();
+    EXPECT_TRUE(started.ok()) << started.message();
+  }
   return run;
 }
 
@@ -97,19 +100,39 @@ TEST(LaunchCounts, EveryBackendCountsItsStep) {
 }
 
 TEST(LaunchCounts, DfsphSolvesWithoutARoundTripPerIteration) {
-  auto run = Start("stir", SolverMethod::kDfsph);
-  ASSERT_TRUE(run);
-  const Totals& totals = run->Solver().GetTotals();
-  SteadyFrame(*run, 1);
-  const int64_t iterations = totals.densityIterations + totals.divergenceIterations;
-  const Frame f = AdvanceFrame(*run);
-  const int64_t frameIterations = totals.densityIterations + totals.divergenceIterations - iterations;
-  SCOPED_TRACE(Show(f) + Format("; %lld iterations", static_cast<long long>(frameIterations)));
-  std::printf("stir dfsph, one frame: %s; %lld iterations\n", Show(f).c_str(), static_cast<long long>(frameIterations));
-  ASSERT_GT(frameIterations, 4 * f.steps);
-  EXPECT_EQ(f.counts.allocations, 0);
-  // A read of the solve's state every kSolveCheckEvery iterations, not one per iteration.
-  EXPECT_LE(f.counts.syncs, frameIterations / 2);
+  // The small dam break (no paddle, no diffuse particles), no stage timings: a step waits for its
+  // reduction and for its solves' states, read every kSolveCheckEvery iterations, not every one.
+  SceneSetup scene = test::SmallDamBreak(0.02f);
+  scene.method = SolverMethod::kDfsph;
+  scene.params.densityTolerance = 0.001f;  // % (a tight solve: several reads of its state per step)
+  SolverConfig config;
+  config.device = Device::kCpuReference;
+  config.threads = 1;
+  config.stageTimes = false;
+  std::unique_ptr<Solver> solver = test::CreateOrFail(scene, config);
+  ASSERT_TRUE(solver);
+  ASSERT_TRUE(test::StepN(*solver, 30));  // the column falling
+  constexpr int64_t kEvery = 4;  // PlainLauncher::kSolveCheckEvery
+  int64_t iterations = 0, reads = 0, roundTrips = 0;
+  const LaunchCounts before = solver->Counts();
+  for (int k = 0; k < 10; ++k) {
+    ASSERT_TRUE(solver->Step().ok());
+    const SolveReport& r = solver->LastStep().solve;
+    iterations += r.densityIterations + r.divergenceIterations;
+    // one read per kEvery iterations of each solve (the last one past its end), and the step's reduction
+    reads += 1 + (r.densityIterations + kEvery) / kEvery + (r.divergenceIterations + kEvery) / kEvery;
+    roundTrips += 1 + r.densityIterations + 1 + r.divergenceIterations + 1;
+  }
+  const LaunchCounts c = solver->Counts() - before;
+  SCOPED_TRACE(Format("10 steps, %lld iterations: %lld waits", static_cast<long long>(iterations),
+                      static_cast<long long>(c.syncs)));
+  std::printf("small dam break dfsph, 10 steps: %lld iterations, %lld waits (%lld reads expected, a read per "
+              "iteration: %lld)\n", static_cast<long long>(iterations), static_cast<long long>(c.syncs),
+              static_cast<long long>(reads), static_cast<long long>(roundTrips));
+  ASSERT_GT(iterations, 60);
+  EXPECT_EQ(c.allocations, 0);
+  EXPECT_LE(c.syncs, reads);
+  EXPECT_LT(2 * c.syncs, roundTrips);  // a read per iteration would wait at least roundTrips times
 }
 
 }  // namespace

@@ -82,7 +82,11 @@ class CudaStageClock {
   }
   /// Ends `stage` (its time from the last Start, Lap or Restart) and checks for a launch error.
   Status Lap(Stage stage) {
-    if (m_timing) m_laps.push_back(LapEvents{m_begin, Record(), stage});
+    if (m_timing) {
+      const size_t end = Record();
+      m_laps.push_back(LapEvents{m_begin, end, stage});
+      m_begin = end;  // the next stage starts here
+    }
     return CudaCheck(StageName(stage));
   }
   /// The next stage's time starts here (after a hook's host work).

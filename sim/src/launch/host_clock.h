@@ -22,6 +22,7 @@ class HostStageClock {
     if (!m_seconds) return Status::Ok();
     const auto now = std::chrono::steady_clock::now();
     m_seconds[static_cast<int>(stage)] += std::chrono::duration<double>(now - m_begin).count();
+    m_begin = now;  // the next stage starts here
     ++m_laps;
     return Status::Ok();
   }
