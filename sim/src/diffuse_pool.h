@@ -97,13 +97,11 @@ class DiffusePool final : public PostStepStage {
                                               Raw(m_cellFlag)});
       m_dev.ForEach(n, DiffuseNormalStage{grid, view, ph, Raw(m_cellFlag)});
       m_dev.ForEach(n, DiffuseSpawnCountStage{grid, view, ph, dt});
-      m_dev.ExclusiveScan(m_spawn.begin(), m_spawn.end(), m_offset.begin());
-      spawned = m_dev.Read(m_offset, n - 1) + m_dev.Read(m_spawn, n - 1);
+      spawned = m_dev.ExclusiveScanTotal(m_spawn, static_cast<size_t>(n), m_offset);
     }
     uint32_t survivors = 0;
     if (m_count > 0) {
-      m_dev.ExclusiveScan(m_alive.begin(), m_alive.begin() + m_count, m_rank.begin());
-      survivors = m_dev.Read(m_rank, m_count - 1) + m_dev.Read(m_alive, m_count - 1);
+      survivors = m_dev.ExclusiveScanTotal(m_alive, static_cast<size_t>(m_count), m_rank);
     }
     // 4. the survivors in their order, less the oldest that the spawns need room from; then the spawns
     const uint32_t capacity = static_cast<uint32_t>(m_capacity);

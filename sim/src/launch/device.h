@@ -26,6 +26,9 @@
 #include <thrust/transform_reduce.h>
 
 #include <cstddef>
+#include <cstdint>
+
+#include "sphxr/common/hd.h"
 
 #include "launch/counter.h"
 #include "launch/kernels.h"
@@ -34,6 +37,15 @@
 namespace sphxr::sim {
 
 enum class CountModel { kCuda, kCpu };
+
+/// An exclusive scan's total: the last item's offset plus the last item (one work item).
+struct ScanTotalStage {
+  const uint32_t* in;
+  const uint32_t* offsets;
+  size_t last;
+  uint32_t* total;
+  SPHXR_HD void operator()(int) const { *total = offsets[last] + in[last]; }
+};
 
 template <class Traits>
 class DeviceOps {
@@ -152,6 +164,17 @@ class DeviceOps {
     thrust::exclusive_scan(Policy(), first, last, out, init, op);
     Algorithm(kernels::kScan);
   }
+  /// The exclusive scan of the first `n` items of `in` into `out`, and its total, read back to the host
+  /// (one copy and one wait, not two).
+  template <class V>
+  uint32_t ExclusiveScanTotal(const V& in, size_t n, V& out) {
+    if (n == 0) return 0;
+    ExclusiveScan(in.begin(), in.begin() + n, out.begin());
+    Resize(m_total, 1);
+    ForEach(1, ScanTotalStage{thrust::raw_pointer_cast(in.data()), thrust::raw_pointer_cast(out.data()), n - 1,
+                              thrust::raw_pointer_cast(m_total.data())});
+    return Read(m_total, 0);
+  }
   /// One element of a device vector, read back to the host.
   template <class V>
   typename V::value_type Read(const V& v, size_t i) {
@@ -197,6 +220,7 @@ class DeviceOps {
 
   LaunchCounter m_counter;
   KeptTemporaries<Traits> m_temporaries{m_counter};
+  typename Traits::template Vector<uint32_t> m_total;  // ExclusiveScanTotal's
 };
 
 }  // namespace sphxr::sim
