@@ -2,7 +2,10 @@
 # One command for the first run on a machine with an NVIDIA GPU: build for this GPU, run the agreement
 # suites (ctest label gpu: the CUDA backend against the CPU and, step by step, against cpu-reference, its
 # own orchestration on the host), time the CUDA backend (sphxr_bench_perf at 50k and 205k particles,
-# sphxr_bench_surface, sphxr_bench_frame), and print one table. No machine the project is built on has a
+# sphxr_bench_surface, sphxr_bench_frame), count what a step asks of the device (the summary's "device
+# work": launches, host waits, allocations, copies back, per step, for stir with PBF and DFSPH and
+# dam_break_1m with WCSPH, on cuda beside cpu-reference, whose counts are CUDA's by construction), and
+# print one table. No machine the project is built on has a
 # GPU, so this is where the CUDA backend first runs: it measures instead of setting up.
 #
 # Exit status: 0 all agreed; 1 a build failure, or an agreement test failed (a disagreement); 2 no GPU.
@@ -56,7 +59,20 @@ timeout "$limit" "$build/bench/sphxr_bench_perf" --device cuda --csv "$logs/perf
 timeout "$limit" "$build/bench/sphxr_bench_surface" --device cuda --csv "$logs/surface.csv" >"$logs/surface.log" 2>&1 || echo "gpu_check: sphxr_bench_surface failed (see $logs/surface.log)"
 timeout "$limit" "$build/bench/sphxr_bench_frame" --device cuda >"$logs/frame.log" 2>&1 || echo "gpu_check: sphxr_bench_frame failed (see $logs/frame.log; it needs EGL)"
 
-# 3. One table.
+# 3. What a step asks of the device, with its stage timings (CUDA events), on cuda and on cpu-reference.
+counts() {  # NAME DEVICE SCENE ARGS...
+  local name=$1 device=$2 scene=$3
+  shift 3
+  timeout "$limit" "$build/app/sphxr" --headless --no-progress --device "$device" --scene "$scene" "$@" \
+    >"$logs/counts_${name}_${device}.log" 2>&1 || echo "gpu_check: counting $name on $device failed (see $logs/counts_${name}_${device}.log)"
+}
+for device in cuda cpu-reference; do
+  counts stir_pbf "$device" scenes/stir.json --set method=pbf --steps 30
+  counts stir_dfsph "$device" scenes/stir.json --set method=dfsph --steps 30
+  counts dam_break_wcsph "$device" scenes/dam_break_1m.json --steps 10
+done
+
+# 4. One table.
 python3 - "$logs" "$gpu" "$driver" "$agreement" "$skipped" <<'EOF'
 import csv, os, re, sys
 logs, gpu, driver, agreement, skipped = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5])
@@ -83,6 +99,14 @@ print(f"| HPMC extraction (field + pyramid + traversal) | {hpmc} |")
 for l in frame:
     cells = [c.strip() for c in l.strip().strip("|").split("|")]
     print(f"| frame, {cells[0]} | step {cells[2]} ms, surface {cells[3]} ms |")
+for name in ("stir_pbf", "stir_dfsph", "dam_break_wcsph"):
+    for device in ("cuda", "cpu-reference"):
+        path = os.path.join(logs, f"counts_{name}_{device}.log")
+        text = open(path).read() if os.path.exists(path) else ""
+        work = re.search(r"device work +per step: (.*)", text)
+        ms = re.search(r"ms per step +([0-9.]+) total", text)
+        print(f"| per step, {name} on {device} | {ms.group(1) + ' ms; ' if ms else ''}"
+              f"{work.group(1) if work else 'n/a'} |")
 for l in lines:
     print(f"| agreement | {l} |")
 print(f"| agreement tests | {'passed' if agreement == 0 else 'FAILED (a disagreement: see agreement.log)'}"

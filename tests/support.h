@@ -11,6 +11,7 @@
 
 #include <sstream>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -337,5 +338,47 @@ inline pid_t SpawnSphxr(const std::vector<std::string>& args, const std::string&
   return pid;
 }
 #endif
+
+/// Two surface fields sampled on the same lattice lines at one cell size, one lattice within the other
+/// (the CPU backend's covers the particles' bounding box, cpu-reference's and CUDA's the clamp box):
+/// the largest difference where both sample, and the largest value the larger one has elsewhere.
+struct SurfaceFieldDiff {
+  bool nested = false;  // same cell size, one lattice within the other on shared lines
+  float worst = 0.0f, outside = 0.0f;
+};
+inline SurfaceFieldDiff CompareSurfaceFields(const sim::SurfaceGrid& ga, const std::vector<float>& fa,
+                                             const sim::SurfaceGrid& gb, const std::vector<float>& fb) {
+  const bool aBig = ga.Samples() >= gb.Samples();
+  const sim::SurfaceGrid& big = aBig ? ga : gb;
+  const sim::SurfaceGrid& small = aBig ? gb : ga;
+  const std::vector<float>& bigField = aBig ? fa : fb;
+  const std::vector<float>& smallField = aBig ? fb : fa;
+  SurfaceFieldDiff d;
+  if (big.cellSize != small.cellSize || static_cast<int64_t>(bigField.size()) != big.Samples() ||
+      static_cast<int64_t>(smallField.size()) != small.Samples()) {
+    return d;
+  }
+  const float o[3] = {small.origin.x - big.origin.x, small.origin.y - big.origin.y, small.origin.z - big.origin.z};
+  const int n[3] = {small.nx, small.ny, small.nz}, nBig[3] = {big.nx, big.ny, big.nz};
+  int off[3];
+  for (int a = 0; a < 3; ++a) {
+    off[a] = static_cast<int>(std::lround(o[a] / big.cellSize));
+    if (off[a] < 0 || off[a] + n[a] > nBig[a]) return d;
+  }
+  d.nested = true;
+  for (int k = 0; k < big.nz; ++k)
+    for (int j = 0; j < big.ny; ++j)
+      for (int i = 0; i < big.nx; ++i) {
+        const float v = bigField[i + static_cast<size_t>(big.nx) * (j + static_cast<size_t>(big.ny) * k)];
+        const int si = i - off[0], sj = j - off[1], sk = k - off[2];
+        if (si < 0 || sj < 0 || sk < 0 || si >= small.nx || sj >= small.ny || sk >= small.nz) {
+          d.outside = std::max(d.outside, std::fabs(v));
+          continue;
+        }
+        const float w = smallField[si + static_cast<size_t>(small.nx) * (sj + static_cast<size_t>(small.ny) * sk)];
+        d.worst = std::max(d.worst, std::fabs(v - w));
+      }
+  return d;
+}
 
 }  // namespace sphxr::test

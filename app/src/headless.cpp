@@ -38,6 +38,16 @@ struct Target {
   int64_t steps = 0;
 };
 
+/// What the steps asked of the device, per step (on cpu-reference: what the CUDA backend launches).
+void PrintCounts(const RunSummary& summary) {
+  const sim::LaunchCounts& c = summary.counts;
+  const double steps = summary.steps > 0 ? static_cast<double>(summary.steps) : 1.0;
+  std::printf("  device work     per step: %.1f launches, %.2f host waits, %.2f allocations, %.2f copies back (%.2f that no "
+              "output asked for), %.2f uploads\n",
+              c.launches / steps, c.syncs / steps, c.allocations / steps, c.downloads / steps,
+              c.UnaskedDownloads() / steps, c.uploads / steps);
+}
+
 /// The summary's lines of the run itself: the scene, the particles, the device, the steps and the time,
 /// the stages' cost, the density error and the speed.
 void PrintRunLines(const Options& options, const SceneFile& scene, const Simulation& simulation, const RunSummary& s) {
@@ -72,6 +82,7 @@ void PrintRunLines(const Options& options, const SceneFile& scene, const Simulat
     std::printf(" %s %.3f", sim::StageName(static_cast<sim::Stage>(s)), summary->stageMsPerStep[s]);
   }
   std::printf("\n");
+  PrintCounts(*summary);
   std::printf("  density error   mean compression %.3f %% (peak over run %.3f %%); largest |rho/rho0 - 1| %.3f %% at the "
               "end (spray and surface particles are light)\n",
               100.0 * summary->meanDensityError, 100.0 * summary->peakMeanDensityError, 100.0 * summary->maxDensityError);
@@ -258,6 +269,7 @@ Status SettleFirst(double settle, bool showProgress, bool progressLines, sim::So
 void Summarise(const SceneFile& scene, const sim::Solver& solver, const SummarySink& measures, const ExportSink& exports,
                RunSummary* summary) {
   const sim::Totals& totals = solver.GetTotals();
+  summary->counts = solver.Counts() - summary->countsAtStart;
   summary->steps = totals.steps;
   summary->simulatedTime = solver.Time();
   summary->msPerStep = totals.steps > 0 ? 1e3 * totals.stepSeconds / totals.steps : 0.0;
@@ -389,6 +401,7 @@ struct RunSinks {
 Status StepToTarget(Simulation& simulation, const Target& target, RunSinks& sinks, RunSummary* summary) {
   sim::Solver& solver = simulation.Solver();
   if (Status s = simulation.Start(); !s) return s;
+  summary->countsAtStart = solver.Counts();
   if (target.steps > 0) {
     while (solver.GetTotals().steps < target.steps && !g_interrupt) {
       if (Status s = simulation.Step(); !s) return s;

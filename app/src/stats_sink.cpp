@@ -61,6 +61,10 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
     header += ",pushed_out";
     for (int k = 0; k < paddles->Count(); ++k) header += Format(",paddle%d_fx,paddle%d_fy,paddle%d_fz,paddle%d_haptic", k, k, k, k);
   }
+  // What the device was asked since the row before (sphxr/sim/launch_counts.h): last, so that the
+  // columns before them read as they always have.
+  header += ",launches,host_waits,allocations,copies_back,copies_back_unasked,uploads";
+  m_counts = simulation.Solver().Counts();
   // A continued run appends to the first half's CSV: the whole run's rows in one file. The first half's
   // rows are never rewritten: later rows (of an earlier continuation) are cut off, then rows appended.
   // A pipe or device is written as it was opened (never read back, never reopened).
@@ -106,6 +110,9 @@ Status StatsSink::WriteHeader(Simulation& simulation, const std::optional<DamBre
 
 Status StatsSink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
   const int64_t wholeStep = simulation.WholeStep();
+  const sim::LaunchCounts counts = simulation.Solver().Counts();
+  const sim::LaunchCounts step = counts - m_counts;
+  m_counts = counts;
   std::ostringstream row;
   row << wholeStep << ',' << info.time << ',' << info.dt << ',' << info.maxSpeed << ',' << info.meanDensityError << ','
       << info.maxDensityError << ',' << info.clamped << ',' << info.activeFraction;
@@ -122,6 +129,8 @@ Status StatsSink::OnStep(Simulation& simulation, const sim::StepInfo& info) {
       row << ',' << p.force.x << ',' << p.force.y << ',' << p.force.z << ',' << p.haptic;
     }
   }
+  row << ',' << step.launches << ',' << step.syncs << ',' << step.allocations << ',' << step.downloads << ','
+      << step.UnaskedDownloads() << ',' << step.uploads;
   row << '\n';
   m_pending += row.str();
   const bool due = m_pending.size() > (size_t{1} << 20) || std::chrono::steady_clock::now() - m_last >= std::chrono::seconds(1);

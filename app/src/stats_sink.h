@@ -11,6 +11,7 @@
 
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/simulation.h"
+#include "sphxr/sim/launch_counts.h"
 #include "sphxr/sim/solver_table.h"
 
 namespace sphxr::app {
@@ -43,6 +44,7 @@ class StatsSink : public SimulationSink {
   std::string m_pending;
   std::chrono::steady_clock::time_point m_last = std::chrono::steady_clock::now();
   sim::HostFluid m_host;
+  sim::LaunchCounts m_counts;  // the solver's counts at the last row (launches, waits, ... since it)
 };
 
 }  // namespace sphxr::app

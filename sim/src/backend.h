@@ -37,7 +37,7 @@ class Backend {
   /// The pressure solver's constants again, for a scene changed at run time (Solver::SetReuse).
   virtual void InitSolver(const SceneSetup& scene, const Physics& physics) = 0;
   /// One step of size dt: the reduction over the fluid into `out`, the solver's report into `report`.
-  /// Adds each stage's wall time to stageSeconds.
+  /// Adds each stage's time to stageSeconds (nullptr: the run asked for no timings, none is taken).
   virtual Status Step(float dt, const Physics& physics, StepReduction* out, SolveReport* report,
                       double* stageSeconds, const StageHook& hook) = 0;
   /// Runs only stages 1-3 (cells, sort, grid) and copies the cell ranges out (tests).

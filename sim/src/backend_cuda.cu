@@ -4,6 +4,7 @@
 #include <thrust/system/cuda/vector.h>
 
 #include "backend_impl.h"
+#include "launch/cuda.h"
 #include "launch/plain.h"
 
 namespace sphxr::sim {
@@ -13,6 +14,20 @@ struct CudaTraits {
   template <class T>
   using Vector = thrust::cuda::vector<T>;
   static auto Policy() { return thrust::cuda::par; }
+  /// The launch layer's policy (launch/device.h): no wait at an algorithm's end, on the backend's one
+  /// stream, the temporaries kept between steps (launch/temporaries.h).
+  template <class Temporaries>
+  static auto Policy(Temporaries& temporaries) {
+    return thrust::cuda::par_nosync(temporaries).on(CudaStream());
+  }
+  static void* AllocateBytes(size_t bytes) { return CudaAllocate(bytes); }
+  static void FreeBytes(void* block) { cudaFree(block); }
+  template <class Temporaries, class It, class T>
+  static void SumInto(Temporaries& temporaries, It first, int n, T* out) {
+    CudaSumInto(temporaries, first, n, out);
+  }
+  template <class T>
+  using StageClock = CudaStageClock;  // stage timings from events on the stream (launch/cuda.h)
   /// Waits for the stage's kernels and reports the first error since the last check, naming the stage (a
   /// kernel's fault surfaces here, at the stage boundary; a Debug build also synchronises and checks
   /// after every launch: THRUST_DEBUG_SYNC, sim/CMakeLists.txt). An error here is sticky: the context
@@ -25,6 +40,7 @@ struct CudaTraits {
                                 cudaGetErrorString(e), stage, cudaGetErrorName(e)));
   }
   static constexpr const char* kName = "cuda";
+  static constexpr CountModel kCountsAs = CountModel::kCuda;
   static constexpr bool kOnDevice = true;  // where the surface mesh lives
   static constexpr bool kSurfaceOverParticles = false;  // no read-back: the lattice over the clamp box
   static constexpr int kTraversalRun = 1;  // one descent per vertex: a thread each

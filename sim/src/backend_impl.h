@@ -7,11 +7,9 @@
 //
 // The solver is one folder in solvers/ (the method's row of the solver table); the stages it calls are
 // StepContext's (solvers/step_context.h). Sorting, fills, gathers and reductions come from thrust
-// (CCCL); nothing of that kind is hand-written. Include this from exactly one translation unit per system.
-#include <thrust/copy.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/transform_reduce.h>
-
+// (CCCL); nothing of that kind is hand-written. Every device operation goes through the counted launch
+// layer (launch/device.h), so Counts() says what a step asked of the device. Include this from exactly
+// one translation unit per system.
 #include <chrono>
 #include <memory>
 #include <utility>
@@ -19,14 +17,15 @@
 #include "backend.h"
 #include "backend_guard.h"
 #include "diffuse_pool.h"
-#include "launch/counter.h"
+#include "launch/device.h"
 #include "post_step.h"
 #include "solvers/factory.h"
 #include "surface_impl.h"
 
 namespace sphxr::sim {
 
-/// Traits: `template <class T> using Vector`, `static auto Policy()`, `static Status Sync(const char* stage)`
+/// Traits: `template <class T> using Vector`, `static auto Policy()`, `static CountModel kCountsAs` (how
+/// the launch layer counts, launch/device.h), `static Status Sync(const char* stage)`
 /// (waits for the work launched so far; CUDA: its error, naming the stage), `using Launcher` (how the
 /// shared stages run: launch/plain.h or cpu/launcher.h), `static const char* kName`, `static bool
 /// kOnDevice` (where the surface mesh lives), `static bool kSurfaceOverParticles` (the surface lattice
@@ -38,6 +37,13 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  BackendImpl() {
+    // The surface counts its own work through the same counter when it takes the launch layer.
+    if constexpr (requires(SurfaceImpl<Traits>& s, DeviceOps<Traits>& d) { s.UseDevice(d); }) {
+      m_surface.UseDevice(m_device);
+    }
+  }
+
   const char* Name() const override { return Traits::kName; }
 
   Status Init(const GridShape& grid, const SceneSetup& scene, const Physics& physics, const HostFluid& fluid,
@@ -45,6 +51,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     return GuardBackend(Traits::kName, "setting up the particles", [&] {
       m_shape = grid;
       m_solver = MakePressureSolver<Traits>(scene.method);
+      m_solver->Bind(m_device);
       m_solver->Init(scene, physics);
       m_fluid.SizeCells(static_cast<size_t>(grid.Cells()));
       m_fluid.Upload(fluid);
@@ -71,8 +78,10 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     m_resorted = true;
     fluidStart->resize(m_fluid.Cells());
     fluidEnd->resize(m_fluid.Cells());
-    thrust::copy(m_fluid.StartVector().begin(), m_fluid.StartVector().end(), fluidStart->begin());
-    thrust::copy(m_fluid.EndVector().begin(), m_fluid.EndVector().end(), fluidEnd->begin());
+    const auto& start = m_fluid.StartVector();
+    const auto& end = m_fluid.EndVector();
+    m_device.Download(start.begin(), start.end(), fluidStart->begin(), /*asked=*/true);
+    m_device.Download(end.begin(), end.end(), fluidEnd->begin(), /*asked=*/true);
   }
 
   void Download(HostFluid* out) const override { m_fluid.Download(out); }
@@ -83,13 +92,10 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   }
 
   FireSums FireReduce() override {
-    const thrust::counting_iterator<int> first(0);
-    return thrust::transform_reduce(Traits::Policy(), first, first + FluidCount(), FireSumsOp{m_fluid.View()},
-                                    FireSums{}, FireSumsCombine{});
+    return m_device.TransformReduce(FluidCount(), FireSumsOp{m_fluid.View()}, FireSums{}, FireSumsCombine{});
   }
   void FireMix(float keep, float mix) override {
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), FluidCount(),
-                       FireMixStage{m_fluid.View(), keep, mix});
+    m_device.ForEach(FluidCount(), FireMixStage{m_fluid.View(), keep, mix});
   }
 
   void SetProbes(const std::vector<Vec4>& p, const std::vector<ProbeLine>& l) override { m_probes.Set(p, l); }
@@ -107,7 +113,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     if constexpr (requires { m_launch.UsePairBlocks(); }) m_launch.UsePairBlocks();
   }
   SurfaceExtractor* Surface() override { return &m_surface; }
-  LaunchCounts Counts() const override { return m_counter.Counts(); }
+  LaunchCounts Counts() const override { return m_device.Counts(); }
   int DiffuseCount() const override { return m_diffuse.Count(); }
   void DownloadDiffuse(HostDiffuse* out) const override { m_diffuse.Download(out); }
   int UploadDiffuse(const HostDiffuse& in) override { return m_diffuse.Upload(in); }
@@ -130,14 +136,15 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
  private:
   Status StepStages(float dt, const Physics& physics, StepReduction* out, SolveReport* report, double* stageSeconds,
                     const StageHook& hook) {
-    auto clock = std::chrono::steady_clock::now();
+    // Each stage ends with a lap: a launch error is named there; its time is taken only when the run
+    // asks for timings (stageSeconds), and the validate hook's host work is left out of it.
+    m_clock.Start(stageSeconds);
     auto lap = [&](Stage stage) -> Status {
-      if (Status s = Traits::Sync(StageName(stage)); !s) return s;
+      SPHXR_TRY(m_clock.Lap(stage));
       m_lastStage = StageName(stage);
-      const auto now = std::chrono::steady_clock::now();
-      stageSeconds[static_cast<int>(stage)] += std::chrono::duration<double>(now - clock).count();
-      Status s = hook ? hook(stage) : Status::Ok();
-      clock = std::chrono::steady_clock::now();
+      if (!hook) return Status::Ok();
+      Status s = hook(stage);
+      m_clock.Restart();
       return s;
     };
     m_solver->BeforeGrid(m_fluid.View(), physics, dt);
@@ -163,15 +170,16 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
                             lap);
     SPHXR_TRY(m_solver->Step(ctx));
     // 4. the statistics the next time step needs, and the solver's own
-    const thrust::counting_iterator<int> first(0);
-    *out = thrust::transform_reduce(Traits::Policy(), first, first + ctx.n, StepReductionOp{ctx.fluid, physics},
-                                    StepReduction{}, StepReductionCombine{});
+    *out = m_device.TransformReduce(ctx.n, StepReductionOp{ctx.fluid, physics}, StepReduction{},
+                                    StepReductionCombine{});
     out->computed = ctx.computing;
     *report = ctx.report;
     SPHXR_TRY(lap(Stage::kIntegrate));
     // 5. the post-step stages, on the state the step ends in (they read the fluid, never write it)
     const float postDt = m_solver->PostStepDt(dt);
-    return postDt > 0.0f ? PostSteps(postDt, physics, lap) : Status::Ok();
+    if (postDt > 0.0f) SPHXR_TRY(PostSteps(postDt, physics, lap));
+    if (m_clock.Finish()) m_device.Sync();  // the stage timings' events
+    return Status::Ok();
   }
 
   /// The post-step stages (post_step.h) in their order; a new one is a member and one entry here.
@@ -200,16 +208,18 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
   }
 
   GridShape m_shape{};
-  FluidStore<Traits> m_fluid;
-  WallStore<Traits> m_walls;
-  BodyStore<Traits> m_bodies;
-  ReuseLists<Traits> m_reuse;      // reuse: the crowding, the compacted list of the particles that compute
-  ProbeArrays<Traits> m_probes;    // the probes and their last readings (empty: no probes)
-  Vector<float> m_densityRate;     // per fluid particle, solver.density delta_sph (DensityRateStage)
-  DiffusePool<Traits> m_diffuse;   // spray, foam and bubbles: a post-step stage (capacity 0: off)
-  typename Traits::Launcher m_launch;
+  // Every device operation below, counted (launch/device.h); mutable: the const downloads count too.
+  mutable DeviceOps<Traits> m_device;
+  FluidStore<Traits> m_fluid{m_device};
+  WallStore<Traits> m_walls{m_device};
+  BodyStore<Traits> m_bodies{m_device};
+  ReuseLists<Traits> m_reuse{m_device};      // reuse: the crowding, the compacted list of the particles that compute
+  ProbeArrays<Traits> m_probes{m_device};    // the probes and their last readings (empty: no probes)
+  Vector<float> m_densityRate;               // per fluid particle, solver.density delta_sph (DensityRateStage)
+  DiffusePool<Traits> m_diffuse{m_device};   // spray, foam and bubbles: a post-step stage (capacity 0: off)
+  typename Traits::Launcher m_launch{m_device};
   std::unique_ptr<PressureSolver<Traits>> m_solver;
-  LaunchCounter m_counter;        // launches, waits, allocations and copies back (launch/counter.h)
+  typename Traits::template StageClock<Traits> m_clock;  // the stage timings (launch/host_clock.h, launch/cuda.h)
   const char* m_lastStage = nullptr;  // the step's last finished stage, for an error's message
   bool m_resorted = true;  // the particles were re-sorted or replaced outside a step (GridGate's argument)
   // The surface reads the particles through a fresh grid: the integrate stage moved them after the
@@ -218,7 +228,7 @@ class BackendImpl : public Backend {  // (the CPU backend adds its team, backend
     m_fluid.Regrid(View());
     m_resorted = true;
     return SurfaceParticles{m_fluid.View().position, FluidCount(), View()};
-  }, &m_counter};
+  }, &m_device.Counter()};
 };
 
 }  // namespace sphxr::sim

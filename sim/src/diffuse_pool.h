@@ -14,17 +14,9 @@
 // fluid's velocities. The pool is kept oldest first in one of two buffers (the compaction writes the other). Every item
 // writes only its own slots and the sums are of integers, so the result is the same at every thread count
 // and on every backend; the random numbers are a hash of (fluid particle id, step, draw).
-#include <thrust/copy.h>
-#include <thrust/count.h>
-#include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/gather.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/scan.h>
-#include <thrust/sort.h>
-
 #include <algorithm>
 
+#include "launch/device.h"
 #include "post_step.h"
 #include "sphxr/sim/diffuse.h"
 #include "stages/diffuse.h"
@@ -39,6 +31,8 @@ class DiffusePool final : public PostStepStage {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  explicit DiffusePool(DeviceOps<Traits>& device) : m_dev(device) {}
+
   /// Sizes the pool for the scene's capacity and the grid's cells (once; nothing when diffuse is off).
   void Init(const DiffuseConstants& c, size_t cells) {
     m_capacity = c.enabled ? c.capacity : 0;
@@ -46,14 +40,14 @@ class DiffusePool final : public PostStepStage {
     if (m_capacity == 0) return;
     const size_t capacity = static_cast<size_t>(m_capacity);
     for (int b = 0; b < 2; ++b) {
-      m_position[b].resize(capacity);
-      m_velocity[b].resize(capacity);
+      m_dev.Resize(m_position[b], capacity);
+      m_dev.Resize(m_velocity[b], capacity);
     }
-    m_alive.resize(capacity);
-    m_rank.resize(capacity);
-    m_start.resize(cells);
-    m_end.resize(cells);
-    m_cellFlag.resize(cells);
+    m_dev.Resize(m_alive, capacity);
+    m_dev.Resize(m_rank, capacity);
+    m_dev.Resize(m_start, cells);
+    m_dev.Resize(m_end, cells);
+    m_dev.Resize(m_cellFlag, cells);
   }
 
   bool Active(const Physics& physics) const override { return physics.diffuse.enabled && m_capacity > 0; }
@@ -67,25 +61,22 @@ class DiffusePool final : public PostStepStage {
   void Advance(float dt, const Physics& ph, GridView grid, const FluidView& fluid) {
     const int n = fluid.count;
     Size(n);
-    const auto policy = Traits::Policy();
-    const thrust::counting_iterator<int> first(0);
     // Nothing to move and no fluid particle with the kinetic energy to spawn: nothing to do (still water
     // costs one pass over the velocities).
     const DiffuseEnergetic energetic{2.0f * ph.diffuse.energyMin};
-    const int energeticCount =
-        n > 0 ? static_cast<int>(thrust::count_if(policy, fluid.velocity, fluid.velocity + n, energetic)) : 0;
+    const int energeticCount = n > 0 ? m_dev.CountIf(fluid.velocity, fluid.velocity + n, energetic) : 0;
     if (m_count == 0 && energeticCount == 0) return;
     // 1. the grid of the fluid as it is now, over copies
     if (n > 0) {
-      thrust::for_each_n(policy, first, n, CellCodeStage{grid, fluid.position, Raw(m_keys), Raw(m_order)});
-      thrust::stable_sort_by_key(policy, m_keys.begin(), m_keys.end(), m_order.begin());
-      thrust::gather(policy, m_order.begin(), m_order.end(), fluid.position, m_fluidPosition.begin());
-      thrust::gather(policy, m_order.begin(), m_order.end(), fluid.velocity, m_fluidVelocity.begin());
-      thrust::gather(policy, m_order.begin(), m_order.end(), fluid.id, m_fluidId.begin());
+      m_dev.ForEach(n, CellCodeStage{grid, fluid.position, Raw(m_keys), Raw(m_order)});
+      m_dev.SortPairs(m_keys, m_order);
+      m_dev.Gather(m_order.begin(), m_order.end(), fluid.position, m_fluidPosition.begin());
+      m_dev.Gather(m_order.begin(), m_order.end(), fluid.velocity, m_fluidVelocity.begin());
+      m_dev.Gather(m_order.begin(), m_order.end(), fluid.id, m_fluidId.begin());
     }
-    thrust::fill(policy, m_start.begin(), m_start.end(), kEmptyCell);
+    m_dev.Fill(m_start, kEmptyCell);
     if (n > 0) {
-      thrust::for_each_n(policy, first, n,
+      m_dev.ForEach(n,
                          CellRangeStage{grid, Raw(m_fluidPosition), Raw(m_keys), Raw(m_start), Raw(m_end), n});
     }
     grid.fluidStart = Raw(m_start);
@@ -95,24 +86,22 @@ class DiffusePool final : public PostStepStage {
     // 2. the pool's particles
     const int now = m_current;
     if (m_count > 0) {
-      thrust::for_each_n(policy, first, m_count,
+      m_dev.ForEach(m_count,
                          DiffuseAdvectStage{grid, Raw(m_fluidPosition), Raw(m_fluidVelocity), Pool(now), ph, dt});
     }
     // 3. what the fluid spawns
     uint32_t spawned = 0;
     if (energeticCount > 0) {
-      thrust::for_each_n(policy, first, static_cast<int>(m_start.size()),
+      m_dev.ForEach(static_cast<int>(m_start.size()),
                          DiffuseCellFlagStage{Raw(m_start), Raw(m_end), Raw(m_fluidVelocity), energetic,
                                               Raw(m_cellFlag)});
-      thrust::for_each_n(policy, first, n, DiffuseNormalStage{grid, view, ph, Raw(m_cellFlag)});
-      thrust::for_each_n(policy, first, n, DiffuseSpawnCountStage{grid, view, ph, dt});
-      thrust::exclusive_scan(policy, m_spawn.begin(), m_spawn.end(), m_offset.begin());
-      spawned = static_cast<uint32_t>(m_offset[n - 1]) + static_cast<uint32_t>(m_spawn[n - 1]);
+      m_dev.ForEach(n, DiffuseNormalStage{grid, view, ph, Raw(m_cellFlag)});
+      m_dev.ForEach(n, DiffuseSpawnCountStage{grid, view, ph, dt});
+      spawned = m_dev.ExclusiveScanTotal(m_spawn, static_cast<size_t>(n), m_offset);
     }
     uint32_t survivors = 0;
     if (m_count > 0) {
-      thrust::exclusive_scan(policy, m_alive.begin(), m_alive.begin() + m_count, m_rank.begin());
-      survivors = static_cast<uint32_t>(m_rank[m_count - 1]) + static_cast<uint32_t>(m_alive[m_count - 1]);
+      survivors = m_dev.ExclusiveScanTotal(m_alive, static_cast<size_t>(m_count), m_rank);
     }
     // 4. the survivors in their order, less the oldest that the spawns need room from; then the spawns
     const uint32_t capacity = static_cast<uint32_t>(m_capacity);
@@ -121,10 +110,10 @@ class DiffusePool final : public PostStepStage {
     const uint32_t kept = survivors - drop;
     const int next = 1 - now;
     if (kept > 0) {
-      thrust::for_each_n(policy, first, m_count,
+      m_dev.ForEach(m_count,
                          DiffuseKeepStage{Pool(now), Raw(m_rank), Raw(m_position[next]), Raw(m_velocity[next]), drop});
     }
-    if (born > 0) thrust::for_each_n(policy, first, n, DiffuseEmitStage{grid, view, Pool(next), ph, dt, kept, born});
+    if (born > 0) m_dev.ForEach(n, DiffuseEmitStage{grid, view, Pool(next), ph, dt, kept, born});
     m_current = next;
     m_count = static_cast<int>(kept + born);
   }
@@ -133,8 +122,10 @@ class DiffusePool final : public PostStepStage {
   void Download(HostDiffuse* out) const {
     out->resize(m_count);
     if (m_count == 0) return;
-    thrust::copy(m_position[m_current].begin(), m_position[m_current].begin() + m_count, out->position.begin());
-    thrust::copy(m_velocity[m_current].begin(), m_velocity[m_current].begin() + m_count, out->velocity.begin());
+    const auto& position = m_position[m_current];
+    const auto& velocity = m_velocity[m_current];
+    m_dev.Download(position.begin(), position.begin() + m_count, out->position.begin(), /*asked=*/true);
+    m_dev.Download(velocity.begin(), velocity.begin() + m_count, out->velocity.begin(), /*asked=*/true);
   }
   /// Replaces the pool (a restart): the newest `capacity` of `in` when it holds more. Returns how many
   /// of `in` were left out.
@@ -144,8 +135,8 @@ class DiffusePool final : public PostStepStage {
     m_current = 0;
     m_count = take;
     if (take > 0) {
-      thrust::copy(in.position.begin() + skip, in.position.end(), m_position[0].begin());
-      thrust::copy(in.velocity.begin() + skip, in.velocity.end(), m_velocity[0].begin());
+      m_dev.Upload(in.position.begin() + skip, in.position.end(), m_position[0].begin());
+      m_dev.Upload(in.velocity.begin() + skip, in.velocity.end(), m_velocity[0].begin());
     }
     return skip;
   }
@@ -158,16 +149,17 @@ class DiffusePool final : public PostStepStage {
   void Size(int n) {
     const size_t count = static_cast<size_t>(n);
     if (m_keys.size() == count) return;
-    m_keys.resize(count);
-    m_order.resize(count);
-    m_fluidPosition.resize(count);
-    m_fluidVelocity.resize(count);
-    m_fluidId.resize(count);
-    m_normal.resize(count);
-    m_spawn.resize(count);
-    m_offset.resize(count);
+    m_dev.Resize(m_keys, count);
+    m_dev.Resize(m_order, count);
+    m_dev.Resize(m_fluidPosition, count);
+    m_dev.Resize(m_fluidVelocity, count);
+    m_dev.Resize(m_fluidId, count);
+    m_dev.Resize(m_normal, count);
+    m_dev.Resize(m_spawn, count);
+    m_dev.Resize(m_offset, count);
   }
 
+  DeviceOps<Traits>& m_dev;
   int m_capacity = 0;
   int m_count = 0;
   int m_current = 0;                          // the buffer that holds the pool

@@ -2,14 +2,11 @@
 // The probes on a backend's system (Traits as in backend_impl.h): the pressure sensors, the level gauges
 // and their last readings, evaluated as one work item per probe over the current grid (ProbeStage,
 // stages/probes.h). Empty: no probes, no probe work.
-#include <thrust/copy.h>
-#include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/iterator/counting_iterator.h>
 #include <thrust/memory.h>
 
 #include <vector>
 
+#include "launch/device.h"
 #include "stages/probes.h"
 #include "stages/views.h"
 
@@ -21,22 +18,24 @@ class ProbeArrays {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  explicit ProbeArrays(DeviceOps<Traits>& device) : m_dev(device) {}
+
   bool Empty() const { return m_out.empty(); }
 
   void Set(const std::vector<Vec4>& points, const std::vector<ProbeLine>& lines) {
     // thrust's copy of an empty std::vector binds a reference to its null data (UBSan): clear instead.
     if (points.empty()) m_points.clear();
-    else m_points.assign(points.begin(), points.end());
+    else m_dev.Assign(m_points, points.begin(), points.end());
     if (lines.empty()) m_lines.clear();
-    else m_lines.assign(lines.begin(), lines.end());
-    m_out.resize(2 * (points.size() + lines.size()));
-    thrust::fill(m_out.begin(), m_out.end(), 0.0f);
+    else m_dev.Assign(m_lines, lines.begin(), lines.end());
+    m_dev.Resize(m_out, 2 * (points.size() + lines.size()));
+    m_dev.Fill(m_out, 0.0f);
   }
 
   /// Two floats per probe, the last evaluation.
   void Values(std::vector<float>* out) const {
     out->resize(m_out.size());
-    if (!out->empty()) thrust::copy(m_out.begin(), m_out.end(), out->begin());
+    m_dev.Download(m_out.begin(), m_out.end(), out->begin(), /*asked=*/true);
   }
 
   /// One work item per probe, run by the backend's launcher (`Few`: the CPU runs them on the calling thread).
@@ -50,6 +49,7 @@ class ProbeArrays {
   }
 
  private:
+  DeviceOps<Traits>& m_dev;
   Vector<Vec4> m_points;     // pressure sensors
   Vector<ProbeLine> m_lines;  // level gauges
   Vector<float> m_out;       // two floats per probe

@@ -75,7 +75,8 @@ Status Solver::Step() {
   const std::vector<BodyState> states = StartBodyMotion(dt);
   StepReduction red;
   SolveReport report;
-  if (Status s = m_backend->Step(dt, physics, &red, &report, m_totals.stageSeconds.data(), hook); !s) return s;
+  double* stageSeconds = m_config.stageTimes ? m_totals.stageSeconds.data() : nullptr;
+  if (Status s = m_backend->Step(dt, physics, &red, &report, stageSeconds, hook); !s) return s;
   EndBodyMotion(states);
   if (red.nonFinite > 0) {
     // Without --validate nothing else would notice: the step's maxima drop NaN, and a NaN particle

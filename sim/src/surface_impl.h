@@ -144,15 +144,18 @@ class SurfaceImpl final : public SurfaceExtractor {
     if (m_written == 0) return;  // (thrust's host copy of nothing dereferences a null begin: UB)
     thrust::copy(m_positions.begin(), m_positions.begin() + 3 * m_written, out->positions.begin());
     thrust::copy(m_normals.begin(), m_normals.begin() + 3 * m_written, out->normals.begin());
-    m_counter.ReadBack();
-    m_counter.ReadBack();
+    for (int copy = 0; copy < 2; ++copy) {  // the mesh, asked for by its reader (a host copy)
+      m_counter.Download(/*asked=*/true);
+      m_counter.Sync();
+    }
   }
 
   void DownloadField(SurfaceGrid* grid, std::vector<float>* field) const override {
     *grid = m_grid;
     field->resize(m_field.size());
     thrust::copy(m_field.begin(), m_field.end(), field->begin());
-    m_counter.ReadBack();
+    m_counter.Download(/*asked=*/true);
+    m_counter.Sync();
   }
 
  private:

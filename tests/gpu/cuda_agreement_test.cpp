@@ -99,30 +99,10 @@ TEST(CudaAgreementTest, SurfaceFieldAndMeshAgree) {
   cuda->BackendForTests()->Surface()->DownloadField(&gridCuda, &fieldCuda);
   // The CPU backend's lattice is the particles' bounding box within CUDA's clamp box, on the same
   // lattice lines: each CPU sample against CUDA's at the same point, every other CUDA sample 0.
-  ASSERT_EQ(gridCpu.cellSize, gridCuda.cellSize);
-  int offset[3];
-  const float o[3] = {gridCpu.origin.x - gridCuda.origin.x, gridCpu.origin.y - gridCuda.origin.y,
-                      gridCpu.origin.z - gridCuda.origin.z};
-  for (int a = 0; a < 3; ++a) offset[a] = static_cast<int>(std::lround(o[a] / gridCuda.cellSize));
-  ASSERT_TRUE(offset[0] >= 0 && offset[1] >= 0 && offset[2] >= 0);
-  ASSERT_LE(offset[0] + gridCpu.nx, gridCuda.nx);
-  ASSERT_LE(offset[1] + gridCpu.ny, gridCuda.ny);
-  ASSERT_LE(offset[2] + gridCpu.nz, gridCuda.nz);
-  float worst = 0.0f, outside = 0.0f;
-  for (int k = 0; k < gridCuda.nz; ++k)
-    for (int j = 0; j < gridCuda.ny; ++j)
-      for (int i = 0; i < gridCuda.nx; ++i) {
-        const float cuda = fieldCuda[i + static_cast<size_t>(gridCuda.nx) * (j + static_cast<size_t>(gridCuda.ny) * k)];
-        const int ci = i - offset[0], cj = j - offset[1], ck = k - offset[2];
-        if (ci < 0 || cj < 0 || ck < 0 || ci >= gridCpu.nx || cj >= gridCpu.ny || ck >= gridCpu.nz) {
-          outside = std::max(outside, std::fabs(cuda));
-          continue;
-        }
-        const float cpuValue = fieldCpu[ci + static_cast<size_t>(gridCpu.nx) * (cj + static_cast<size_t>(gridCpu.ny) * ck)];
-        worst = std::max(worst, std::fabs(cpuValue - cuda));
-      }
-  EXPECT_LT(worst, 1e-5f);
-  EXPECT_EQ(outside, 0.0f);  // beyond the margin of every particle: no kernel reaches
+  const test::SurfaceFieldDiff d = test::CompareSurfaceFields(gridCuda, fieldCuda, gridCpu, fieldCpu);
+  ASSERT_TRUE(d.nested);
+  EXPECT_LT(d.worst, 1e-5f);
+  EXPECT_EQ(d.outside, 0.0f);  // beyond the margin of every particle: no kernel reaches
 }
 
 }  // namespace

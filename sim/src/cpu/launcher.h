@@ -3,10 +3,10 @@
 // density, force and wall-pressure stages (cpu/stages.h) and of the solvers' neighbour passes (each in
 // its solver's folder), and guided OpenMP chunks. The only place where
 // the CPU's stages differ from the ones CUDA runs.
-#include <thrust/copy.h>
 #include <thrust/iterator/counting_iterator.h>
 
 #include "cpu/stages.h"
+#include "launch/device.h"
 #include "solvers/dfsph/dfsph_simd.h"  // DFSPH's factor and its solves' two passes
 #include "solvers/pbf/pbf_simd.h"      // position-based fluids' lambda, correction and XSPH passes
 #include "reuse_lists.h"
@@ -20,6 +20,10 @@ class CpuLauncher {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  explicit CpuLauncher(DeviceOps<Traits>& device) : m_dev(device) {}
+
+  /// The backend's counted operations (launch/device.h); this launcher's own loops count as one launch each.
+  DeviceOps<Traits>& Device() { return m_dev; }
   /// The SIMD forms keep each listed pair's kernel gradient lane-blocked (PairCacheStride) for the passes
   /// after them: PBF's lambda pass for its correction (solvers/pbf/pbf_simd.h), DFSPH's factor for its solves
   /// (solvers/dfsph/dfsph_simd.h).
@@ -47,6 +51,8 @@ class CpuLauncher {
   /// for them cost more than that on a loaded machine (sphxr_bench_probes).
   template <class F>
   void Few(int n, const F& f) {
+    if (n <= 0) return;
+    m_dev.Counter().Launch();
     for (int k = 0; k < n; ++k) f(k);
   }
   /// kLanes wall particles of a cell at once (cpu/walls.h).
@@ -61,11 +67,10 @@ class CpuLauncher {
     const int n = density.fluid.count;
     BlockSet set{Raw(store.Keys()), n};
     if (computing < n && !m_pairBlocks) set = reuse.template CompactedBlocks<BlockSet>(store.Keys(), density.fluid, ph, computing);
-    m_blockStart.resize(set.count);
+    m_dev.Resize(m_blockStart, static_cast<size_t>(set.count));
     const thrust::counting_iterator<int> first(0);
-    auto end = thrust::copy_if(Traits::Policy(), first, first + set.count, m_blockStart.begin(),
-                               DensityBlockStart{density.grid, set, m_pairBlocks});
-    const int blocks = static_cast<int>(end - m_blockStart.begin());
+    const int blocks = m_dev.CopyIf(first, first + set.count, m_blockStart.begin(),
+                                    DensityBlockStart{density.grid, set, m_pairBlocks});
     const bool masked = computing < n && m_pairBlocks;
     ForEach(blocks, 8,
             DensityBlockStage{density, set, Raw(m_blockStart), masked ? Raw(store.Idle()) : nullptr, ph.reuseIdle,
@@ -88,10 +93,13 @@ class CpuLauncher {
  private:
   template <class F>
   void Loop(int n, int chunk, const F& f) {
+    if (n <= 0) return;
+    m_dev.Counter().Launch();
 #pragma omp parallel for schedule(guided, chunk)
     for (int i = 0; i < n; ++i) f(i);
   }
 
+  DeviceOps<Traits>& m_dev;
   Vector<uint32_t> m_blockStart;  // the density blocks: first entry of each (cpu/blocks.h)
   bool m_pairBlocks = false;
 };

@@ -1,7 +1,7 @@
 #pragma once
-// The launch layer's counter (sphxr/sim/launch_counts.h): one per backend, incremented where the
-// backend launches, waits, allocates or copies back. Host-only bookkeeping; the counts are read between
-// steps, never inside a stage.
+// The launch layer's counter (sphxr/sim/launch_counts.h): one per backend, incremented by the counted
+// device operations (launch/device.h) where the backend launches, waits, allocates or copies. Host-only
+// bookkeeping; the counts are read between steps, never inside a stage.
 #include "sphxr/sim/launch_counts.h"
 
 namespace sphxr::sim {
@@ -11,7 +11,12 @@ class LaunchCounter {
   void Launch(int kernels = 1) { m_c.launches += kernels; }
   void Sync() { ++m_c.syncs; }
   void Allocation() { ++m_c.allocations; }
-  void Download() { ++m_c.downloads; }
+  /// A device-to-host copy; `asked`: an output asked for it (a state download, the bodies' loads).
+  void Download(bool asked = false) {
+    ++m_c.downloads;
+    if (asked) ++m_c.asked;
+  }
+  void Upload() { ++m_c.uploads; }
   /// A blocking read of a device value: one copy back, one wait.
   void ReadBack() {
     Download();

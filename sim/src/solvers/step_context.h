@@ -12,6 +12,7 @@
 #include <chrono>
 #include <functional>
 
+#include "launch/device.h"
 #include "probe_arrays.h"
 #include "reuse_lists.h"
 #include "sphxr/sim/solve_report.h"
@@ -57,6 +58,8 @@ class StepContext {
   Status Lap(Stage stage) { return m_lap(stage); }
   NeighbourList Neighbours() { return m_s.fluid.Neighbours(physics.maxNeighbours); }
   typename Traits::Launcher& Launch() { return m_s.launch; }
+  /// The backend's counted device operations (fills, sorts, reductions, copies; launch/device.h).
+  DeviceOps<Traits>& Device() { return m_s.launch.Device(); }
   /// Each fluid particle's p_i / rho_i^2 for the bodies' reaction (nullptr without bodies).
   float* BodyPressureTerm() { return HasBodies() ? m_s.bodies.PressureTerm(n) : nullptr; }
 
@@ -106,7 +109,7 @@ class StepContext {
   void Drift() { Map(DriftStage{fluid, physics, dt}); }
   /// delta_sph: rho += dt d rho/dt at the drifted state (stages/density_diffusion.h).
   void DensityDiffusion() {
-    m_s.densityRate.resize(n);
+    Device().Resize(m_s.densityRate, static_cast<size_t>(n));
     m_s.launch.ForEach(n, 32, DensityRateStage{grid, fluid, Neighbours(), physics, Raw(m_s.densityRate)});
     Map(DensityIntegrateStage{fluid, Raw(m_s.densityRate), dt});
   }
@@ -115,7 +118,7 @@ class StepContext {
   /// f(i) for every fluid particle, equal slices (cheap, uniform items).
   template <class F>
   void Map(const F& f) {
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), n, f);
+    Device().ForEach(n, f);
   }
 
  private:
@@ -131,6 +134,14 @@ template <class Traits>
 inline constexpr bool kLauncherPairCache = [] {
   if constexpr (requires { Traits::Launcher::kPairCache; }) return Traits::Launcher::kPairCache;
   return false;
+}();
+
+/// How many iterations of a solve the host launches between two reads of its state on the device (the
+/// launcher's kSolveCheckEvery): 1 where a read costs nothing (the CPU's), more where it is a wait.
+template <class Traits>
+inline constexpr int kLauncherSolveCheckEvery = [] {
+  if constexpr (requires { Traits::Launcher::kSolveCheckEvery; }) return Traits::Launcher::kSolveCheckEvery;
+  return 1;
 }();
 
 template <class Traits>
@@ -155,6 +166,16 @@ class PressureSolver {
   /// The time the post-step stages advance by after this step: dt, or, for a solver that substeps
   /// the displayed frame, the frame at its last substep and 0 (they do not run) at the others.
   virtual float PostStepDt(float dt) { return dt; }
+
+  /// The backend's counted device operations, for the work a solver launches outside a step's context
+  /// (BeforeGrid). The backend binds them once, when it makes the solver.
+  void Bind(DeviceOps<Traits>& device) { m_device = &device; }
+
+ protected:
+  DeviceOps<Traits>& Device() { return *m_device; }
+
+ private:
+  DeviceOps<Traits>* m_device = nullptr;
 };
 
 /// `if (Status s = expr; !s) return s;` for a solver's stage list.

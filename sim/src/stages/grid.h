@@ -28,6 +28,20 @@ struct CellCodeStage {
 };
 
 // ---- stage 3: cell ranges from sorted particles --------------------------------------------------
+// ---- stage 2: the sort's reorder ------------------------------------------------------------------
+/// Every field of the list gathered into the sorted order at once: to.name[i] = from.name[order[i]], one
+/// work item per particle (one kernel for all fields, not one gather per field).
+struct ReorderFieldsStage {
+  FluidView from, to;
+  const uint32_t* order;
+  SPHXR_HD void operator()(int i) const {
+    const uint32_t j = order[i];
+#define SPHXR_GATHER_FIELD(type, name) to.name[i] = from.name[j];
+    SPHXR_FLUID_FIELDS(SPHXR_GATHER_FIELD)
+#undef SPHXR_GATHER_FIELD
+  }
+};
+
 struct CellRangeStage {
   GridView grid;
   const Vec4* position;  // sorted

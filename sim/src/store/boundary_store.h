@@ -2,15 +2,11 @@
 // The boundary particles on a backend's system (Traits as in backend_impl.h): the walls and obstacles
 // (sampled once, sorted once, their volumes after Akinci et al. 2012) and the moving bodies (paddles:
 // canonical body-frame particles and their sorted world copies each step, stages/bodies.h).
-#include <thrust/copy.h>
-#include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
-#include <thrust/sort.h>
 
 #include <vector>
 
+#include "launch/device.h"
 #include "sphxr/common/status.h"
 #include "sphxr/sim/fields.h"
 #include "stages.h"
@@ -25,6 +21,8 @@ class WallStore {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  explicit WallStore(DeviceOps<Traits>& device) : m_dev(device) {}
+
   /// Sorts the walls' particles by cell code once, builds their cell ranges, volumes and (under
   /// wall_density) the list of the cells that hold them, and the near-boundary flag of every cell.
   /// `g` is the grid whose boundary pointers are this store's (it is re-made between the passes).
@@ -36,46 +34,49 @@ class WallStore {
       return Status::Error("walls with their own density need one reference per boundary particle "
                            "(sampling.h WallInverseReferences)");
     }
-    auto policy = Traits::Policy();
-    const thrust::counting_iterator<int> first(0);
-    m_start.resize(cells);
-    m_end.resize(cells);
-    m_near.resize(cells);
+    m_dev.Resize(m_start, cells);
+    m_dev.Resize(m_end, cells);
+    m_dev.Resize(m_near, cells);
     const int nb = static_cast<int>(boundary.size());
     const bool wallDensity = physics.wallDensity;
-    Vector<Vec4> unsorted(boundary.position.begin(), boundary.position.end());
-    Vector<float> unsortedAlpha(boundary.viscosity.begin(), boundary.viscosity.end());
-    Vector<float> unsortedReference(boundary.invReference.begin(), boundary.invReference.end());
-    m_position.resize(nb);
-    m_alpha.resize(nb);
-    m_invReference.resize(wallDensity ? nb : 0);
-    m_pressureTerm.resize(wallDensity ? nb : 0);
-    Vector<uint32_t> keys(nb), order(nb);
-    thrust::fill(policy, m_start.begin(), m_start.end(), kEmptyCell);
-    thrust::fill(policy, m_end.begin(), m_end.end(), kEmptyCell);
+    Vector<Vec4> unsorted;
+    Vector<float> unsortedAlpha, unsortedReference;
+    m_dev.Assign(unsorted, boundary.position.begin(), boundary.position.end());
+    m_dev.Assign(unsortedAlpha, boundary.viscosity.begin(), boundary.viscosity.end());
+    m_dev.Assign(unsortedReference, boundary.invReference.begin(), boundary.invReference.end());
+    m_dev.Resize(m_position, nb);
+    m_dev.Resize(m_alpha, nb);
+    m_dev.Resize(m_invReference, wallDensity ? nb : 0);
+    m_dev.Resize(m_pressureTerm, wallDensity ? nb : 0);
+    Vector<uint32_t> keys, order;
+    m_dev.Resize(keys, nb);
+    m_dev.Resize(order, nb);
+    m_dev.Fill(m_start, kEmptyCell);
+    m_dev.Fill(m_end, kEmptyCell);
     if (nb > 0) {
-      thrust::for_each_n(policy, first, nb, CellCodeStage{grid(), Raw(unsorted), Raw(keys), Raw(order)});
-      thrust::stable_sort_by_key(policy, keys.begin(), keys.end(), order.begin());
-      Vector<Vec4> sorted(nb);
-      thrust::gather(policy, order.begin(), order.end(), unsorted.begin(), sorted.begin());
-      thrust::gather(policy, order.begin(), order.end(), unsortedAlpha.begin(), m_alpha.begin());
-      if (wallDensity) thrust::gather(policy, order.begin(), order.end(), unsortedReference.begin(), m_invReference.begin());
-      thrust::for_each_n(policy, first, nb, CellRangeStage{grid(), Raw(sorted), Raw(keys), Raw(m_start), Raw(m_end), nb});
-      thrust::for_each_n(policy, first, nb,
+      m_dev.ForEach(nb, CellCodeStage{grid(), Raw(unsorted), Raw(keys), Raw(order)});
+      m_dev.SortPairs(keys, order);
+      Vector<Vec4> sorted;
+      m_dev.Resize(sorted, nb);
+      m_dev.Gather(order.begin(), order.end(), unsorted.begin(), sorted.begin());
+      m_dev.Gather(order.begin(), order.end(), unsortedAlpha.begin(), m_alpha.begin());
+      if (wallDensity) m_dev.Gather(order.begin(), order.end(), unsortedReference.begin(), m_invReference.begin());
+      m_dev.ForEach(nb, CellRangeStage{grid(), Raw(sorted), Raw(keys), Raw(m_start), Raw(m_end), nb});
+      m_dev.ForEach(nb,
                          BoundaryVolumeStage{grid(), Raw(sorted), Raw(m_position), physics.boundaryGamma * physics.restDensity,
                                              physics.kernel});
     }
     // The cells that hold boundary particles: the walls' own pressure runs over them.
     m_wallCells.clear();
     if (wallDensity) {
-      m_wallCells.resize(cells);
+      m_dev.Resize(m_wallCells, cells);
       const thrust::counting_iterator<uint32_t> cell(0);
-      auto end = thrust::copy_if(policy, cell, cell + cells, m_start.begin(), m_wallCells.begin(), NonEmptyCell{});
-      m_wallCells.resize(end - m_wallCells.begin());
+      const int found = m_dev.CopyIf(cell, cell + cells, m_start.begin(), m_wallCells.begin(), NonEmptyCell{});
+      m_dev.Resize(m_wallCells, static_cast<size_t>(found));
       m_wallCells.shrink_to_fit();  // (a vector keeps its capacity: 4 B per grid cell for the whole run)
     }
     // Which cells have boundary particles in their 27-cell neighbourhood (the walls never move).
-    thrust::for_each_n(policy, first, static_cast<int>(cells), BoundaryNearStage{grid(), Raw(m_near)});
+    m_dev.ForEach(static_cast<int>(cells), BoundaryNearStage{grid(), Raw(m_near)});
     return Status::Ok();
   }
 
@@ -92,13 +93,12 @@ class WallStore {
 
   void Download(HostBoundary* out) const {
     out->position.resize(m_position.size());
-    thrust::copy(m_position.begin(), m_position.end(), out->position.begin());
+    m_dev.Download(m_position.begin(), m_position.end(), out->position.begin(), /*asked=*/true);
     out->viscosity.resize(m_alpha.size());
-    thrust::copy(m_alpha.begin(), m_alpha.end(), out->viscosity.begin());
+    m_dev.Download(m_alpha.begin(), m_alpha.end(), out->viscosity.begin(), /*asked=*/true);
     out->invReference.resize(m_invReference.size());  // empty unless the walls have their own density
-    if (!out->invReference.empty()) {  // (a copy of nothing dereferences the empty vector's null begin: UB)
-      thrust::copy(m_invReference.begin(), m_invReference.end(), out->invReference.begin());
-    }
+    // (Download copies nothing for an empty range: a copy of nothing would dereference a null begin)
+    m_dev.Download(m_invReference.begin(), m_invReference.end(), out->invReference.begin(), /*asked=*/true);
   }
 
   int Count() const { return static_cast<int>(m_position.size()); }
@@ -108,6 +108,7 @@ class WallStore {
   float* PressureTerm() { return Raw(m_pressureTerm); }
 
  private:
+  DeviceOps<Traits>& m_dev;
   Vector<Vec4> m_position;
   Vector<float> m_alpha;
   Vector<float> m_pressureTerm;  // per boundary particle, walls with their own density only
@@ -123,6 +124,8 @@ class BodyStore {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  explicit BodyStore(DeviceOps<Traits>& device) : m_dev(device) {}
+
   bool Empty() const { return m_hostStates.empty(); }
   int Count() const { return static_cast<int>(m_hostStates.size()); }
   int ParticleCount() const { return static_cast<int>(m_position.size()); }
@@ -130,26 +133,26 @@ class BodyStore {
   void Init(const std::vector<Vec4>& local, const std::vector<uint32_t>& bodyOf, const std::vector<float>& alpha,
             const std::vector<ShapePrimitive>& shapes, size_t cells) {
     const size_t nb = local.size();
-    m_local.assign(local.begin(), local.end());
-    m_ofLocal.assign(bodyOf.begin(), bodyOf.end());
-    m_alphaLocal.assign(alpha.begin(), alpha.end());
-    m_shapes.assign(shapes.begin(), shapes.end());
-    m_keys.resize(nb);
-    m_order.resize(nb);
-    m_position.resize(nb);
-    m_velocity.resize(nb);
-    m_of.resize(nb);
-    m_force.resize(nb);
-    thrust::fill(m_force.begin(), m_force.end(), Vec4{});
-    m_start.resize(cells);
-    m_end.resize(cells);
-    m_near.resize(cells);
-    thrust::fill(m_near.begin(), m_near.end(), uint8_t{0});
+    m_dev.Assign(m_local, local.begin(), local.end());
+    m_dev.Assign(m_ofLocal, bodyOf.begin(), bodyOf.end());
+    m_dev.Assign(m_alphaLocal, alpha.begin(), alpha.end());
+    m_dev.Assign(m_shapes, shapes.begin(), shapes.end());
+    m_dev.Resize(m_keys, nb);
+    m_dev.Resize(m_order, nb);
+    m_dev.Resize(m_position, nb);
+    m_dev.Resize(m_velocity, nb);
+    m_dev.Resize(m_of, nb);
+    m_dev.Resize(m_force, nb);
+    m_dev.Fill(m_force, Vec4{});
+    m_dev.Resize(m_start, cells);
+    m_dev.Resize(m_end, cells);
+    m_dev.Resize(m_near, cells);
+    m_dev.Fill(m_near, uint8_t{0});
   }
 
   void SetStates(const std::vector<BodyState>& states) {
     m_hostStates = states;
-    m_states.assign(states.begin(), states.end());
+    m_dev.Assign(m_states, states.begin(), states.end());
   }
 
   /// The bodies' part of a grid view.
@@ -165,39 +168,37 @@ class BodyStore {
   /// The body particles at their start-of-step pose: cell codes, stable sort, world positions and rigid
   /// velocities in sorted order, cell ranges, and the near-cell flags over each body's bounding box.
   void Place(const GridView& g) {
-    auto policy = Traits::Policy();
-    const thrust::counting_iterator<int> first(0);
     const int nb = static_cast<int>(m_local.size());
-    thrust::for_each_n(policy, first, nb,
+    m_dev.ForEach(nb,
                        BodyCellStage{g, Raw(m_states), Raw(m_local), Raw(m_ofLocal), Raw(m_keys), Raw(m_order)});
-    thrust::stable_sort_by_key(policy, m_keys.begin(), m_keys.end(), m_order.begin());
-    thrust::for_each_n(policy, first, nb,
+    m_dev.SortPairs(m_keys, m_order);
+    m_dev.ForEach(nb,
                        BodyPlaceStage{Raw(m_states), Raw(m_local), Raw(m_ofLocal), Raw(m_alphaLocal), Raw(m_order),
                                       Raw(m_position), Raw(m_velocity), Raw(m_of)});
-    thrust::fill(policy, m_start.begin(), m_start.end(), kEmptyCell);
-    thrust::for_each_n(policy, first, nb, CellRangeStage{g, Raw(m_position), Raw(m_keys), Raw(m_start), Raw(m_end), nb});
-    thrust::fill(policy, m_near.begin(), m_near.end(), uint8_t{0});
+    m_dev.Fill(m_start, kEmptyCell);
+    m_dev.ForEach(nb, CellRangeStage{g, Raw(m_position), Raw(m_keys), Raw(m_start), Raw(m_end), nb});
+    m_dev.Fill(m_near, uint8_t{0});
     for (const BodyState& s : m_hostStates) {
       const MovingNearStage stage = MovingNearStage::Around(g, s.position, s.boundRadius, Raw(m_near));
-      thrust::for_each_n(policy, first, stage.Items(), stage);
+      m_dev.ForEach(stage.Items(), stage);
     }
   }
 
   /// Each fluid particle's p_i / rho_i^2 for the reaction (written by the force stage or a solver).
   float* PressureTerm(int fluidCount) {
-    if (m_pressureTerm.size() != static_cast<size_t>(fluidCount)) m_pressureTerm.resize(fluidCount);
+    m_dev.Resize(m_pressureTerm, static_cast<size_t>(fluidCount));
     return Raw(m_pressureTerm);
   }
 
   /// The fluid's force on each body particle (BodyReactionStage) from PressureTerm.
   void React(const GridView& g, const FluidView& fluid, const Physics& physics) {
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), ParticleCount(),
+    m_dev.ForEach(ParticleCount(),
                        BodyReactionStage{g, fluid, physics, Raw(m_pressureTerm), Raw(m_force)});
   }
 
   /// Fluid particles out of the bodies' solids at their end-of-step pose.
   void PushOut(const FluidView& fluid, const Physics& physics) {
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), fluid.count,
+    m_dev.ForEach(fluid.count,
                        PushOutStage{fluid, Raw(m_states), Raw(m_shapes), Count(), physics.bodyClearance});
   }
 
@@ -206,9 +207,9 @@ class BodyStore {
     if (m_hostStates.empty()) return;
     std::vector<Vec4> force(m_force.size()), position(m_position.size());
     std::vector<uint32_t> of(m_of.size());
-    thrust::copy(m_force.begin(), m_force.end(), force.begin());
-    thrust::copy(m_position.begin(), m_position.end(), position.begin());
-    thrust::copy(m_of.begin(), m_of.end(), of.begin());
+    m_dev.Download(m_force.begin(), m_force.end(), force.begin(), /*asked=*/true);
+    m_dev.Download(m_position.begin(), m_position.end(), position.begin(), /*asked=*/true);
+    m_dev.Download(m_of.begin(), m_of.end(), of.begin(), /*asked=*/true);
     // Serial sums in the sorted order: the same result on every run and thread count.
     std::vector<double> sums(6 * m_hostStates.size(), 0.0);
     for (size_t b = 0; b < force.size(); ++b) {
@@ -230,11 +231,12 @@ class BodyStore {
     position->resize(m_position.size());
     velocity->resize(m_velocity.size());
     if (m_position.empty()) return;  // (thrust's host copy of nothing dereferences a null begin: UB)
-    thrust::copy(m_position.begin(), m_position.end(), position->begin());
-    thrust::copy(m_velocity.begin(), m_velocity.end(), velocity->begin());
+    m_dev.Download(m_position.begin(), m_position.end(), position->begin(), /*asked=*/true);
+    m_dev.Download(m_velocity.begin(), m_velocity.end(), velocity->begin(), /*asked=*/true);
   }
 
  private:
+  DeviceOps<Traits>& m_dev;
   Vector<Vec4> m_local;         // body frame, w = Psi_b
   Vector<uint32_t> m_ofLocal;   // body index of each canonical particle
   Vector<float> m_alphaLocal;   // alpha of each canonical particle

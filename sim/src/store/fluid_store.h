@@ -3,16 +3,7 @@
 // (sphxr/sim/fields.h), the Z-order sort that keeps them in cell order, the cells' ranges and the
 // neighbour-list scratch. Resize, reorder, upload and download loop over the one field list, so a new
 // field cannot be forgotten by the sort.
-#include <thrust/copy.h>
-#include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/gather.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/memory.h>
-#include <thrust/sort.h>
-
-#include <type_traits>
-
+#include "launch/device.h"
 #include "sphxr/sim/fields.h"
 #include "stages.h"
 #include "store/raw.h"
@@ -25,34 +16,34 @@ class FluidStore {
   using Vector = typename Traits::template Vector<T>;
 
  public:
+  explicit FluidStore(DeviceOps<Traits>& device) : m_dev(device) {}
+
   int Count() const { return static_cast<int>(m_fields.position.size()); }
 
   /// Sizes the cell ranges for a grid of `cells` cells.
   void SizeCells(size_t cells) {
-    m_start.resize(cells);
-    m_end.resize(cells);
+    m_dev.Resize(m_start, cells);
+    m_dev.Resize(m_end, cells);
   }
   size_t Cells() const { return m_start.size(); }
 
   void Upload(const HostFluid& fluid) {
     const size_t n = fluid.size();
-#define SPHXR_UPLOAD_FIELD(type, name) \
-  m_fields.name.resize(n);             \
-  if (n > 0) thrust::copy(fluid.name.begin(), fluid.name.end(), m_fields.name.begin());  /* (as in Download) */
+#define SPHXR_UPLOAD_FIELD(type, name) m_dev.Assign(m_fields.name, fluid.name.begin(), fluid.name.end());
     SPHXR_FLUID_FIELDS(SPHXR_UPLOAD_FIELD)
 #undef SPHXR_UPLOAD_FIELD
-    m_keys.resize(n);
-    m_order.resize(n);
-    m_scratchVec4.resize(n);
-    m_scratchFloat.resize(n);
-    m_scratchU32.resize(n);
-    m_scratchI32.resize(n);
+#define SPHXR_SIZE_SORTED(type, name) m_dev.Resize(m_sorted.name, n);
+    SPHXR_FLUID_FIELDS(SPHXR_SIZE_SORTED)
+#undef SPHXR_SIZE_SORTED
+    m_dev.Resize(m_keys, n);
+    m_dev.Resize(m_order, n);
   }
 
   void Download(HostFluid* out) const {
     out->resize(m_fields.position.size());
     if (out->size() == 0) return;  // (thrust's host copy of nothing dereferences a null begin: UB)
-#define SPHXR_DOWNLOAD_FIELD(type, name) thrust::copy(m_fields.name.begin(), m_fields.name.end(), out->name.begin());
+#define SPHXR_DOWNLOAD_FIELD(type, name) \
+  m_dev.Download(m_fields.name.begin(), m_fields.name.end(), out->name.begin(), /*asked=*/true);
     SPHXR_FLUID_FIELDS(SPHXR_DOWNLOAD_FIELD)
 #undef SPHXR_DOWNLOAD_FIELD
   }
@@ -67,36 +58,27 @@ class FluidStore {
   /// Each particle's Morton cell code and its index, the sort's keys and values (Huang et al. 2013, §3.1);
   /// where the device flag `gate` is 0, the codes of the last sort (CellCodeStage).
   void CellCodes(const GridView& g, const int* gate = nullptr) {
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), Count(),
-                       CellCodeStage{g, Raw(m_fields.position), Raw(m_keys), Raw(m_order), gate});
+    m_dev.ForEach(Count(), CellCodeStage{g, Raw(m_fields.position), Raw(m_keys), Raw(m_order), gate});
   }
-  /// The stable sort by cell code and the gather of every field of the list.
+  /// The stable sort by cell code (one key-and-index radix sort) and the gather of every field of the list.
   void Sort() {
-    thrust::stable_sort_by_key(Traits::Policy(), m_keys.begin(), m_keys.end(), m_order.begin());
+    m_dev.SortPairs(m_keys, m_order);
     Reorder();
   }
   /// cellStart/cellEnd of every cell from the sorted codes.
   void CellRanges(const GridView& g) {
     const int n = Count();
-    thrust::fill(Traits::Policy(), m_start.begin(), m_start.end(), kEmptyCell);
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), n,
-                       CellRangeStage{g, Raw(m_fields.position), Raw(m_keys), Raw(m_start), Raw(m_end), n});
+    m_dev.Fill(m_start, kEmptyCell);
+    m_dev.ForEach(n, CellRangeStage{g, Raw(m_fields.position), Raw(m_keys), Raw(m_start), Raw(m_end), n});
   }
 
-  FluidView View() {
-    FluidView v;
-#define SPHXR_VIEW_OF(type, name) v.name = Raw(m_fields.name);
-    SPHXR_FLUID_FIELDS(SPHXR_VIEW_OF)
-#undef SPHXR_VIEW_OF
-    v.count = Count();
-    return v;
-  }
+  FluidView View() { return ViewOf(m_fields, Count()); }
 
   /// The neighbour-list scratch, sized for the particle count and `capacity` slots each.
   NeighbourList Neighbours(int capacity) {
     const size_t n = static_cast<size_t>(Count());
-    if (m_neighbourIndex.size() != n * static_cast<size_t>(capacity)) m_neighbourIndex.resize(n * capacity);
-    if (m_neighbourCount.size() != n) m_neighbourCount.resize(n);
+    m_dev.Resize(m_neighbourIndex, n * static_cast<size_t>(capacity));
+    m_dev.Resize(m_neighbourCount, n);
     return NeighbourList{Raw(m_neighbourIndex), Raw(m_neighbourCount), capacity};
   }
 
@@ -115,36 +97,29 @@ class FluidStore {
 #undef SPHXR_DEVICE_FIELD
   };
 
-  template <class T>
-  Vector<T>& Scratch() {
-    if constexpr (std::is_same_v<T, Vec4>) return m_scratchVec4;
-    else if constexpr (std::is_same_v<T, float>) return m_scratchFloat;
-    else if constexpr (std::is_same_v<T, int32_t>) return m_scratchI32;
-    else {
-      static_assert(std::is_same_v<T, uint32_t>, "add a scratch buffer for this type");
-      return m_scratchU32;
-    }
+  static FluidView ViewOf(Fields& f, int count) {
+    FluidView v;
+#define SPHXR_VIEW_OF(type, name) v.name = Raw(f.name);
+    SPHXR_FLUID_FIELDS(SPHXR_VIEW_OF)
+#undef SPHXR_VIEW_OF
+    v.count = count;
+    return v;
   }
 
-  /// Applies the sort permutation to every field of the list (one gather and one O(1) swap each).
+  /// Applies the sort permutation to every field of the list: one gather of all of them into the
+  /// second set (ReorderFieldsStage), then an O(1) swap of each.
   void Reorder() {
-    auto policy = Traits::Policy();
-#define SPHXR_REORDER_FIELD(type, name)                                                               \
-  {                                                                                                   \
-    auto& scratch = Scratch<type>();                                                                  \
-    thrust::gather(policy, m_order.begin(), m_order.end(), m_fields.name.begin(), scratch.begin()); \
-    m_fields.name.swap(scratch);                                                                      \
-  }
-    SPHXR_FLUID_FIELDS(SPHXR_REORDER_FIELD)
-#undef SPHXR_REORDER_FIELD
+    const int n = Count();
+    m_dev.ForEach(n, ReorderFieldsStage{ViewOf(m_fields, n), ViewOf(m_sorted, n), Raw(m_order)});
+#define SPHXR_SWAP_FIELD(type, name) m_fields.name.swap(m_sorted.name);
+    SPHXR_FLUID_FIELDS(SPHXR_SWAP_FIELD)
+#undef SPHXR_SWAP_FIELD
   }
 
+  DeviceOps<Traits>& m_dev;
   Fields m_fields;
+  Fields m_sorted;  // the reorder's destination, swapped with m_fields after it
   Vector<uint32_t> m_keys, m_order;
-  Vector<Vec4> m_scratchVec4;
-  Vector<float> m_scratchFloat;
-  Vector<uint32_t> m_scratchU32;
-  Vector<int32_t> m_scratchI32;
   Vector<uint32_t> m_start, m_end;  // per cell: the sorted particles' range
   Vector<uint32_t> m_neighbourIndex, m_neighbourCount;
 };

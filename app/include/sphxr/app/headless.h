@@ -20,6 +20,8 @@ struct RunSummary {
   double wallSeconds = 0.0;
   double msPerStep = 0.0;
   double stageMsPerStep[static_cast<int>(sim::Stage::kCount)] = {};
+  sim::LaunchCounts countsAtStart;   // the solver's launch counts before the first step
+  sim::LaunchCounts counts;          // what the run's steps asked of the device (sphxr/sim/launch_counts.h)
   float meanDensityError = 0.0f;     // of the last step
   float maxDensityError = 0.0f;      // of the last step
   float peakMeanDensityError = 0.0f; // over the run

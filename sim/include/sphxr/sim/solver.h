@@ -37,6 +37,9 @@ struct SolverConfig {
   Device device = Device::kAuto;
   int threads = 0;        // CPU backends (cpu, cpu-reference): 0 = all cores
   bool validate = false;  // check every stage for non-finite values (slow)
+  /// Time every stage (Totals::stageSeconds: the summary's and the panel's stage costs). On CUDA from
+  /// events on the stream, read after the step; off, no stage is timed at all.
+  bool stageTimes = true;
 };
 
 /// What Solver::Settle did.

@@ -2,9 +2,6 @@
 // Divergence-free SPH (Bender & Koschier 2015, 2017 [BK17]): the accurate solver, whose step follows the
 // flow speed instead of the sound speed. Two Jacobi solves per step, on the velocities: the divergence
 // (before the non-pressure forces) and the density (after them). The stages: solvers/dfsph/dfsph_stages.h.
-#include <thrust/fill.h>
-#include <thrust/reduce.h>
-
 #include "solvers/dfsph/dfsph_constants.h"
 #include "solvers/dfsph/dfsph_stages.h"
 #include "solvers/step_context.h"
@@ -86,43 +83,60 @@ class DfsphSolver final : public PressureSolver<Traits> {
     if constexpr (kPairCache) {
       m_pairStride = PairCacheStride(list.maxNeighbours);
       const size_t floats = n * static_cast<size_t>(m_pairStride);
-      if (m_pairGrad.size() != floats) m_pairGrad.resize(floats);
+      ctx.Device().Resize(m_pairGrad, floats);
     } else {
-      const size_t slots = n * static_cast<size_t>(list.maxNeighbours);
-      if (m_grad.size() != slots) m_grad.resize(slots);
+      ctx.Device().Resize(m_grad, n * static_cast<size_t>(list.maxNeighbours));
     }
     if (m_boundary.size() != n) {
-      m_boundary.resize(n);
-      m_factor.resize(n);
-      m_neighbours.resize(n);
-      m_delta.resize(n);
-      m_error.resize(n);
-      m_velocityStart.resize(n);
-      m_kappa.resize(n);
-      m_kappaV.resize(n);
+      DeviceOps<Traits>& device = ctx.Device();
+      device.Resize(m_boundary, n);
+      device.Resize(m_factor, n);
+      device.Resize(m_neighbours, n);
+      device.Resize(m_delta, n);
+      device.Resize(m_error, n);
+      device.Resize(m_velocityStart, n);
+      device.Resize(m_kappa, n);
+      device.Resize(m_kappaV, n);
     }
     ctx.Launch().ForEach(ctx.n, 64, DfsphFactorStage{ctx.grid, ctx.fluid, list, ctx.physics, View()});
   }
 
   /// Jacobi iterations of one solve until its mean residual is below `tolerance` (after at least
-  /// `minIterations`) or `maxIterations` were taken.
+  /// `minIterations`) or `maxIterations` were taken. The loop's decision is taken on the device
+  /// (DfsphSolveDecideStage); the host reads it every kCheckEvery iterations, and the iterations
+  /// launched past the end do nothing (UntilSolved), so the result is the same for any kCheckEvery.
   Result Solve(StepContext<Traits>& ctx, bool density, int minIterations, int maxIterations, float tolerance) {
     const int n = ctx.n;
     const NeighbourList list = ctx.Neighbours();
     const DfsphView view = View();
     const float scale = density ? 1.0f / ctx.dt : 1.0f;
-    auto& kappa = density ? m_kappa : m_kappaV;
-    thrust::fill(Traits::Policy(), kappa.begin(), kappa.end(), 0.0f);
-    Result result;
-    for (;;) {
-      ctx.Launch().ForEach(n, 64, DfsphPredictStage{ctx.grid, ctx.fluid, list, ctx.physics, view, ctx.dt, density});
-      const uint64_t sum = thrust::reduce(Traits::Policy(), m_error.begin(), m_error.end(), uint64_t{0});
-      result.error = n > 0 ? static_cast<float>(static_cast<double>(sum) / kErrorScale / n) : 0.0f;
-      if ((result.error <= tolerance && result.iterations >= minIterations) || result.iterations >= maxIterations) break;
-      ctx.Launch().ForEach(n, 64, DfsphCorrectStage{ctx.grid, ctx.fluid, list, ctx.physics, view, scale, density});
-      ++result.iterations;
+    DeviceOps<Traits>& device = ctx.Device();
+    device.Fill(density ? m_kappa : m_kappaV, 0.0f);
+    device.Resize(m_state, 1);
+    DfsphSolveState* state = Raw(m_state);
+    device.ForEach(1, DfsphSolveResetStage{state});
+    const DfsphPredictStage predict{ctx.grid, ctx.fluid, list, ctx.physics, view, ctx.dt, density};
+    const DfsphCorrectStage correct{ctx.grid, ctx.fluid, list, ctx.physics, view, scale, density};
+    DfsphSolveState last{};
+    for (int k = 1;; ++k) {
+      if constexpr (kCheckEvery == 1) {
+        ctx.Launch().ForEach(n, 64, predict);
+      } else {
+        ctx.Launch().ForEach(n, 64, UntilSolved<DfsphPredictStage>{state, predict});
+      }
+      device.SumInto(Raw(m_error), n, &state->sum);
+      device.ForEach(1, DfsphSolveDecideStage{state, n, tolerance, minIterations, maxIterations});
+      if (k % kCheckEvery == 0) {
+        last = device.Read(m_state, 0);
+        if (last.done) break;
+      }
+      if constexpr (kCheckEvery == 1) {
+        ctx.Launch().ForEach(n, 64, correct);
+      } else {
+        ctx.Launch().ForEach(n, 64, UntilSolved<DfsphCorrectStage>{state, correct});
+      }
     }
-    return result;
+    return Result{last.iterations, last.error};
   }
 
   DfsphView View() {
@@ -134,6 +148,9 @@ class DfsphSolver final : public PressureSolver<Traits> {
   /// Whether the launcher's SIMD passes keep G_ij lane-blocked (the CPU's, solvers/dfsph/dfsph_simd.h) in place of the
   /// scalar stages' Vec3 a slot.
   static constexpr bool kPairCache = kLauncherPairCache<Traits>;
+  /// How often the host reads a solve's state: every iteration where that read costs nothing (the
+  /// CPU's launcher, whose SIMD passes then need no gate), else the launcher's period.
+  static constexpr int kCheckEvery = kLauncherSolveCheckEvery<Traits>;
 
   DfsphConstants m_c{};
   Vector<Vec3> m_grad;       // G_ij a neighbour slot (the scalar stages)
@@ -146,6 +163,7 @@ class DfsphSolver final : public PressureSolver<Traits> {
   Vector<uint64_t> m_error;
   Vector<Vec4> m_velocityStart;
   Vector<float> m_kappa, m_kappaV;
+  Vector<DfsphSolveState> m_state;  // the running solve's (one)
 };
 
 }  // namespace sphxr::sim

@@ -286,4 +286,52 @@ struct DfsphFinishStage {
   }
 };
 
+// ---- a solve's loop on the device --------------------------------------------------------------------
+/// Where a solve stands, kept on the device between its iterations: the last residual's integer sum
+/// (written by the launch layer's SumInto), the mean error it is, the corrections taken, and whether
+/// the solve has ended. The host reads it only every few iterations (DfsphSolver::Solve).
+struct DfsphSolveState {
+  uint64_t sum;
+  float error;
+  int32_t iterations;
+  int32_t done;
+};
+
+/// Clears a solve's state (one item).
+struct DfsphSolveResetStage {
+  DfsphSolveState* state;
+  SPHXR_HD void operator()(int) const { *state = DfsphSolveState{0, 0.0f, 0, 0}; }
+};
+
+/// After a prediction's residual sum: the mean error, and whether the solve ends here (below the
+/// tolerance after at least the minimum iterations, or at the maximum); else one more correction is
+/// counted, the one that follows (one item).
+struct DfsphSolveDecideStage {
+  DfsphSolveState* state;
+  int n;
+  float tolerance;
+  int minIterations, maxIterations;
+  SPHXR_HD void operator()(int) const {
+    DfsphSolveState& s = *state;
+    if (s.done) return;
+    s.error = n > 0 ? static_cast<float>(static_cast<double>(s.sum) / kErrorScale / n) : 0.0f;
+    if ((s.error <= tolerance && s.iterations >= minIterations) || s.iterations >= maxIterations) {
+      s.done = 1;
+    } else {
+      ++s.iterations;
+    }
+  }
+};
+
+/// A solve's pass that does nothing once the solve has ended: the iterations launched after the end
+/// (between two of the host's reads of the state) cost a launch each and change nothing.
+template <class F>
+struct UntilSolved {
+  const DfsphSolveState* state;
+  F stage;
+  SPHXR_HD void operator()(int i) const {
+    if (!state->done) stage(i);
+  }
+};
+
 }  // namespace sphxr::sim

@@ -3,10 +3,7 @@
 // [MM13]): the real-time solver. A fixed number of Jacobi iterations of the density constraint on
 // predicted positions per step, so a step costs the same at any speed and the water can advance by
 // one displayed frame per step (docs/design/pbf.md). The stages: solvers/pbf/pbf_stages.h.
-#include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/transform_reduce.h>
+#include <thrust/functional.h>
 
 #include <utility>
 
@@ -26,8 +23,8 @@ class PbfSolver final : public PressureSolver<Traits> {
     m_c = MakePbfConstants(scene, physics);
     m_reach = physics;
     m_reach.kernel = CubicSpline::Make(physics.kernel.H + m_c.margin);
-    m_gate.resize(1);
-    thrust::fill(Traits::Policy(), m_gate.begin(), m_gate.end(), 1);
+    this->Device().Resize(m_gate, 1);
+    this->Device().Fill(m_gate, 1);
     m_referenced = false;
   }
 
@@ -37,8 +34,7 @@ class PbfSolver final : public PressureSolver<Traits> {
     m_step = ph.step;
     m_frameTime += dt;
     const bool check = m_c.margin > 0.0f && m_referenced && m_reference.size() == static_cast<size_t>(fluid.count);
-    thrust::for_each_n(Traits::Policy(), thrust::counting_iterator<int>(0), fluid.count,
-                       PbfPredictStage{fluid, ph, m_c, dt, check ? Raw(m_reference) : nullptr, Raw(m_gate)});
+    this->Device().ForEach(fluid.count, PbfPredictStage{fluid, ph, m_c, dt, check ? Raw(m_reference) : nullptr, Raw(m_gate)});
   }
 
   /// The grid and the skin's lists once per displayed frame (its first substep), and again where the
@@ -46,7 +42,7 @@ class PbfSolver final : public PressureSolver<Traits> {
   const int* GridGate(bool resorted) override {
     if (m_c.margin <= 0.0f) return nullptr;
     const bool frameStart = m_c.substeps <= 1 || (m_step - 1) % m_c.substeps == 0;
-    if (resorted || frameStart || !m_referenced) thrust::fill(Traits::Policy(), m_gate.begin(), m_gate.end(), 1);
+    if (resorted || frameStart || !m_referenced) this->Device().Fill(m_gate, 1);
     return Raw(m_gate);
   }
 
@@ -65,16 +61,15 @@ class PbfSolver final : public PressureSolver<Traits> {
     // 3. pbf_iterations Jacobi iterations of the density constraint                 [MM13 eq. 9-13]
     const NeighbourList list = ctx.Neighbours();
     const PbfView view = View(ph.maxNeighbours);
-    thrust::fill(Traits::Policy(), m_lambdaSum.begin(), m_lambdaSum.end(), 0.0f);
+    ctx.Device().Fill(m_lambdaSum, 0.0f);
     for (int k = 0; k < m_c.iterations; ++k) {
       ctx.Launch().ForEach(ctx.n, 64, PbfLambdaStage{ctx.grid, ctx.fluid, list, ph, m_c, view});
       ctx.Launch().ForEach(ctx.n, 64, PbfCorrectStage{ctx.grid, ctx.fluid, list, ph, m_c, view});
       ctx.Map(PbfApplyStage{ctx.fluid, ph, m_c, view});
     }
     ctx.report.densityIterations = m_c.iterations;
-    const thrust::counting_iterator<int> first(0);
-    const double residual = thrust::transform_reduce(Traits::Policy(), first, first + ctx.n,
-                                                     PbfResidual{ctx.fluid, ph.invRestDensity}, 0.0, thrust::plus<double>());
+    const double residual =
+        ctx.Device().TransformReduce(ctx.n, PbfResidual{ctx.fluid, ph.invRestDensity}, 0.0, thrust::plus<double>());
     ctx.report.densityError = ctx.n > 0 ? static_cast<float>(residual / ctx.n) : 0.0f;
     SPHXR_TRY(ctx.Lap(Stage::kPressure));
     // 4. velocities from the position change, the clamps, the pressure estimate            [MM13 alg. 1]
@@ -86,7 +81,7 @@ class PbfSolver final : public PressureSolver<Traits> {
     }
     // 5b. vorticity confinement, when the scene asks for it                            [MM13 eq. 15-16]
     if (m_c.vorticity > 0.0f) {
-      if (m_vorticity.size() != static_cast<size_t>(ctx.n)) m_vorticity.resize(static_cast<size_t>(ctx.n));
+      if (m_vorticity.size() != static_cast<size_t>(ctx.n)) this->Device().Resize(m_vorticity, static_cast<size_t>(ctx.n));
       ctx.Launch().ForEach(ctx.n, 64, PbfVorticityStage{ctx.grid, ctx.fluid, list, ph, Raw(m_vorticity)});
       ctx.Launch().ForEach(ctx.n, 64,
                            PbfConfinementStage{ctx.grid, ctx.fluid, list, ph, m_c, view, Raw(m_vorticity), ctx.dt});
@@ -127,15 +122,15 @@ class PbfSolver final : public PressureSolver<Traits> {
     }
     const size_t n = static_cast<size_t>(ctx.n);
     const size_t slots = n * static_cast<size_t>(m_c.skinCapacity);
-    if (m_skinIndex.size() != slots) m_skinIndex.resize(slots);
-    if (m_skinCount.size() != n) m_skinCount.resize(n);
-    if (m_reference.size() != n) m_reference.resize(n);
+    if (m_skinIndex.size() != slots) this->Device().Resize(m_skinIndex, slots);
+    if (m_skinCount.size() != n) this->Device().Resize(m_skinCount, n);
+    if (m_reference.size() != n) this->Device().Resize(m_reference, n);
     const NeighbourList skin{Raw(m_skinIndex), Raw(m_skinCount), m_c.skinCapacity};
     const int* gate = Raw(m_gate);
     if (ctx.Launch().Launches(gate)) {
       ctx.ListsWithin(skin, m_reach, gate);
       ctx.Map(PbfReferenceStage{ctx.fluid, Raw(m_reference), gate});
-      thrust::fill(Traits::Policy(), m_gate.begin(), m_gate.end(), 0);
+      ctx.Device().Fill(m_gate, 0);
       m_referenced = true;
     }
     ctx.Launch().ForEach(ctx.n, 64, PbfNearListStage{ctx.fluid, skin, ctx.Neighbours(), ctx.physics.kernel.H2});
@@ -144,17 +139,17 @@ class PbfSolver final : public PressureSolver<Traits> {
   void Size(int n) {
     const size_t count = static_cast<size_t>(n);
     if (m_lambda.size() == count) return;
-    m_lambda.resize(count);
-    m_lambdaSum.resize(count);
-    m_delta.resize(count);
-    m_boundaryGrad.resize(count);
-    if constexpr (kPairCache) m_ownCorrection.resize(count);
+    this->Device().Resize(m_lambda, count);
+    this->Device().Resize(m_lambdaSum, count);
+    this->Device().Resize(m_delta, count);
+    this->Device().Resize(m_boundaryGrad, count);
+    if constexpr (kPairCache) this->Device().Resize(m_ownCorrection, count);
   }
   PbfView View(int maxNeighbours) {
     PbfView v{Raw(m_lambda), Raw(m_lambdaSum), Raw(m_delta), Raw(m_boundaryGrad), nullptr, nullptr, 0};
     if constexpr (kPairCache) {
       v.pairStride = PairCacheStride(maxNeighbours);
-      m_pairGrad.resize(m_lambda.size() * static_cast<size_t>(v.pairStride));
+      this->Device().Resize(m_pairGrad, m_lambda.size() * static_cast<size_t>(v.pairStride));
       v.pairGrad = Raw(m_pairGrad);
       v.ownCorrection = Raw(m_ownCorrection);
     }
