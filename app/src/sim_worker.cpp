@@ -252,6 +252,7 @@ void SimWorker::ApplyPendingReset(Pacing* pacing) {
   }
   pacing->Restart(m_sim->Solver());
   m_notice.reset();  // the new scene is judged anew
+  m_frameRateSet = 0.0;  // the new simulation takes the display's rate again
   double zero[static_cast<int>(sim::Stage::kCount)] = {};
   Publish(zero, 0.0);
 }
@@ -265,8 +266,10 @@ void SimWorker::AdvanceWithNewestHands(bool oneStep) {
     hands = m_hands;
     frameRate = m_frameRate;
   }
-  // The display's rate becomes the frame's, between two frames (a change of more than 0.1 %).
-  if (frameRate > 0.0 && std::abs(frameRate * m_sim->FramePeriod() - 1.0) > 1e-3 && m_sim->SetFrameRate(frameRate)) {
+  // The display's rate becomes the frame's from the simulation's next frame (a change of more than 0.1 %).
+  const double current = m_frameRateSet > 0.0 ? m_frameRateSet : 1.0 / m_sim->FramePeriod();
+  if (frameRate > 0.0 && std::abs(frameRate / current - 1.0) > 1e-3 && m_sim->SetFrameRate(frameRate)) {
+    m_frameRateSet = frameRate;
     SPHXR_LOG_INFO("frame: %.2f Hz, the display's rate (the scene's paddles.frame_rate is %g Hz)", frameRate,
                    m_scene.paddleFrameRate);
   }

@@ -137,6 +137,7 @@ class SimWorker {
   std::atomic<int> m_stepRequests{0};
   double m_rateSteps = 0.0, m_rateSim = 0.0;
   double m_frameRate = 0.0;  // SetFrameRate's (under m_mutex); 0: the scene's
+  double m_frameRateSet = 0.0;  // the rate given to the worker's simulation (the worker thread's)
   std::unique_ptr<RealTimeNotice> m_notice;  // the worker thread's: the line when real time is out of reach
   RealTimeNotice& RealTimeNoticeOf(const sim::Solver& solver);
   std::chrono::steady_clock::time_point m_lastSurface{};

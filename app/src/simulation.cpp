@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "sphxr/app/scene_file.h"
 #include "sphxr/app/state_file.h"
@@ -49,7 +50,7 @@ Status Simulation::Create(const SimScene& scene, const SimulationConfig& config,
   run->m_setup = scene.setup;
   // One frame clock: PBF substeps the displayed frame, whose period is the paddles' (pbf_frame is the
   // period only where no Simulation sets it: the sim library alone).
-  const float period = static_cast<float>(run->FramePeriod());
+  const float period = 1.0f / static_cast<float>(scene.paddleFrameRate);  // (float: 90 Hz is the default's bits)
   float& pbfFrame = run->m_setup.params.pbfFrame;
   if (pbfFrame != sim::SolverParams{}.pbfFrame && std::abs(pbfFrame - period) > 1e-6f * period) {
     SPHXR_LOG_WARN("pbf_frame %.4g s is not used: PBF substeps the displayed frame, 1 / paddles.frame_rate = %.4g s",
@@ -107,13 +108,22 @@ Status Simulation::SetFrameRate(double hz) {
   if (!(hz >= kMinFrameRate && hz <= kMaxFrameRate)) {
     return Status::Error(Format("frame rate %g Hz is out of range [%g, %g]", hz, kMinFrameRate, kMaxFrameRate));
   }
+  m_pendingFrameRate = hz;
+  return Status::Ok();
+}
+
+Status Simulation::BeginFrameRate() {
+  if (m_pendingFrameRate <= 0.0) return Status::Ok();
+  const double hz = std::exchange(m_pendingFrameRate, 0.0);
+  if (Status s = m_solver->SetPbfFrame(1.0f / static_cast<float>(hz)); !s) return s;  // PBF substeps the new frame
   m_scene.paddleFrameRate = hz;
   return Status::Ok();
 }
 
 Status Simulation::Step(const std::vector<interaction::HandInput>& hands) {
   if (m_solver->Time() >= m_nextFrame - 1e-9) {
-    // A frame: the hands become the paddles' targets one frame ahead in simulated time.
+    // A frame: at the display's newest rate, the hands the paddles' targets one frame ahead.
+    if (Status s = BeginFrameRate(); !s) return s;
     m_nextFrame += FramePeriod();
     if (m_paddles) {
       std::vector<interaction::HandInput> framed = hands;

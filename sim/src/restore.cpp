@@ -114,6 +114,15 @@ Status Solver::RestoreDiffuse(const HostDiffuse& diffuse) {
   return Status::Ok();
 }
 
+Status Solver::SetPbfFrame(float seconds) {
+  SceneSetup changed = m_scene;
+  changed.params.pbfFrame = seconds;
+  if (Status s = ValidateScene(changed); !s) return s;
+  m_scene.params.pbfFrame = seconds;
+  SceneChanged();
+  return Status::Ok();
+}
+
 Status Solver::SetReuse(const ReuseParams& reuse) {
   if (Status s = ValidateReuse(reuse); !s) return s;
   m_scene.reuse = reuse;

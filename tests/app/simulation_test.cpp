@@ -185,9 +185,10 @@ TEST(SimulationTest, ANewFrameRateTakesEffectAtTheNextFrameAndOutOfRangeIsRefuse
   const double firstEnd = run->NextFrame();
   ASSERT_TRUE(run->SetFrameRate(72.0).ok());  // a headset displaying at 72 Hz
   EXPECT_EQ(run->NextFrame(), firstEnd);       // the frame under way keeps its end
-  EXPECT_EQ(run->FramePeriod(), 1.0 / 72.0);
   ASSERT_TRUE(run->AdvanceFrame().ok());
+  EXPECT_EQ(run->FramePeriod(), 1.0 / 72.0);
   EXPECT_EQ(run->NextFrame(), firstEnd + 1.0 / 72.0);
+  EXPECT_EQ(run->Solver().Scene().params.pbfFrame, 1.0f / 72.0f);  // PBF substeps the new frame
   for (double hz : {0.0, -90.0, 0.5, 5000.0, std::numeric_limits<double>::quiet_NaN(),
                     std::numeric_limits<double>::infinity()}) {
     const Status s = run->SetFrameRate(hz);

@@ -126,14 +126,18 @@ class Simulation {
   /// 1/SimScene::paddleFrameRate: the displayed frame, in simulated s.
   double FramePeriod() const { return 1.0 / m_scene.paddleFrameRate; }
   /// The displayed frame's rate from the next frame on (the headset's display rate): the frame under
-  /// way ends where it was planned. Refused unless finite and in [kMinFrameRate, kMaxFrameRate] Hz.
+  /// way ends where it was planned; the next has the new period, and PBF substeps it (Solver::
+  /// SetPbfFrame). Refused unless finite and in [kMinFrameRate, kMaxFrameRate] Hz.
   Status SetFrameRate(double hz);
   static constexpr double kMinFrameRate = 1.0, kMaxFrameRate = 1000.0;
 
  private:
   Simulation() = default;
 
+  Status BeginFrameRate();  // a new frame takes SetFrameRate's rate
+
   SimScene m_scene;
+  double m_pendingFrameRate = 0.0;  // Hz, SetFrameRate's, taken when the next frame begins (0: none)
   sim::SceneSetup m_setup;
   std::unique_ptr<sim::Solver> m_solver;
   std::unique_ptr<interaction::PaddleSystem> m_paddles;  // bound to m_solver (destroyed before it)

@@ -128,6 +128,9 @@ class Solver {
   /// Changes the reuse parameters from the next step on (the panel, the benchmarks). Every particle
   /// starts active again (idle counts reset), so no particle reuses values from before the change.
   Status SetReuse(const ReuseParams& reuse);
+  /// The frame PBF substeps (solver.pbf_frame, s) from the next step on: the displayed frame's period
+  /// when the display sets it (app::Simulation). Out of pbf_frame's range: refused, nothing changes.
+  Status SetPbfFrame(float seconds);
   /// Replaces the fluid state (tests, restarts). Sizes must match FluidCount().
   Status Upload(const HostFluid& fluid);
   /// The clock, for a state file (app/src/state_file.h).
