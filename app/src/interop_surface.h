@@ -24,4 +24,9 @@ class InteropSurface {
   uint64_t m_written = 0;  // the newest build in m_mesh
 };
 
+/// Vertices for the interop buffers of the next write, from their current capacity and the solver's
+/// last write report (Solver::LastSurfaceWrite, a frame late on the CUDA device): unchanged while the
+/// mesh fits; else max(1.25x the mesh, 1.5x the capacity, 3 x 4096), whole triangles, at most 2^26.
+int64_t InteropCapacity(int64_t capacity, const sim::SurfaceWriteReport& last);
+
 }  // namespace sphxr::app

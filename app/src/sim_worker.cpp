@@ -3,10 +3,10 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 
+#include "interop_surface.h"  // InteropCapacity
 #include "sphxr/app/scene_file.h"
 #include "sphxr/common/log.h"
 
@@ -361,28 +361,6 @@ std::unique_lock<std::mutex> SimWorker::LockSolver() {
   return std::unique_lock(m_solverMutex);
 }
 
-std::string DefaultStatePath(const std::string& sceneName) {
-  // The scene's name comes from a file that may be shared: only its letters, digits, '-', '_' and inner
-  // '.' make the file name (a name like "../x" or "/abs/x" saved outside the working directory).
-  std::string stem;
-  char previous = '\0';
-  for (char c : sceneName) {
-    const bool safe = std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ||
-                      (c == '.' && std::isalnum(static_cast<unsigned char>(previous)));
-    stem += safe ? c : '_';
-    previous = c;
-  }
-  if (stem.find_first_not_of('_') == std::string::npos) stem = "sphxr";
-  // A file name has at most 255 bytes: a long scene name is cut (its "-lost" and ".state" still fit).
-  if (stem.size() > kMaxStateStem) stem.resize(kMaxStateStem);
-  return stem + ".state";
-}
-
-std::string LostStatePath(const std::string& sceneName) {
-  const std::string path = DefaultStatePath(sceneName);
-  return path.substr(0, path.size() - 6) + "-lost.state";
-}
-
 std::string SimWorker::SaveStateLogged(const std::string& savePath, const std::string& sceneName) {
   const std::string path = !savePath.empty() ? savePath : DefaultStatePath(sceneName);
   Status s;
@@ -454,15 +432,6 @@ Status SimWorker::WriteSurfaceInto(std::unique_ptr<render::InteropMesh>* mesh, u
   if (!written) return written;
   *build = m_builtBuild;
   return Status::Ok();
-}
-
-int64_t InteropCapacity(int64_t capacity, const sim::SurfaceWriteReport& last) {
-  constexpr int64_t kMaxVertices = int64_t{1} << 26;
-  constexpr int64_t kLeast = 3 * 4096;
-  if (capacity >= kLeast && !(last.vertices > capacity)) return capacity;
-  // Geometric growth, as the solver's own buffer (docs/dev/surface.md): O(log) re-creations, each logged.
-  int64_t grown = std::min(kMaxVertices, std::max<int64_t>({last.vertices + last.vertices / 4, capacity + capacity / 2, kLeast}));
-  return grown - grown % 3;
 }
 
 void SimWorker::FallBackToHostCopy(const std::string& why) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "realtime_notice.h"
+#include "state_paths.h"
 #include "sphxr/app/simulation.h"
 #include "sphxr/app/snapshot.h"
 #include "sphxr/app/state_file.h"
@@ -26,16 +27,6 @@
 #include "sphxr/sim/solver.h"
 
 namespace sphxr::app {
-
-/// Bytes of a scene's name kept in a state file's default name.
-inline constexpr size_t kMaxStateStem = 100;
-/// "<scene name>.state" for a save without --save-state: the name's letters, digits, '-', '_' and a '.'
-/// after a letter or digit only (others become '_'), so a shared scene cannot name a path outside the
-/// working directory, its first kMaxStateStem bytes only; "sphxr.state" for a name without any.
-std::string DefaultStatePath(const std::string& sceneName);
-/// "<scene name>-lost.state" (the same name rule): where a lost headset session's water goes when no
-/// --save-state was given, beside, not over, what the save button wrote.
-std::string LostStatePath(const std::string& sceneName);
 
 class SimWorker {
  public:
@@ -149,10 +140,5 @@ class SimWorker {
   uint64_t m_builds = 0;        // surfaces built so far (all solvers); guarded by m_solverMutex
   uint64_t m_builtBuild = 0;    // the current solver's last build on the interop path (0: none)
 };
-
-/// Vertices for the interop buffers of the next write, from their current capacity and the solver's
-/// last write report (Solver::LastSurfaceWrite, a frame late on the CUDA device): unchanged while the
-/// mesh fits; else max(1.25x the mesh, 1.5x the capacity, 3 x 4096), whole triangles, at most 2^26.
-int64_t InteropCapacity(int64_t capacity, const sim::SurfaceWriteReport& last);
 
 }  // namespace sphxr::app
