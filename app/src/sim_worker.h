@@ -94,8 +94,8 @@ class SimWorker {
  private:
   struct Pacing;  // the worker thread's clocks (sim_worker.cpp)
   std::unique_lock<std::mutex> LockSolver();
-  /// The worker thread: a pending reset, a pending save, then a step when it is due (or asked for),
-  /// and a snapshot at most 60 times a second.
+  /// The worker thread: a pending reset, a pending save, then a frame when it is due (or the window's
+  /// single step), and a snapshot after it.
   void Run();
   void ApplyPendingReset(Pacing* pacing);
   void SaveIfAsked();
