@@ -136,6 +136,11 @@ struct FieldStage {
   /// Indices [lo, hi] of the samples first + i (i in [0, n)) at spacing h with |s_i - q| < reach.
   SPHXR_HD SPHXR_INLINE static void Clip(float q, float first, float invH, float reachCells, int n, int* lo, int* hi) {
     const float t = (q - first) * invH;
+    if (!(fabsf(t) < 1e9f)) {  // a non-finite particle (or one 1e9 samples away) reaches no sample
+      *lo = 0;
+      *hi = -1;
+      return;
+    }
     const int a = static_cast<int>(ceilf(t - reachCells)), b = static_cast<int>(floorf(t + reachCells));
     *lo = a < 0 ? 0 : a;
     *hi = b > n - 1 ? n - 1 : b;
