@@ -6,7 +6,7 @@
 #include <thrust/system/omp/vector.h>
 
 #include "backend_impl.h"
-#include "launch/host_clock.h"
+#include "launch/omp_system.h"
 #include "cpu/launcher.h"
 #include "cpu/team.h"
 #include "sphxr/common/log.h"
@@ -15,29 +15,12 @@
 namespace sphxr::sim {
 namespace {
 
-struct OmpTraits {
-  template <class T>
-  using Vector = thrust::omp::vector<T>;
-  static auto Policy() { return thrust::omp::par; }
-  /// The launch layer's policy: thrust's OpenMP system with its temporaries kept (launch/temporaries.h).
-  template <class Temporaries>
-  static auto Policy(Temporaries& temporaries) {
-    return thrust::omp::par(temporaries);
-  }
-  static void* AllocateBytes(size_t bytes) { return ::operator new(bytes); }
-  static void FreeBytes(void* block) { ::operator delete(block); }
-  template <class Temporaries, class It, class T>
-  static void SumInto(Temporaries& temporaries, It first, int n, T* out) {
-    *out = thrust::reduce(Policy(temporaries), first, first + n, T{});
-  }
-  template <class T>
-  using StageClock = HostStageClock<T>;  // stage timings on the host's clock (launch/host_clock.h)
-  static Status Sync(const char* /*stage*/) { return Status::Ok(); }  // thrust's OpenMP calls return when done
+struct OmpTraits : OmpSystem {
   static constexpr const char* kName = "cpu";
   static constexpr CountModel kCountsAs = CountModel::kCpu;  // a parallel loop or algorithm is one launch; nothing waits
   static constexpr bool kOnDevice = false;  // where the surface mesh lives
-  static constexpr int kTraversalRun = 256;
-  static constexpr bool kSurfaceOverParticles = true;  // host memory: the particles' bounds cost no wait  // a descent per run of vertices: few threads, each stepping along the mesh
+  static constexpr int kTraversalRun = 256;  // a descent per run of vertices: few threads, each stepping along the mesh
+  static constexpr bool kSurfaceOverParticles = true;  // host memory: the particles' bounds cost no wait
   using Launcher = CpuLauncher<OmpTraits>;  // the SIMD density, force and wall-pressure stages (cpu/launcher.h)
 };
 

@@ -9,30 +9,13 @@
 #include <thrust/system/omp/vector.h>
 
 #include "backend_impl.h"
-#include "launch/host_clock.h"
+#include "launch/omp_system.h"
 #include "launch/plain.h"
 
 namespace sphxr::sim {
 namespace {
 
-struct OmpReferenceTraits {
-  template <class T>
-  using Vector = thrust::omp::vector<T>;
-  static auto Policy() { return thrust::omp::par; }
-  /// The launch layer's policy: thrust's OpenMP system with its temporaries kept (launch/temporaries.h).
-  template <class Temporaries>
-  static auto Policy(Temporaries& temporaries) {
-    return thrust::omp::par(temporaries);
-  }
-  static void* AllocateBytes(size_t bytes) { return ::operator new(bytes); }
-  static void FreeBytes(void* block) { ::operator delete(block); }
-  template <class Temporaries, class It, class T>
-  static void SumInto(Temporaries& temporaries, It first, int n, T* out) {
-    *out = thrust::reduce(Policy(temporaries), first, first + n, T{});
-  }
-  template <class T>
-  using StageClock = HostStageClock<T>;  // stage timings on the host's clock (launch/host_clock.h)
-  static Status Sync(const char* /*stage*/) { return Status::Ok(); }
+struct OmpReferenceTraits : OmpSystem {
   static constexpr const char* kName = "cpu-reference";
   static constexpr CountModel kCountsAs = CountModel::kCuda;  // counts what the CUDA backend launches (launch/kernels.h)
   static constexpr bool kOnDevice = false;   // the mesh is host memory (CUDA's is device memory: the only difference)
